@@ -1,0 +1,61 @@
+"""Deformation diagnostics that tell physics from noise (DESIGN §8, GitHub issue 7).
+
+Works on plain arrays (node positions in m, CCW triangles, window in s) so it
+applies equally to model output and to RGPS-like Lagrangian data:
+
+- :func:`velocity_gradients`, :func:`lagrangian_velocity_gradients`:
+  per-triangle gradients and invariants (divergence, shear, total; s-1);
+- :func:`coarse_grain`, :func:`spatial_scaling`: ⟨ε̇tot⟩(L) ∝ L^−β (seed 001 §3.5);
+- :func:`temporal_scaling`: ⟨ε̇tot⟩(T) ∝ T^−α;
+- :func:`log_binned_pdf`, :func:`fit_power_law_tail`: PDFs and ML tail exponents;
+- :func:`localisation_area_fraction`, :func:`shear_divergence_r2`;
+- :func:`summarise`, :func:`write_json`, :func:`write_figures`, :func:`diagnose_arrays`.
+
+See ``docs/diagnostics.md``.
+"""
+
+from lagice.diagnostics.strain import (
+    ElementStrainRates,
+    divergence_rate,
+    lagrangian_velocity_gradients,
+    shear_rate,
+    total_deformation_rate,
+    triangle_geometry,
+    velocity_gradients,
+)
+from lagice.diagnostics.scaling import (
+    CoarseGraining,
+    PowerLawFit,
+    SpatialScaling,
+    TemporalScaling,
+    coarse_grain,
+    default_box_sizes,
+    fit_power_law,
+    spatial_scaling,
+    temporal_scaling,
+)
+from lagice.diagnostics.statistics import (
+    LogBinnedPdf,
+    PowerLawTail,
+    fit_power_law_tail,
+    localisation_area_fraction,
+    log_binned_pdf,
+    shear_divergence_r2,
+)
+from lagice.diagnostics.report import (
+    JSON_KEYS,
+    diagnose_arrays,
+    summarise,
+    write_figures,
+    write_json,
+)
+
+__all__ = [
+    "ElementStrainRates", "divergence_rate", "lagrangian_velocity_gradients", "shear_rate",
+    "total_deformation_rate", "triangle_geometry", "velocity_gradients",
+    "CoarseGraining", "PowerLawFit", "SpatialScaling", "TemporalScaling", "coarse_grain",
+    "default_box_sizes", "fit_power_law", "spatial_scaling", "temporal_scaling",
+    "LogBinnedPdf", "PowerLawTail", "fit_power_law_tail", "localisation_area_fraction",
+    "log_binned_pdf", "shear_divergence_r2",
+    "JSON_KEYS", "diagnose_arrays", "summarise", "write_figures", "write_json",
+]

@@ -1,0 +1,100 @@
+"""Physical parameters: one table with defaults, units and sources.
+
+Values and sources follow ``DESIGN.md`` §9 and seed 004 Table 1.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields, replace
+
+from .errors import ConfigError, check_range
+
+#: Gravity-free physical constants shared by the forcing/thermo packages.
+RHO_ICE = 900.0  # kg m-3, seed 004 Table 1
+RHO_AIR = 1.3  # kg m-3, seed 000
+RHO_WATER = 1025.0  # kg m-3, seed 000
+OMEGA_EARTH = 7.2921e-5  # rad s-1
+
+
+@dataclass(frozen=True)
+class MaxwellEBParams:
+    """Maxwell-Elasto-Brittle rheology parameters (seed 004 Table 1).
+
+    Attributes (units in brackets):
+        poisson: ν [-], 0 <= ν < 0.5
+        friction: μ internal friction coefficient [-]
+        rho_ice: ice density [kg m-3]
+        shear_wave_speed: cs [m s-1]; E0 = 2 cs² (1+ν) ρ unless ``young_modulus_pa`` given
+        young_modulus_pa: undamaged E0 [Pa] (None: derived from cs)
+        relaxation_time_s: undamaged λ0 [s]
+        alpha: damage exponent α > 1 of η ∝ (1-d)^α [-]
+        cohesion_min_pa, cohesion_max_pa: uniform range of cohesion C [Pa]
+        healing_time_s: th of constant-rate healing [s] (None or inf: no healing)
+        concentration_c: c* of exp(-c*(1-A)) [-]
+        max_damage: damage cap below 1 keeping E > 0 [-]
+    """
+
+    poisson: float = 0.3
+    friction: float = 0.7
+    rho_ice: float = RHO_ICE
+    shear_wave_speed: float = 500.0
+    young_modulus_pa: float | None = None
+    relaxation_time_s: float = 1.0e7
+    alpha: float = 4.0
+    cohesion_min_pa: float = 25.0e3
+    cohesion_max_pa: float = 50.0e3
+    healing_time_s: float | None = 1.0e5
+    concentration_c: float = 20.0
+    max_damage: float = 1.0 - 1.0e-6
+
+    def __post_init__(self):
+        check_range("poisson (ν)", self.poisson, 0.0, 0.5, high_open=True)
+        check_range("friction (μ)", self.friction, 0.0, None)
+        check_range("rho_ice", self.rho_ice, 0.0, None, low_open=True, unit="kg m-3")
+        check_range("shear_wave_speed", self.shear_wave_speed, 0.0, None, low_open=True, unit="m s-1")
+        if self.young_modulus_pa is not None:
+            check_range("young_modulus_pa (E0)", self.young_modulus_pa, 0.0, None, low_open=True, unit="Pa")
+        check_range("relaxation_time_s (λ0)", self.relaxation_time_s, 0.0, None, low_open=True, unit="s")
+        check_range("alpha (α)", self.alpha, 1.0, None, low_open=True)
+        check_range("cohesion_min_pa", self.cohesion_min_pa, 0.0, None, unit="Pa")
+        check_range("cohesion_max_pa", self.cohesion_max_pa, self.cohesion_min_pa, None, unit="Pa")
+        if self.healing_time_s is not None:
+            check_range("healing_time_s (th)", self.healing_time_s, 0.0, None, low_open=True, unit="s")
+        check_range("concentration_c (c*)", self.concentration_c, 0.0, None)
+        check_range("max_damage", self.max_damage, 0.0, 1.0, high_open=True)
+
+    @property
+    def E0(self) -> float:
+        """Undamaged Young modulus [Pa]: E0 = 2 cs² (1+ν) ρ (seed 004 Table 1)."""
+        if self.young_modulus_pa is not None:
+            return float(self.young_modulus_pa)
+        return 2.0 * self.shear_wave_speed**2 * (1.0 + self.poisson) * self.rho_ice
+
+    @property
+    def q(self) -> float:
+        """Slope of the Mohr-Coulomb envelope, seed 004 eq. 3."""
+        return (math.sqrt(self.friction**2 + 1.0) + self.friction) ** 2
+
+    def replace(self, **changes) -> "MaxwellEBParams":
+        names = {f.name for f in fields(self)}
+        for k in changes:
+            if k not in names:
+                raise ConfigError(f"unknown rheology parameter {k!r}; known: {sorted(names)}")
+        return replace(self, **changes)
+
+
+@dataclass(frozen=True)
+class DragParams:
+    """Air/ocean drag and Coriolis parameters (seed 000; DESIGN.md §9)."""
+
+    rho_air: float = RHO_AIR
+    air_drag: float = 1.2e-3
+    rho_water: float = RHO_WATER
+    water_drag: float = 5.5e-3
+    turning_angle_deg: float = 0.0
+    coriolis_f: float = 0.0  # s-1; use coriolis_from_latitude for f(lat)
+
+
+def coriolis_from_latitude(lat_deg: float) -> float:
+    """Coriolis parameter f = 2 Ω sin(lat) [s-1]."""
+    return 2.0 * OMEGA_EARTH * math.sin(math.radians(lat_deg))

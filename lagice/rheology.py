@@ -1,0 +1,186 @@
+"""Maxwell-Elasto-Brittle rheology as functions of state (no mesh, no solver).
+
+Conventions (DESIGN.md §2-3): stress is tension positive, stored per element as
+(σxx, σyy, σxy) [Pa]; damage d ∈ [0, 1), 0 undamaged, 1 fully damaged
+(seed 004 uses d_seed = 1 − d).
+
+* stiffness   E = E0 (1−d) exp(−c*(1−A))                 (seed 004 eqs. 12, 17)
+* relaxation  λ = λ0 [(1−d) exp(−c*(1−A))]^(α−1)         (seed 004 eq. 12)
+* constitutive law  dσ/dt + σ/λ = E K:ε̇                   (seed 004 eq. 1)
+* Mohr–Coulomb envelope with tensile cut-off, d_crit        (seed 004 eqs. 2-8)
+* damage  dd/dt = (1−d_crit)(1−d)/td − H_heal, stress scaled onto the envelope
+                                                             (seed 004 eqs. 9-11)
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from .errors import ConfigError
+from .params import MaxwellEBParams
+
+
+def plane_stress_matrix(poisson: float) -> np.ndarray:
+    """K of DESIGN.md §3 acting on (ε̇xx, ε̇yy, ε̇xy) (tensor shear component)."""
+    nu = poisson
+    return np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 1.0 - nu]]) / (1.0 - nu * nu)
+
+
+def young_modulus(E0, damage, concentration, c_star):
+    """E = E0 (1−d) exp(−c*(1−A)) [Pa]."""
+    return E0 * (1.0 - damage) * np.exp(-c_star * (1.0 - concentration))
+
+
+def relaxation_time(lambda0, damage, concentration, c_star, alpha):
+    """λ = λ0 [(1−d) exp(−c*(1−A))]^(α−1) [s]; η = Eλ ∝ (1−d)^α."""
+    return lambda0 * ((1.0 - damage) * np.exp(-c_star * (1.0 - concentration))) ** (alpha - 1.0)
+
+
+def envelope(cohesion, friction):
+    """(q, σc, σT) of seed 004 eqs. 3, 4, 6: slope, uniaxial compressive strength
+    [Pa] and tensile strength [Pa, positive]."""
+    s = math.sqrt(friction * friction + 1.0)
+    q = (s + friction) ** 2
+    sigma_c = 2.0 * np.asarray(cohesion) / (s - friction)
+    return q, sigma_c, sigma_c / q
+
+
+@njit(cache=True, inline="always")
+def _principal(sxx, syy, sxy):
+    m = 0.5 * (sxx + syy)
+    r = math.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
+    return m + r, m - r
+
+
+@njit(cache=True, inline="always")
+def _dcrit(sxx, syy, sxy, cohesion, q, denom):
+    """d_crit of seed 004 eq. 8 in tension-positive form (DESIGN.md §3)."""
+    s1, s2 = _principal(sxx, syy, sxy)
+    sigma_c = 2.0 * cohesion / denom
+    sigma_t = sigma_c / q
+    dc = 1.0
+    if s1 > 0.0:
+        dc = min(dc, sigma_t / s1)
+    mc = q * s1 - s2
+    if mc > 0.0:
+        dc = min(dc, sigma_c / mc)
+    return dc
+
+
+def principal_stresses(sigma: np.ndarray):
+    """Principal stresses (s1 ≥ s2) [Pa] of (m, 3) stresses."""
+    sxx, syy, sxy = sigma[..., 0], sigma[..., 1], sigma[..., 2]
+    m = 0.5 * (sxx + syy)
+    r = np.sqrt(0.25 * (sxx - syy) ** 2 + sxy**2)
+    return m + r, m - r
+
+
+def dcrit(sigma: np.ndarray, cohesion, friction: float) -> np.ndarray:
+    """d_crit ∈ (0, 1] for (m, 3) stresses: 1 inside the envelope, the factor that
+    scales σ back onto it outside (seed 004 eq. 8)."""
+    sigma = np.atleast_2d(np.asarray(sigma, dtype=np.float64))
+    C = np.broadcast_to(np.asarray(cohesion, np.float64), (len(sigma),))
+    out = np.empty(len(sigma))
+    s = math.sqrt(friction * friction + 1.0)
+    _dcrit_kernel(sigma, np.ascontiguousarray(C), (s + friction) ** 2, s - friction, out)
+    return out
+
+
+@njit(cache=True, parallel=True)
+def _dcrit_kernel(sigma, cohesion, q, denom, out):
+    for e in prange(sigma.shape[0]):
+        out[e] = _dcrit(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom)
+
+
+@njit(cache=True, parallel=True)
+def damage_update_kernel(sigma, damage, cohesion, dt, td, heal_rate, q, denom, max_damage,
+                         dcrit_out):
+    """Explicit damage update with stress correction, in place (seed 004 eqs. 9-11).
+
+    Per element: r = min(1, dt/td_e)(1 − d_crit);  1 − d ← (1 − d)(1 − r);
+    σ ← σ (1 − r);  then healing d ← d − dt·H_e, floored at 0 (a fully healed
+    element). With dt = td this is seed 004's d_{n+1} = d_crit d_n. Damage is
+    capped at ``max_damage`` (< 1, keeps E > 0); the number of capped elements
+    is returned so the caller can report it.
+
+    ``heal_rate`` is an array (m,) [s-1] (zeros: no healing).
+    """
+    n_capped = 0
+    for e in prange(sigma.shape[0]):
+        dc = _dcrit(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom)
+        dcrit_out[e] = dc
+        d = damage[e]
+        if dc < 1.0:
+            r = min(1.0, dt / td[e]) * (1.0 - dc)
+            d = 1.0 - (1.0 - d) * (1.0 - r)
+            f = 1.0 - r
+            sigma[e, 0] *= f
+            sigma[e, 1] *= f
+            sigma[e, 2] *= f
+        d -= dt * heal_rate[e]
+        if d < 0.0:
+            d = 0.0
+        if d > max_damage:
+            d = max_damage
+            n_capped += 1
+        damage[e] = d
+    return n_capped
+
+
+def draw_cohesion(n_elements: int, params: MaxwellEBParams, rng: np.random.Generator) -> np.ndarray:
+    """Cohesion C [Pa] per element, uniform in [C_min, C_max] from a seeded generator
+    (quenched disorder, seed 004 §2.2)."""
+    if n_elements < 0:
+        raise ConfigError(f"n_elements = {n_elements} must be >= 0")
+    return rng.uniform(params.cohesion_min_pa, params.cohesion_max_pa, size=n_elements)
+
+
+class MaxwellEB:
+    """The Maxwell-EB rheology: parameters plus the element-wise laws.
+
+    The solvers (``lagice.solvers``) call :meth:`moduli` for E and λ and
+    :meth:`damage_update` after each step; nothing here knows about meshes.
+    """
+
+    name = "maxwell_eb"
+
+    def __init__(self, params: MaxwellEBParams | None = None, **overrides):
+        params = params or MaxwellEBParams()
+        self.params = params.replace(**overrides) if overrides else params
+        p = self.params
+        s = math.sqrt(p.friction**2 + 1.0)
+        self.q = (s + p.friction) ** 2
+        self._denom = s - p.friction
+        self.K = plane_stress_matrix(p.poisson)
+        self.n_capped_total = 0
+
+    @property
+    def E0(self) -> float:
+        return self.params.E0
+
+    def moduli(self, damage, concentration):
+        """(E [Pa], λ [s]) per element."""
+        p = self.params
+        E = young_modulus(p.E0, damage, concentration, p.concentration_c)
+        lam = relaxation_time(p.relaxation_time_s, damage, concentration, p.concentration_c, p.alpha)
+        return E, lam
+
+    def damage_time(self, element_size_m):
+        """td = Δx / cs [s] (seed 004 §3.1.1)."""
+        return np.asarray(element_size_m, np.float64) / self.params.shear_wave_speed
+
+    def constant_heal_rate(self, n: int) -> np.ndarray:
+        th = self.params.healing_time_s
+        rate = 0.0 if th is None or not np.isfinite(th) else 1.0 / th
+        return np.full(n, rate)
+
+    def damage_update(self, sigma, damage, cohesion, dt, td, heal_rate):
+        """Apply the damage/healing update in place; returns d_crit per element."""
+        out = np.empty(len(damage))
+        n = damage_update_kernel(sigma, damage, cohesion, float(dt), np.ascontiguousarray(td),
+                                 np.ascontiguousarray(heal_rate), self.q, self._denom,
+                                 self.params.max_damage, out)
+        self.n_capped_total += int(n)
+        return out

@@ -1,0 +1,77 @@
+"""Sparse linear solvers for the implicit step, chosen by measurement
+(``benchmarks/bench_implicit.py``): SuperLU (with factor reuse while the
+matrix is unchanged), Jacobi-preconditioned warm-started CG, and pyamg
+smoothed aggregation with rigid-body modes as a CG preconditioner."""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..errors import ConfigError, SolverError
+
+LINEAR_SOLVERS = ("cg", "superlu", "amg")
+
+
+class LinearSolver:
+    def __init__(self, kind: str = "cg", rtol: float = 1e-10, maxiter: int = 2000):
+        if kind not in LINEAR_SOLVERS:
+            raise ConfigError(f"linear_solver = {kind!r} is unknown; expected one of {LINEAR_SOLVERS}")
+        self.kind = kind
+        self.rtol = rtol
+        self.maxiter = maxiter
+        self._data_key = None
+        self._lu = None
+        self._amg = None
+        self.last_iterations = 0
+        self.nodes = None  # for rigid-body modes (amg)
+
+    def _changed(self, A) -> bool:
+        key = self._data_key
+        if key is not None and key.shape == A.data.shape and np.array_equal(key, A.data):
+            return False
+        self._data_key = A.data.copy()
+        return True
+
+    def solve(self, A: sp.csr_matrix, b: np.ndarray, x0: np.ndarray | None = None) -> np.ndarray:
+        if self.kind == "superlu":
+            if self._changed(A) or self._lu is None:
+                self._lu = spla.splu(A.tocsc(), permc_spec="COLAMD")
+            self.last_iterations = 1
+            x = self._lu.solve(b)
+        else:
+            count = [0]
+
+            def cb(_xk):
+                count[0] += 1
+
+            if self.kind == "cg":
+                dinv = 1.0 / A.diagonal()
+                M = spla.LinearOperator(A.shape, matvec=lambda r: dinv * r, dtype=np.float64)
+            else:
+                if self._changed(A) or self._amg is None:
+                    import pyamg
+                    B = _rigid_body_modes(self.nodes, A.shape[0])
+                    self._amg = pyamg.smoothed_aggregation_solver(A, B=B, max_coarse=200)
+                M = self._amg.aspreconditioner(cycle="V")
+            x, info = spla.cg(A, b, x0=x0, rtol=self.rtol, atol=0.0, maxiter=self.maxiter, M=M,
+                              callback=cb)
+            self.last_iterations = count[0]
+            if info != 0:
+                raise SolverError(f"{self.kind} did not converge to rtol={self.rtol:g} in "
+                                  f"{self.maxiter} iterations (info={info})")
+        if not np.all(np.isfinite(x)):
+            raise SolverError(f"linear solver {self.kind} returned NaN/inf")
+        return x
+
+
+def _rigid_body_modes(nodes, ndof):
+    B = np.zeros((ndof, 3))
+    B[0::2, 0] = 1.0
+    B[1::2, 1] = 1.0
+    if nodes is not None:
+        xc = nodes - nodes.mean(axis=0)
+        scale = max(np.abs(xc).max(), 1.0)
+        B[0::2, 2] = -xc[:, 1] / scale
+        B[1::2, 2] = xc[:, 0] / scale
+    return B

@@ -1,0 +1,112 @@
+"""lagice.mesh: gmsh generation, tags, adjacency, quality, meshio I/O, bad input."""
+import numpy as np
+import pytest
+from shapely.geometry import LineString, Point, Polygon
+
+from lagice.errors import ConfigError, LagiceError, MeshError
+from lagice.mesh import (angles_deg, edge_lengths, generate_mesh, quality_report, read_mesh,
+                         rectangle_domain, write_mesh)
+
+
+def island_domain():
+    outer = [(0, 0), (400e3, 0), (450e3, 300e3), (0, 350e3)]
+    hole = Point(200e3, 170e3).buffer(50e3, quad_segs=8)
+    return Polygon(outer, [list(hole.exterior.coords)[::-1]])
+
+
+def test_polygon_with_island_ccw_and_area():
+    poly = island_domain()
+    m = generate_mesh(poly, 20e3, segments={"open": LineString([(0, 0), (400e3, 0)])})
+    a = m.areas()
+    assert np.all(a > 0), "all triangles counter-clockwise"
+    # mesh covers the polygon (straight-sided hole polygon: exact up to round-off)
+    assert np.isclose(a.sum(), poly.area, rtol=1e-9)
+    assert set(m.tag_names) == {"open", "coast"}
+    # every island-boundary node lies on the circle polygon, tagged coast
+    coast = m.nodes_with_tag("coast")
+    r = np.hypot(m.nodes[coast, 0] - 200e3, m.nodes[coast, 1] - 170e3)
+    on_island = r < 60e3
+    assert on_island.sum() >= 16
+    assert np.all(np.abs(r[on_island] - 50e3) < 1e3)
+    # open edge nodes are exactly on y = 0
+    assert np.all(m.nodes[m.nodes_with_tag("open"), 1] == 0.0)
+
+
+def test_boundary_edges_closed_and_left_oriented(plate_mesh):
+    m = plate_mesh
+    # each boundary node has exactly two boundary edges (closed loop)
+    cnt = np.bincount(m.boundary_edges.ravel(), minlength=m.n_nodes)
+    assert set(np.unique(cnt[cnt > 0])) == {2}
+    # the domain lies to the left: the centroid of the owning triangle is left of the edge
+    assert len(m.boundary_edges) == len(m.boundary_tags)
+    # sides tagged: the four named segments and corners
+    for name, coord, val in (("bottom", 1, 0.0), ("top", 1, 200e3), ("left", 0, 0.0), ("right", 0, 100e3)):
+        nodes = m.nodes_with_tag(name)
+        assert len(nodes) >= 9
+        assert np.allclose(m.nodes[nodes, coord], val)
+
+
+def test_node_element_adjacency(plate_mesh):
+    m = plate_mesh
+    ptr, el, loc = m.node_elements
+    assert ptr[-1] == 3 * m.n_elements
+    # node i is vertex loc[k] of element el[k]
+    for i in (0, 5, m.n_nodes // 2, m.n_nodes - 1):
+        for k in range(ptr[i], ptr[i + 1]):
+            assert m.triangles[el[k], loc[k]] == i
+    # every (element, vertex) appears exactly once
+    assert len(set(zip(el.tolist(), loc.tolist()))) == 3 * m.n_elements
+
+
+def test_size_function_is_followed():
+    poly, _ = rectangle_domain(400e3, 100e3)
+    m = generate_mesh(poly, lambda x, y: 5e3 + 20e3 * (x / 400e3))
+    L = edge_lengths(m.nodes, m.triangles).mean(axis=1)
+    cx = m.centroids()[:, 0]
+    left, right = L[cx < 60e3].mean(), L[cx > 340e3].mean()
+    assert 4e3 < left < 9e3
+    assert 18e3 < right < 28e3
+
+
+def test_quality_metrics_consistent(plate_mesh):
+    m = plate_mesh
+    ang = angles_deg(m.nodes, m.triangles)
+    assert np.allclose(ang.sum(axis=1), 180.0)
+    q = quality_report(m.nodes, m.triangles)
+    assert q["n_inverted"] == 0 and q["min_angle_deg"] > 20
+    # equilateral check on a hand-made triangle
+    nodes = np.array([[0, 0], [1, 0], [0.5, np.sqrt(3) / 2]])
+    assert np.allclose(angles_deg(nodes, np.array([[0, 1, 2]])), 60.0)
+    assert np.allclose(edge_lengths(nodes, np.array([[0, 1, 2]])), 1.0)
+
+
+@pytest.mark.parametrize("suffix", [".vtu", ".msh"])
+def test_meshio_roundtrip(tmp_path, plate_mesh, suffix):
+    p = write_mesh(tmp_path / f"m{suffix}", plate_mesh)
+    m2 = read_mesh(p)
+    assert np.array_equal(m2.triangles, plate_mesh.triangles)
+    assert np.allclose(m2.nodes, plate_mesh.nodes)
+    assert np.array_equal(m2.boundary_edges, plate_mesh.boundary_edges)
+    assert np.array_equal(m2.boundary_tags, plate_mesh.boundary_tags)
+    if suffix == ".msh":  # gmsh physical names carry the tag names
+        assert m2.tag_names == plate_mesh.tag_names
+
+
+def test_bad_polygon_and_size():
+    bowtie = Polygon([(0, 0), (1e5, 1e5), (1e5, 0), (0, 1e5)])
+    with pytest.raises(MeshError, match="invalid.*Self-intersection"):
+        generate_mesh(bowtie, 1e4)
+    poly, _ = rectangle_domain(1e5, 1e5)
+    for bad in (0.0, -5.0, float("nan")):
+        with pytest.raises(ConfigError, match="element size"):
+            generate_mesh(poly, bad)
+    with pytest.raises(ConfigError, match="element size function returned"):
+        generate_mesh(poly, lambda x, y: -1.0 + 0 * x)
+    with pytest.raises(ConfigError, match="rectangle size"):
+        rectangle_domain(-1.0, 1.0)
+
+
+def test_unknown_tag_error(plate_mesh):
+    with pytest.raises(ConfigError, match="unknown boundary tag 'north'"):
+        plate_mesh.nodes_with_tag("north")
+    assert issubclass(ConfigError, LagiceError) and issubclass(MeshError, LagiceError)

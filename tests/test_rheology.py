@@ -1,0 +1,140 @@
+"""Maxwell-EB rheology: envelope, d_crit, damage/healing update, moduli, bad input."""
+import math
+
+import numpy as np
+import pytest
+
+from lagice.errors import ConfigError
+from lagice.params import MaxwellEBParams
+from lagice.rheology import MaxwellEB, dcrit, draw_cohesion, envelope, principal_stresses, relaxation_time, young_modulus
+
+
+def rotate(s1, s2, theta):
+    """Stress (xx, yy, xy) with principal values s1, s2 rotated by theta."""
+    c, s = np.cos(theta), np.sin(theta)
+    sxx = s1 * c * c + s2 * s * s
+    syy = s1 * s * s + s2 * c * c
+    sxy = (s1 - s2) * s * c
+    return np.stack([sxx, syy, sxy], axis=-1)
+
+
+def test_seed004_q_and_strength_ratio():
+    q, sc, st = envelope(37.5e3, 0.7)
+    assert q == pytest.approx(3.69, abs=0.005)
+    assert st / sc == pytest.approx(0.27, abs=0.005)
+    assert sc == pytest.approx(2 * 37.5e3 / (math.sqrt(1.49) - 0.7))
+
+
+def test_points_on_envelope_have_dcrit_one(rng):
+    C = rng.uniform(25e3, 50e3, 400)
+    q, sc, st = envelope(C, 0.7)
+    theta = rng.uniform(0, np.pi, 400)
+    # Mohr-Coulomb branch: q s1 - s2 = sigma_c with s1 in [-sigma_c, sigma_T]
+    s1 = rng.uniform(-2 * sc, st)
+    s2 = q * s1 - sc
+    sig = rotate(s1, s2, theta)
+    p1, p2 = principal_stresses(sig)
+    assert np.allclose(p1, s1, atol=1e-6 * sc) and np.allclose(p2, s2, atol=1e-6 * sc)
+    assert np.allclose(dcrit(sig, C, 0.7), 1.0, atol=1e-12)
+    # tensile cut-off branch: s1 = sigma_T, s2 between q*sigma_T - sigma_c = 0 and sigma_T
+    s2t = rng.uniform(0.0, st)
+    assert np.allclose(dcrit(rotate(st, s2t, theta), C, 0.7), 1.0, atol=1e-12)
+    # scaling a state outside by k gives dcrit = 1/k (radial return to envelope)
+    assert np.allclose(dcrit(1.7 * sig, C, 0.7), 1 / 1.7, rtol=1e-12)
+
+
+def test_uniaxial_strengths():
+    C = 40e3
+    q, sc, st = envelope(C, 0.7)
+    for eps in (0.05, 0.3):
+        comp = np.array([[0.0, -sc * (1 + eps), 0.0]])
+        tens = np.array([[st * (1 + eps), 0.0, 0.0]])
+        assert dcrit(comp, C, 0.7)[0] == pytest.approx(1 / (1 + eps), rel=1e-12)
+        assert dcrit(tens, C, 0.7)[0] == pytest.approx(1 / (1 + eps), rel=1e-12)
+    assert dcrit(np.array([[0.0, -0.999 * sc, 0.0]]), C, 0.7)[0] == 1.0
+    assert dcrit(np.array([[0.999 * st, 0.0, 0.0]]), C, 0.7)[0] == 1.0
+    # biaxial compression is never critical (no cap on the envelope)
+    assert dcrit(np.array([[-1e9, -1e9, 0.0]]), C, 0.7)[0] == 1.0
+
+
+def test_damage_update_with_dt_equal_td_is_seed004_recursion(rng):
+    rheo = MaxwellEB(healing_time_s=None)
+    m = 500
+    C = rng.uniform(25e3, 50e3, m)
+    q, sc, _ = envelope(C, 0.7)
+    sig = rotate(rng.uniform(-3, 0.2, m) * sc, rng.uniform(-3, 0, m) * sc, rng.uniform(0, np.pi, m))
+    d0 = rng.uniform(0, 0.9, m)
+    dc = dcrit(sig, C, 0.7)
+    d = d0.copy()
+    s = sig.copy()
+    td = np.full(m, 20.0)
+    rheo.damage_update(s, d, C, 20.0, td, np.zeros(m))
+    # seed 004: d_seed^{n+1} = dcrit d_seed^n with d_seed = 1 - d
+    assert np.allclose(1 - d, dc * (1 - d0), rtol=1e-14)
+    assert np.allclose(s, sig * dc[:, None], rtol=1e-14)
+    # after the update, every stress is inside or on the envelope
+    assert np.all(dcrit(s, C, 0.7) > 1 - 1e-12)
+    # half step: half of the increment
+    d = d0.copy()
+    s = sig.copy()
+    rheo.damage_update(s, d, C, 10.0, td, np.zeros(m))
+    assert np.allclose(1 - d, (1 - d0) * (1 - 0.5 * (1 - dc)), rtol=1e-14)
+
+
+def test_constant_healing_rate():
+    rheo = MaxwellEB(healing_time_s=1e5)
+    d = np.array([0.5, 0.001, 0.0])
+    s = np.zeros((3, 3))
+    rheo.damage_update(s, d, np.full(3, 3e4), 100.0, np.full(3, 5.0), rheo.constant_heal_rate(3))
+    assert d[0] == pytest.approx(0.5 - 100.0 / 1e5, rel=1e-14)
+    assert d[1] == 0.0 and d[2] == 0.0  # fully healed, floor of the law
+
+
+def test_damage_cap_is_counted():
+    rheo = MaxwellEB(healing_time_s=None)
+    q, sc, _ = envelope(30e3, 0.7)
+    d = np.array([1 - 1e-7])
+    s = np.array([[0.0, -10 * sc, 0.0]])
+    rheo.damage_update(s, d, np.array([30e3]), 5.0, np.array([5.0]), np.zeros(1))
+    assert d[0] == rheo.params.max_damage
+    assert rheo.n_capped_total == 1
+
+
+def test_moduli_and_viscosity_scaling():
+    p = MaxwellEBParams()
+    assert p.E0 == pytest.approx(2 * 500**2 * 1.3 * 900)
+    d = np.array([0.0, 0.5, 0.9])
+    E = young_modulus(p.E0, d, 1.0, 20.0)
+    lam = relaxation_time(1e7, d, 1.0, 20.0, 4.0)
+    assert np.allclose(E, p.E0 * (1 - d))
+    eta = E * lam
+    assert np.allclose(eta / eta[0], (1 - d) ** 4)
+    # concentration dependence exp(-c*(1-A))
+    assert young_modulus(p.E0, 0.0, 0.9, 20.0) == pytest.approx(p.E0 * math.exp(-2.0))
+
+
+def test_cohesion_field_seeded(rng):
+    p = MaxwellEBParams()
+    a = draw_cohesion(1000, p, np.random.default_rng(3))
+    b = draw_cohesion(1000, p, np.random.default_rng(3))
+    c = draw_cohesion(1000, p, np.random.default_rng(4))
+    assert np.array_equal(a, b) and not np.array_equal(a, c)
+    assert a.min() >= 25e3 and a.max() <= 50e3
+    assert abs(a.mean() - 37.5e3) < 1.5e3
+
+
+@pytest.mark.parametrize("kw,name", [
+    ({"poisson": 0.5}, "poisson"), ({"poisson": 0.7}, "poisson"), ({"alpha": 1.0}, "alpha"),
+    ({"alpha": 0.5}, "alpha"), ({"cohesion_min_pa": -1.0}, "cohesion_min_pa"),
+    ({"cohesion_max_pa": 1.0}, "cohesion_max_pa"), ({"relaxation_time_s": 0}, "relaxation_time_s"),
+])
+def test_bad_parameters_name_the_parameter(kw, name):
+    with pytest.raises(ConfigError, match=name) as e:
+        MaxwellEBParams(**kw)
+    assert "expected" in str(e.value)
+    assert repr(list(kw.values())[0]) in str(e.value)
+
+
+def test_unknown_parameter():
+    with pytest.raises(ConfigError, match="unknown rheology parameter 'youngs'"):
+        MaxwellEB(youngs=1.0)
