@@ -1,0 +1,124 @@
+"""Snapshot output: one UGRID-1.0 / CF netCDF file per snapshot.
+
+Remeshing changes the mesh, so a time series cannot live on one fixed mesh
+dimension. Each snapshot file ``snapshot_SSSSSS.nc`` holds its own mesh
+(UGRID topology ``mesh``) and the element/node fields at one time; the
+attribute ``mesh_epoch`` counts remesh events, so files with equal epochs
+share the same mesh. ``index.json`` lists every snapshot (file, time, step,
+mesh epoch). Open one with ``xugrid.open_dataset`` or ``xarray.open_dataset``;
+the files of one epoch concatenate with ``xarray.open_mfdataset(...,
+combine="nested", concat_dim="time")``.
+"""
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from ..deformation import invariants
+from .ugrid import mesh_dataset
+
+FIELD_ATTRS = {
+    "thickness": ("sea_ice_thickness", "m", "ice volume per unit area (effective thickness)"),
+    "concentration": ("sea_ice_area_fraction", "1", "ice concentration"),
+    "damage": (None, "1", "damage (0 undamaged, 1 fully damaged)"),
+    "cohesion": (None, "Pa", "cohesion"),
+    "snow": ("surface_snow_thickness", "m", "snow volume per unit area"),
+}
+
+
+def _crs_var(crs_epsg: int | None):
+    if crs_epsg is None:
+        return None
+    try:
+        import pyproj
+
+        crs = pyproj.CRS.from_epsg(crs_epsg)
+        attrs = crs.to_cf()
+        attrs["crs_wkt"] = crs.to_wkt()
+        return xr.DataArray(np.int32(0), attrs=attrs)
+    except Exception:  # noqa: BLE001 - pyproj missing data: keep the EPSG code
+        return xr.DataArray(np.int32(0), attrs={"epsg_code": f"EPSG:{crs_epsg}"})
+
+
+def snapshot_dataset(state, strain_rate=None, crs_epsg: int | None = 3413, extra: dict | None = None,
+                     start_date: str = "2000-01-01 00:00:00"):
+    """The snapshot of ``state`` as an xarray Dataset (UGRID + CF attributes)."""
+    ds = mesh_dataset(state.mesh)
+    grid_mapping = {}
+    crs = _crs_var(crs_epsg)
+    if crs is not None:
+        ds["crs"] = crs
+        grid_mapping = {"grid_mapping": "crs"}
+        ds["mesh_node_x"].attrs.update(grid_mapping)
+        ds["mesh_node_y"].attrs.update(grid_mapping)
+    face = {"mesh": "mesh", "location": "face", **grid_mapping}
+    node = {"mesh": "mesh", "location": "node", **grid_mapping}
+    ds["time"] = ("time", np.array([state.time_s]), {"units": f"seconds since {start_date}",
+                                                     "standard_name": "time", "calendar": "standard"})
+    for name, (std, units, long) in FIELD_ATTRS.items():
+        val = getattr(state, name, None)
+        if val is None:
+            continue
+        attrs = {"units": units, "long_name": long, **face}
+        if std:
+            attrs["standard_name"] = std
+        ds[name] = (("time", "mesh_face"), val[None, :], attrs)
+    ds["stress"] = (("time", "mesh_face", "stress_component"), state.stress[None],
+                    {"units": "Pa", "long_name": "depth-averaged internal stress (xx, yy, xy), tension positive",
+                     **face})
+    ds["stress_component"] = ("stress_component", np.array(["xx", "yy", "xy"]))
+    ds["velocity_x"] = (("time", "mesh_node"), state.velocity[None, :, 0],
+                        {"units": "m s-1", "standard_name": "sea_ice_x_velocity", **node})
+    ds["velocity_y"] = (("time", "mesh_node"), state.velocity[None, :, 1],
+                        {"units": "m s-1", "standard_name": "sea_ice_y_velocity", **node})
+    if strain_rate is not None:
+        div, shear, tot = invariants(strain_rate)
+        for name, val, long in (("divergence_rate", div, "divergence of ice velocity"),
+                                ("shear_rate", shear, "maximum shear rate"),
+                                ("total_deformation_rate", tot, "total deformation rate sqrt(div^2+shear^2)")):
+            ds[name] = (("time", "mesh_face"), val[None], {"units": "s-1", "long_name": long, **face})
+    ds.attrs.update({"Conventions": "CF-1.8 UGRID-1.0", "step": int(state.step),
+                     "mesh_epoch": int(state.counters.get("mesh_epoch", 0)), **(extra or {})})
+    return ds
+
+
+class SnapshotWriter:
+    """Writes snapshots and keeps ``index.json`` up to date (atomically)."""
+
+    def __init__(self, directory, crs_epsg: int | None = 3413, vtu: bool = False,
+                 start_date: str = "2000-01-01 00:00:00"):
+        self.dir = Path(directory)
+        self.start_date = start_date
+        self.crs_epsg = crs_epsg
+        self.vtu = vtu
+
+    def write(self, state, strain_rate=None, extra=None) -> Path:
+        self.dir.mkdir(parents=True, exist_ok=True)
+        path = self.dir / f"snapshot_{state.step:08d}.nc"
+        ds = snapshot_dataset(state, strain_rate, self.crs_epsg, extra, self.start_date)
+        tmp = path.with_suffix(".nc.tmp")
+        # no fill values: every value written is a model value
+        ds.to_netcdf(tmp, encoding={v: {"_FillValue": None} for v in ds.variables
+                                    if ds[v].dtype.kind == "f"})
+        os.replace(tmp, path)
+        if self.vtu:
+            from ..mesh import write_mesh
+            cd = {k: getattr(state, k) for k in ("thickness", "concentration", "damage")}
+            write_mesh(path.with_suffix(".vtu"), state.mesh, cell_data=cd,
+                       point_data={"velocity": np.column_stack([state.velocity, np.zeros(len(state.velocity))])})
+        self._index_add({"file": path.name, "time_s": state.time_s, "step": int(state.step),
+                         "mesh_epoch": int(state.counters.get("mesh_epoch", 0))})
+        return path
+
+    def _index_add(self, entry):
+        idx_path = self.dir / "index.json"
+        entries = json.loads(idx_path.read_text()) if idx_path.exists() else []
+        entries = [e for e in entries if e["step"] < entry["step"]]  # a resumed run rewrites later ones
+        entries.append(entry)
+        tmp = idx_path.with_suffix(".json.tmp")
+        tmp.write_text(json.dumps(entries, indent=1))
+        os.replace(tmp, idx_path)

@@ -1,0 +1,251 @@
+"""Scene files (TOML): strict schema, defaults, expressions and overrides.
+
+A scene is a TOML file with the tables below; unknown tables/keys and values
+of the wrong type are errors that name the key (``domain.resolution_m``).
+Values that may vary in space/time accept a number, a numpy expression string
+in ``x, y`` (initial fields) or ``t, x, y`` (forcing), e.g.
+``"0.3 + 0.005*(sin(6e-5*x) + sin(3e-5*y))"``, or ``"module:function"``
+naming a Python function with the same arguments.
+
+``--set key=value`` (CLI) or ``overrides={"run.duration": "2d"}`` replaces
+any key using its dotted path; the value is parsed as a TOML value.
+"""
+from __future__ import annotations
+
+import copy
+import importlib
+import re
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ConfigError
+
+NUM = (int, float)
+EXPR = (int, float, str)
+ANY = object
+
+# table -> key -> (type or tuple of types, default). A nested dict is a sub-table;
+# "*" as a key means free-form sub-tables (validated by the builder).
+SCHEMA = {
+    "scene": {"name": (str, None), "description": (str, "")},
+    "domain": {
+        "kind": (str, "rectangle"), "width_m": (NUM, None), "height_m": (NUM, None),
+        "x0_m": (NUM, 0.0), "y0_m": (NUM, 0.0), "vertices": (list, None), "islands": (list, []),
+        "file": (str, None), "resolution_m": (EXPR, None), "exterior_tag": (str, "coast"),
+        "segments": (dict, {}),
+    },
+    "initial": {
+        "thickness_m": (EXPR, 1.0), "concentration": (EXPR, 1.0), "damage": (EXPR, 0.0),
+        "snow_m": (EXPR, None), "cohesion_pa": (EXPR, "random"),
+    },
+    "rheology": {
+        "poisson": (NUM, 0.3), "friction": (NUM, 0.7), "rho_ice": (NUM, 900.0),
+        "shear_wave_speed": (NUM, 500.0), "young_modulus_pa": (NUM, None),
+        "relaxation_time_s": (NUM, 1e7), "alpha": (NUM, 4.0), "cohesion_min_pa": (NUM, 25e3),
+        "cohesion_max_pa": (NUM, 50e3), "healing_time_s": (NUM, 1e5), "concentration_c": (NUM, 20.0),
+        "max_damage": (NUM, 1.0 - 1e-6),
+    },
+    "solver": {
+        "name": (str, "implicit"), "dt": (EXPR, None), "substeps": (int, None),
+        "linear_solver": (str, None), "tol": (NUM, None), "max_iter": (int, None),
+        "allow_unstable": (bool, False),
+    },
+    "boundary": {"*": {"u": (EXPR, None), "v": (EXPR, None)}},
+    "forcing": {
+        "grid_spacing_m": (NUM, 25e3), "crs": (str, "EPSG:3413"),
+        "wind": (dict, None), "ocean": (dict, None), "air_temperature": (dict, None),
+        "coriolis": (dict, None), "drag": (dict, None),
+    },
+    "thermo": {"enabled": (bool, False), "params": (dict, {})},
+    "healing": {"law": (str, "constant"), "params": (dict, {})},
+    "lagrangian": {"enabled": (bool, False)},
+    "remesh": {"enabled": (bool, False), "min_angle_deg": (NUM, 10.0), "params": (dict, {})},
+    "run": {"duration": (EXPR, None), "seed": (int, 0), "progress": (bool, True),
+            "start_date": (str, "2000-01-01 00:00:00")},
+    "output": {"every": (EXPR, "1d"), "vtu": (bool, False), "crs_epsg": (int, 3413), "plot": (bool, True),
+               "grid_resolution_m": (NUM, None)},
+    "checkpoint": {"every": (EXPR, None), "keep": (int, 3)},
+}
+
+SCENE_DIR = Path(__file__).resolve().parents[2] / "examples"
+_MODFUNC = re.compile(r"^[A-Za-z_][\w.]*:[A-Za-z_]\w*$")
+
+
+def _type_name(t):
+    if isinstance(t, tuple):
+        return " or ".join(_type_name(x) for x in t)
+    return {int: "integer", float: "number", str: "string", bool: "boolean", list: "array",
+            dict: "table"}.get(t, getattr(t, "__name__", str(t)))
+
+
+def _check_type(key, value, typ):
+    if value is None:
+        return
+    types = typ if isinstance(typ, tuple) else (typ,)
+    if isinstance(value, bool) and bool not in types:
+        raise ConfigError(f"{key} = {value!r}: expected {_type_name(typ)}, got a boolean")
+    if float in types and isinstance(value, int) and not isinstance(value, bool):
+        return
+    if not isinstance(value, types):
+        raise ConfigError(f"{key} = {value!r}: expected {_type_name(typ)}, got {type(value).__name__}")
+
+
+def validate(raw: dict, source: str = "<scene>") -> dict:
+    """Check keys and types against SCHEMA and fill defaults. Returns a new dict."""
+    if not isinstance(raw, dict):
+        raise ConfigError(f"{source}: a scene must be a TOML table")
+    out = {}
+    for table in raw:
+        if table not in SCHEMA:
+            raise ConfigError(f"{source}: unknown table [{table}]; known tables: {sorted(SCHEMA)}")
+    for table, spec in SCHEMA.items():
+        given = raw.get(table, {})
+        if not isinstance(given, dict):
+            raise ConfigError(f"{source}: [{table}] must be a table")
+        if "*" in spec:
+            sub = {}
+            for name, vals in given.items():
+                if not isinstance(vals, dict):
+                    raise ConfigError(f"{source}: {table}.{name} must be a table")
+                sub[name] = _validate_table(f"{table}.{name}", vals, spec["*"], source)
+            out[table] = sub
+        else:
+            out[table] = _validate_table(table, given, spec, source)
+    return out
+
+
+def _validate_table(prefix, given, spec, source):
+    res = {}
+    for key, val in given.items():
+        if key not in spec:
+            raise ConfigError(f"{source}: unknown key {prefix}.{key}; known keys of [{prefix}]: {sorted(spec)}")
+        _check_type(f"{source}: {prefix}.{key}", val, spec[key][0])
+        res[key] = val
+    for key, (_typ, default) in spec.items():
+        res.setdefault(key, copy.deepcopy(default))
+    return res
+
+
+def parse_value(raw: str):
+    """A ``--set`` value: a TOML value (number, boolean, string, array), else a bare string."""
+    try:
+        return tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        return raw
+
+
+def apply_overrides(raw: dict, overrides) -> dict:
+    """Apply ``{"table.key": value}`` or ``["table.key=value", ...]`` to a raw scene."""
+    raw = copy.deepcopy(raw)
+    items = overrides.items() if isinstance(overrides, dict) else [_split(s) for s in overrides or []]
+    for dotted, val in items:
+        parts = dotted.split(".")
+        if len(parts) < 2:
+            raise ConfigError(f"--set {dotted}: expected table.key=value (e.g. run.duration=2d)")
+        table = parts[0]
+        if table not in SCHEMA:
+            raise ConfigError(f"--set {dotted}: unknown table [{table}]; known tables: {sorted(SCHEMA)}")
+        node = raw.setdefault(table, {})
+        for p in parts[1:-1]:
+            node = node.setdefault(p, {})
+            if not isinstance(node, dict):
+                raise ConfigError(f"--set {dotted}: {p} is not a table")
+        node[parts[-1]] = val
+    return raw
+
+
+def _split(s):
+    if "=" not in s:
+        raise ConfigError(f"--set {s!r}: expected key=value")
+    k, v = s.split("=", 1)
+    return k.strip(), parse_value(v.strip())
+
+
+def scene_path(name_or_path) -> Path:
+    p = Path(name_or_path)
+    if p.suffix == ".toml" or p.exists():
+        if not p.exists():
+            raise ConfigError(f"scene file {p} does not exist")
+        return p
+    cand = SCENE_DIR / f"{name_or_path}.toml"
+    if cand.exists():
+        return cand
+    known = sorted(q.stem for q in SCENE_DIR.glob("*.toml")) if SCENE_DIR.exists() else []
+    raise ConfigError(f"unknown scene {name_or_path!r}; bundled scenes: {known}")
+
+
+def load_scene(name_or_path, overrides=None) -> dict:
+    """Read, override and validate a scene; returns the full config dict."""
+    path = scene_path(name_or_path)
+    try:
+        raw = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML: {exc}") from exc
+    raw = apply_overrides(raw, overrides or {})
+    cfg = validate(raw, str(path))
+    cfg["scene"]["name"] = cfg["scene"]["name"] or path.stem
+    cfg["scene"]["source"] = str(path)
+    return cfg
+
+
+# -- expressions ---------------------------------------------------------------
+_NP_NAMES = {name: getattr(np, name) for name in (
+    "sin", "cos", "tan", "exp", "log", "log10", "sqrt", "abs", "tanh", "arctan2", "hypot", "where",
+    "minimum", "maximum", "clip", "pi", "sign", "floor", "ceil", "ones_like", "zeros_like")}
+
+
+def resolve_callable(spec: str, key: str):
+    mod, _, fn = spec.partition(":")
+    try:
+        f = getattr(importlib.import_module(mod), fn)
+    except (ImportError, AttributeError) as exc:
+        raise ConfigError(f"{key} = {spec!r}: cannot import {fn!r} from {mod!r} ({exc})") from exc
+    if not callable(f):
+        raise ConfigError(f"{key} = {spec!r} is not callable")
+    return f
+
+
+def spatial_values(value, x, y, key: str) -> np.ndarray:
+    """Evaluate an initial field (number, expression in x, y, or module:function)."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return np.full(len(x), float(value))
+    if isinstance(value, str):
+        if _MODFUNC.match(value):
+            out = resolve_callable(value, key)(x, y)
+        else:
+            try:
+                out = eval(compile(value, key, "eval"), {"__builtins__": {}}, {**_NP_NAMES, "x": x, "y": y})
+            except Exception as exc:  # noqa: BLE001
+                raise ConfigError(f"{key} = {value!r}: cannot evaluate the expression in x, y: {exc}") from exc
+        out = np.broadcast_to(np.asarray(out, np.float64), (len(x),)).copy()
+        if not np.all(np.isfinite(out)):
+            raise ConfigError(f"{key} = {value!r} gives NaN or inf in the domain")
+        return out
+    raise ConfigError(f"{key} = {value!r}: expected a number, an expression in x, y or module:function")
+
+
+def time_space_callable(value, key: str):
+    """A callable f(t, x, y) from a number, expression in t, x, y, or module:function."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        v = float(value)
+        return lambda t, x, y: np.full(np.shape(x), v)
+    if isinstance(value, str):
+        if _MODFUNC.match(value):
+            return resolve_callable(value, key)
+        try:
+            code = compile(value, key, "eval")
+        except SyntaxError as exc:
+            raise ConfigError(f"{key} = {value!r}: not a valid expression: {exc}") from exc
+
+        def f(t, x, y, _code=code):
+            return np.broadcast_to(np.asarray(eval(_code, {"__builtins__": {}},
+                                                   {**_NP_NAMES, "t": t, "x": x, "y": y}), np.float64),
+                                   np.shape(x))
+        try:
+            f(0.0, np.zeros(2), np.zeros(2))
+        except Exception as exc:  # noqa: BLE001
+            raise ConfigError(f"{key} = {value!r}: cannot evaluate the expression in t, x, y: {exc}") from exc
+        return f
+    raise ConfigError(f"{key} = {value!r}: expected a number, an expression in t, x, y or module:function")

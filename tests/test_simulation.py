@@ -1,0 +1,175 @@
+"""Simulation API: schedules, bit-identical resume, damaged checkpoints, kill
+during checkpoint writing, scene (TOML) validation."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from lagice.errors import ConfigError, RestartError
+from lagice.io.checkpoint import latest_valid_checkpoint, list_checkpoints, read_checkpoint, write_checkpoint
+from lagice.scenes.config import load_scene
+from lagice.scenes.toml_scene import build_simulation
+from lagice.simulation import Simulation
+
+FAST = {"run.duration": 1600.0, "solver.dt": 40.0, "output.every": 800.0, "checkpoint.every": 800.0,
+        "domain.resolution_m": 25e3, "run.progress": False, "output.plot": False,
+        "boundary.top.u": "5e-2*minimum(1.0, t/600.0)"}
+
+
+def fields(model):
+    st = model.state
+    return {"nodes": st.mesh.nodes, "velocity": st.velocity, "stress": st.stress, "damage": st.damage,
+            "thickness": st.thickness, "concentration": st.concentration, "cohesion": st.cohesion}
+
+
+def test_resume_is_bit_identical(tmp_path):
+    cfg = load_scene("shear_box", FAST)
+    full = build_simulation(cfg, tmp_path / "full")
+    full.run()
+    assert full.model.state.step == 40
+    assert full.model.state.damage.max() > 0, "the scene must crack for the test to mean something"
+
+    cfg2 = load_scene("shear_box", FAST)
+    part = build_simulation(cfg2, tmp_path / "part")
+    part.run(n_steps=20)  # checkpoint at step 20 (t = 800 s)
+    del part
+    resumed = Simulation.resume(tmp_path / "part" / "checkpoints")
+    assert resumed.model.state.step == 20
+    resumed.run()
+    a, b = fields(full.model), fields(resumed.model)
+    for k in a:
+        assert np.array_equal(a[k], b[k]), f"{k} differs after resume"
+    # the snapshot written after resume equals the uninterrupted one
+    sa = xr.load_dataset(tmp_path / "full" / "snapshots" / "snapshot_00000040.nc")
+    sb = xr.load_dataset(tmp_path / "part" / "snapshots" / "snapshot_00000040.nc")
+    assert np.array_equal(sa["damage"].values, sb["damage"].values)
+
+
+def _one_checkpoint(tmp_path):
+    cfg = load_scene("shear_box", FAST)
+    sim = build_simulation(cfg, tmp_path / "run")
+    sim.run(n_steps=20)
+    return sim, list_checkpoints(tmp_path / "run" / "checkpoints")[-1]
+
+
+def test_damaged_checkpoints_raise_restart_error(tmp_path):
+    sim, ck = _one_checkpoint(tmp_path)
+    data = ck.read_bytes()
+    trunc = tmp_path / "trunc.npz"
+    trunc.write_bytes(data[: len(data) // 2])
+    with pytest.raises(RestartError, match="trunc.npz"):
+        read_checkpoint(trunc)
+    corrupt = tmp_path / "corrupt.npz"
+    b = bytearray(data)
+    for k in range(len(b) // 3, len(b) // 3 + 64):
+        b[k] ^= 0xFF
+    corrupt.write_bytes(bytes(b))
+    with pytest.raises(RestartError, match="corrupt"):
+        read_checkpoint(corrupt)
+    garbage = tmp_path / "garbage.npz"
+    garbage.write_text("not a checkpoint")
+    with pytest.raises(RestartError):
+        Simulation.resume(garbage)
+    # incompatible: another lagice version
+    arrays, meta = read_checkpoint(ck)
+    meta["lagice_version"] = "0.0.0"
+    old = write_checkpoint(tmp_path / "old", 20, arrays, meta)
+    with pytest.raises(RestartError, match="lagice 0.0.0"):
+        Simulation.resume(old)
+    # incompatible: another scene configuration (different seed)
+    other = build_simulation(load_scene("shear_box", {**FAST, "run.seed": 99}), tmp_path / "other")
+    with pytest.raises(RestartError, match="another scene"):
+        Simulation.resume(ck, model=other.model)
+
+
+def test_damaged_newest_checkpoint_falls_back_to_older(tmp_path):
+    sim, _ = _one_checkpoint(tmp_path)
+    sim.run()  # checkpoints at steps 20 and 40
+    d = tmp_path / "run" / "checkpoints"
+    files = list_checkpoints(d)
+    assert [int(f.stem.split("_")[1]) for f in files] == [20, 40]
+    files[-1].write_bytes(files[-1].read_bytes()[:1000])
+    path, _, meta, skipped = latest_valid_checkpoint(d)
+    assert path == files[0] and meta["step"] == 20 and len(skipped) == 1
+    res = Simulation.resume(d)
+    assert res.model.state.step == 20
+
+
+def test_keep_last_k(tmp_path):
+    cfg = load_scene("shear_box", {**FAST, "checkpoint.every": 200.0, "checkpoint.keep": 2})
+    sim = build_simulation(cfg, tmp_path)
+    sim.run()
+    steps = [int(f.stem.split("_")[1]) for f in list_checkpoints(tmp_path / "checkpoints")]
+    assert steps == [35, 40]
+
+
+KILL_SCRIPT = textwrap.dedent("""
+    import sys, numpy as np
+    from lagice.io.checkpoint import write_checkpoint
+    d = sys.argv[1]
+    write_checkpoint(d, 1, {"a": np.arange(10.0)}, {"lagice_version": "x"}, keep=5)
+    print("first", flush=True)
+    big = np.random.default_rng(0).random(40_000_000)  # 320 MB: slow to write
+    step = 2
+    while True:
+        write_checkpoint(d, step, {"a": big}, {"lagice_version": "x"}, keep=5)
+        step += 1
+""")
+
+
+def test_sigkill_during_checkpoint_keeps_previous(tmp_path):
+    d = tmp_path / "ck"
+    p = subprocess.Popen([sys.executable, "-c", KILL_SCRIPT, str(d)], stdout=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "first"
+    t0 = time.time()
+    while not any(".tmp-" in f.name for f in d.iterdir()):
+        assert time.time() - t0 < 60, "checkpoint writing never started"
+        time.sleep(0.005)
+    time.sleep(0.05)
+    os.kill(p.pid, signal.SIGKILL)
+    p.wait()
+    assert any(".tmp-" in f.name for f in d.iterdir()), "killed mid-write: a temp file is left"
+    path, arrays, meta, skipped = latest_valid_checkpoint(d)
+    assert np.array_equal(arrays["a"], np.arange(10.0)) or arrays["a"].size == 40_000_000
+    assert skipped == []  # no half-written file carries a checkpoint name
+
+
+@pytest.mark.parametrize("override,match", [
+    ({"domain.colour": "blue"}, "unknown key domain.colour"),
+    ({"physics.x": 1}, r"unknown table \[physics\]"),
+    ({"domain.resolution_m": True}, "domain.resolution_m = True: expected"),
+    ({"run.seed": "abc"}, "run.seed = 'abc': expected integer"),
+    ({"rheology.poisson": 0.5}, "poisson"),
+    ({"rheology.alpha": 0.9}, "alpha"),
+    ({"solver.dt": "-5s"}, "solver.dt"),
+    ({"run.duration": "soon"}, "run.duration"),
+    ({"boundary.north.u": 1.0}, "unknown boundary tag 'north'"),
+    ({"initial.thickness_m": "1 + undefined_name*x"}, "initial.thickness_m"),
+    ({"domain.kind": "file", "domain.file": "no/such/coast.geojson"}, "file not found"),
+    ({"healing.law": "magic"}, "healing.law = 'magic'"),
+])
+def test_bad_scene_fails_before_work_naming_key(override, match, tmp_path, monkeypatch):
+    import lagice.scenes.toml_scene as ts
+
+    calls = []
+    real = ts.generate_mesh
+    monkeypatch.setattr(ts, "generate_mesh", lambda *a, **k: calls.append(1) or real(*a, **k))
+    with pytest.raises(ConfigError, match=match):
+        cfg = load_scene("shear_box", {**FAST, **override})
+        build_simulation(cfg, tmp_path)
+    assert not calls, "meshing started before the scene was validated"
+    assert not (tmp_path / "snapshots").exists()
+
+
+def test_missing_scene_file():
+    with pytest.raises(ConfigError, match="does not exist"):
+        load_scene("nowhere/scene.toml")
+    with pytest.raises(ConfigError, match="unknown scene 'nope'"):
+        load_scene("nope")
