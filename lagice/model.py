@@ -16,6 +16,7 @@ from .solvers import SOLVERS
 from .state import IceState
 
 STATE_FIELDS = ("thickness", "concentration", "damage", "stress", "cohesion")
+COMPONENTS = ("thermo", "mover", "remesher", "drifters")
 
 
 class Model:
@@ -41,7 +42,7 @@ class Model:
 
     def __init__(self, state: IceState, rheology: MaxwellEB | None = None, solver="implicit",
                  solver_options: dict | None = None, bcs=(), forces=(), thermo=None, healing=None,
-                 mover=None, remesher=None, config: dict | None = None, rng=None):
+                 mover=None, remesher=None, drifters=None, config: dict | None = None, rng=None):
         self.state = state
         self.rheology = rheology or MaxwellEB()
         self.forces = list(forces)
@@ -49,6 +50,7 @@ class Model:
         self.healing = healing
         self.mover = mover
         self.remesher = remesher
+        self.drifters = drifters
         self.config = config or {}
         self.rng = rng if rng is not None else np.random.default_rng(0)
         opts = dict(solver_options or {})
@@ -96,6 +98,8 @@ class Model:
                 st.counters["mesh_epoch"] = st.counters.get("mesh_epoch", 0) + 1
             report["remesh"] = ev
             self.timings["remeshing"] += time.perf_counter() - t1
+        if self.drifters is not None:
+            self.drifters.advance(st, dt_s)
         return report
 
     # -- checkpoint support ------------------------------------------------------
@@ -123,7 +127,7 @@ class Model:
     def extra_arrays(self) -> dict:
         """Arrays of components that carry state (e.g. a thermodynamic budget)."""
         out = {}
-        for comp_name in ("thermo", "mover", "remesher"):
+        for comp_name in COMPONENTS:
             comp = getattr(self, comp_name)
             if comp is not None and hasattr(comp, "checkpoint_arrays"):
                 for k, v in comp.checkpoint_arrays().items():
@@ -133,7 +137,7 @@ class Model:
     def state_meta(self) -> dict:
         st = self.state
         comp = {}
-        for comp_name in ("thermo", "mover", "remesher"):
+        for comp_name in COMPONENTS:
             c = getattr(self, comp_name)
             if c is not None and hasattr(c, "checkpoint_meta"):
                 comp[comp_name] = c.checkpoint_meta()
@@ -158,7 +162,7 @@ class Model:
         self.timings = dict(meta.get("timings", self.timings))
         self.solver.reset_topology(mesh)
         comp_meta = meta.get("components", {})
-        for comp_name in ("thermo", "mover", "remesher"):
+        for comp_name in COMPONENTS:
             c = getattr(self, comp_name)
             if c is not None and hasattr(c, "load_checkpoint"):
                 pre = f"extra_{comp_name}_"

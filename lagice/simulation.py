@@ -53,9 +53,10 @@ class Simulation:
 
     # -- attachments ---------------------------------------------------------------
     def output(self, every, path, crs_epsg: int | None = 3413, vtu: bool = False,
-               start_date: str = "2000-01-01 00:00:00"):
+               start_date: str = "2000-01-01 00:00:00", grid_resolution_m: float | None = None):
         self.output_schedule = TimeInterval(every, "output every")
-        self.writer = SnapshotWriter(path, crs_epsg=crs_epsg, vtu=vtu, start_date=start_date)
+        self.writer = SnapshotWriter(path, crs_epsg=crs_epsg, vtu=vtu, start_date=start_date,
+                                     grid_resolution_m=grid_resolution_m)
         return self
 
     def checkpoint(self, every, path, keep: int = 3):

@@ -5,7 +5,10 @@ dimension. Each snapshot file ``snapshot_SSSSSS.nc`` holds its own mesh
 (UGRID topology ``mesh``) and the element/node fields at one time; the
 attribute ``mesh_epoch`` counts remesh events, so files with equal epochs
 share the same mesh. ``index.json`` lists every snapshot (file, time, step,
-mesh epoch). Open one with ``xugrid.open_dataset`` or ``xarray.open_dataset``;
+mesh epoch). With a grid resolution, ``grid_SSSSSSSS.nc`` holds the
+element fields conservatively averaged on a regular projected grid
+(:mod:`lagice.io.gridded`); with ``vtu`` a ``.vtu`` file per snapshot is
+written for ParaView. Open one with ``xugrid.open_dataset`` or ``xarray.open_dataset``;
 the files of one epoch concatenate with ``xarray.open_mfdataset(...,
 combine="nested", concat_dim="time")``.
 """
@@ -90,8 +93,9 @@ class SnapshotWriter:
     """Writes snapshots and keeps ``index.json`` up to date (atomically)."""
 
     def __init__(self, directory, crs_epsg: int | None = 3413, vtu: bool = False,
-                 start_date: str = "2000-01-01 00:00:00"):
+                 start_date: str = "2000-01-01 00:00:00", grid_resolution_m: float | None = None):
         self.dir = Path(directory)
+        self.grid_resolution_m = grid_resolution_m
         self.start_date = start_date
         self.crs_epsg = crs_epsg
         self.vtu = vtu
@@ -110,6 +114,12 @@ class SnapshotWriter:
             cd = {k: getattr(state, k) for k in ("thickness", "concentration", "damage")}
             write_mesh(path.with_suffix(".vtu"), state.mesh, cell_data=cd,
                        point_data={"velocity": np.column_stack([state.velocity, np.zeros(len(state.velocity))])})
+        if self.grid_resolution_m:
+            from .gridded import gridded_dataset
+            gds = gridded_dataset(state, self.grid_resolution_m, self.crs_epsg, self.start_date)
+            gpath = self.dir / f"grid_{state.step:08d}.nc"
+            gds.to_netcdf(gpath.with_suffix(".nc.tmp"))
+            os.replace(gpath.with_suffix(".nc.tmp"), gpath)
         self._index_add({"file": path.name, "time_s": state.time_s, "step": int(state.step),
                          "mesh_epoch": int(state.counters.get("mesh_epoch", 0))})
         return path

@@ -67,6 +67,7 @@ SCHEMA = {
     "output": {"every": (EXPR, "1d"), "vtu": (bool, False), "crs_epsg": (int, 3413), "plot": (bool, True),
                "grid_resolution_m": (NUM, None)},
     "checkpoint": {"every": (EXPR, None), "keep": (int, 3)},
+    "drifters": {"positions_m": (list, None), "count": (int, 0)},
 }
 
 SCENE_DIR = Path(__file__).resolve().parents[2] / "examples"

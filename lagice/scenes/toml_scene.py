@@ -151,7 +151,31 @@ def build_model(cfg: dict) -> Model:
         opts.pop("linear_solver", None)
     return Model(state, rheology=rheo, solver=sv["name"], solver_options=opts, bcs=bcs,
                  forces=parts["forces"], thermo=parts["thermo"], healing=parts["healing"],
-                 mover=parts["mover"], remesher=parts["remesher"], config=cfg, rng=rng)
+                 mover=parts["mover"], remesher=parts["remesher"], drifters=build_drifters(cfg, poly),
+                 config=cfg, rng=rng)
+
+
+def build_drifters(cfg, poly):
+    """Drifters at the given positions, or ``count`` seeded random points at
+    least 50 km inside the domain (None when none are asked for)."""
+    from ..drifters import Drifters
+
+    dr = cfg["drifters"]
+    if dr["positions_m"]:
+        return Drifters(dr["positions_m"])
+    if dr["count"] <= 0:
+        return None
+    inner = poly.buffer(-50e3)
+    if inner.is_empty:
+        inner = poly
+    rng = np.random.default_rng(cfg["run"]["seed"] + 7919)
+    minx, miny, maxx, maxy = inner.bounds
+    pts = []
+    while len(pts) < dr["count"]:
+        p = rng.uniform((minx, miny), (maxx, maxy))
+        if inner.contains(shapely.Point(p)):
+            pts.append(p)
+    return Drifters(pts)
 
 
 def build_simulation(cfg: dict, out_dir=None, progress: bool | None = None) -> Simulation:
@@ -163,7 +187,8 @@ def build_simulation(cfg: dict, out_dir=None, progress: bool | None = None) -> S
     cfg["_out_dir"] = str(out)
     sim.out_dir = out
     sim.output(cfg["output"]["every"], out / "snapshots", crs_epsg=cfg["output"]["crs_epsg"],
-               vtu=cfg["output"]["vtu"], start_date=cfg["run"]["start_date"])
+               vtu=cfg["output"]["vtu"], start_date=cfg["run"]["start_date"],
+               grid_resolution_m=cfg["output"]["grid_resolution_m"])
     if cfg["checkpoint"]["every"] is not None:
         sim.checkpoint(cfg["checkpoint"]["every"], out / "checkpoints", keep=cfg["checkpoint"]["keep"])
     return sim
@@ -189,6 +214,8 @@ def finish(sim: Simulation) -> dict:
            "png": None, "out_dir": out}
     if sim.model.config["output"]["plot"]:
         from ..plotting import plot_run
-        res["png"] = plot_run(out / "snapshots", out / f"{summary['scene']}.png", summary)
+        dr = sim.model.drifters
+        res["png"] = plot_run(out / "snapshots", out / f"{summary['scene']}.png", summary,
+                              trajectories=dr.trajectories() if dr is not None else None)
     (out / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
     return res
