@@ -52,11 +52,13 @@ def _resume(args) -> int:
     from .scenes.toml_scene import finish
     from .simulation import Simulation
 
-    sim = Simulation.resume(args.checkpoint)
+    ck = Path(args.checkpoint)
+    ck_dir = ck if ck.is_dir() else ck.parent
+    run_dir = ck_dir.parent if ck_dir.name == "checkpoints" else ck_dir
+    sim = Simulation.resume(ck, out_dir=run_dir)
     st = sim.model.state
     print(f"lagice: resuming {sim.model.config.get('scene', {}).get('name', '?')!r} from "
-          f"{sim.resumed_from} (step {st.step}, day {st.time_s / 86400:.3f})", flush=True)
-    sim.out_dir = Path(sim.model.config.get("_out_dir", Path(args.checkpoint).parent))
+          f"{sim.resumed_from} (step {st.step}, day {st.time_s / 86400:.3f}) -> {run_dir}/", flush=True)
     _report(finish(sim))
     return 0
 

@@ -92,7 +92,7 @@ class Model:
             t1 = t2
         if self.remesher is not None:
             ev = self.remesher(st, self.solver)
-            if ev is not None:
+            if ev is not None and getattr(ev, "kind", "") != "failed":
                 self.remesh_events.append(ev)
                 st.counters["remesh_count"] = st.counters.get("remesh_count", 0) + 1
                 st.counters["mesh_epoch"] = st.counters.get("mesh_epoch", 0) + 1
@@ -102,10 +102,29 @@ class Model:
             self.drifters.advance(st, dt_s)
         return report
 
+    def volume_budget(self) -> dict:
+        """Ice volume budget [m³]: V(t) − V(0) = thermodynamic change − outflow + residual.
+
+        The residual is what mesh motion and remapping did to the volume
+        (round-off when they conserve it)."""
+        st = self.state
+        v0 = st.counters.get("volume0_m3", st.ice_volume_m3)
+        thermo = 0.0
+        if self.thermo is not None and getattr(self.thermo, "budget", None) is not None:
+            thermo = float(self.thermo.budget.thermo_m3)
+        outflow = 0.0
+        if self.mover is not None and hasattr(self.mover, "budget"):
+            outflow = float(self.mover.budget.get("outflow_volume_m3", 0.0))
+        v = st.ice_volume_m3
+        res = v - v0 - thermo + outflow
+        return {"initial_m3": v0, "current_m3": v, "thermodynamic_m3": thermo, "outflow_m3": outflow,
+                "residual_m3": res, "relative_residual": res / v0 if v0 else 0.0}
+
     # -- checkpoint support ------------------------------------------------------
     def fingerprint(self) -> str:
         """Hash of the scene configuration: a checkpoint resumes only the same scene."""
-        blob = json.dumps(self.config, sort_keys=True, default=str).encode()
+        cfg = {k: v for k, v in self.config.items() if not k.startswith("_")}  # e.g. _out_dir
+        blob = json.dumps(cfg, sort_keys=True, default=str).encode()
         return hashlib.sha256(blob).hexdigest()[:16]
 
     def state_arrays(self) -> dict:

@@ -32,7 +32,7 @@ def plot_run(snap_dir, png_path, summary: dict | None = None, trajectories=None)
     panels = [("damage", "damage", "magma_r", (0, 1)),
               ("total_deformation_rate", "log10 total deformation rate (s⁻¹)", "viridis", None),
               ("thickness", "thickness h (m)", "Blues", None),
-              ("concentration", "concentration A", "Greys_r", (0, 1))]
+              ("concentration", "concentration A", "cividis", None)]
     fig, axes = plt.subplots(2, 3, figsize=(15, 9.5))
     axes = axes.ravel()
     for ax, (name, title, cmap, lim) in zip(axes[:4], panels):
@@ -40,6 +40,8 @@ def plot_run(snap_dir, png_path, summary: dict | None = None, trajectories=None)
             ax.set_visible(False)
             continue
         v = ds[name].values[0]
+        if name == "concentration":
+            lim = (min(float(v.min()), 0.999), 1.0)
         if name == "total_deformation_rate":
             v = np.log10(np.maximum(v, 1e-12))
             vmax = float(np.nanmax(v))

@@ -114,16 +114,18 @@ class Simulation:
         st = self.model.state
         days = st.time_s / 86400.0
         rate = (st.step * self.dt / 86400.0) / max(wall_s, 1e-9) * 3600.0 if wall_s > 0 else float("nan")
-        drift = (st.ice_volume_m3 - self.volume0) / self.volume0 if self.volume0 else 0.0
+        b = self.model.volume_budget()
         print(f"  day {days:7.3f}  step {st.step}/{self.n_steps}  {rate:8.1f} sim-days/wall-hour  "
-              f"remeshes {st.counters.get('remesh_count', 0)}  volume drift {drift:+.2e}", flush=True)
+              f"remeshes {st.counters.get('remesh_count', 0)}  volume {b['current_m3']:.4e} m3 "
+              f"(thermo {b['thermodynamic_m3']:+.2e}, outflow {b['outflow_m3']:.2e}, "
+              f"drift {b['relative_residual']:+.1e})", flush=True)
 
     def summary(self) -> dict:
         st = self.model.state
         return {"time_s": st.time_s, "steps": st.step, "wall_s": self.wall_total,
                 "timings": {**self.model.timings, **self.wall},
                 "remesh_count": st.counters.get("remesh_count", 0),
-                "ice_volume_m3": st.ice_volume_m3}
+                "ice_volume_m3": st.ice_volume_m3, "volume_budget": self.model.volume_budget()}
 
     # -- checkpoint / resume ---------------------------------------------------------
     def _meta(self) -> dict:

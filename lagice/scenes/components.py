@@ -25,6 +25,8 @@ from __future__ import annotations
 
 import inspect
 
+import numpy as np
+
 from ..errors import ConfigError
 from .config import time_space_callable
 
@@ -216,13 +218,67 @@ def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
     if cfg["lagrangian"]["enabled"]:
         parts["mover"] = build_mover(cfg, mesh)
     if cfg["remesh"]["enabled"]:
-        parts["remesher"] = build_remesher(cfg, mesh)
+        parts["remesher"] = build_remesher(cfg, mesh, parts["mover"])
     return parts
 
 
+class Mover:
+    """Lagrangian mesh motion (:func:`lagice.lagrangian.move_mesh`) with its
+    budget (outflow, ridging, limited nodes) carried in checkpoints."""
+
+    def __init__(self):
+        from ..lagrangian import new_budget
+
+        self.budget = new_budget()
+        self.last_flagged = None
+
+    def advance(self, state, dt_s):
+        from ..lagrangian import move_mesh
+
+        rep = move_mesh(state, dt_s, self.budget)
+        self.last_flagged = rep.flagged_elements
+        return rep
+
+    def checkpoint_meta(self):
+        return {"budget": self.budget}
+
+    def load_checkpoint(self, arrays, meta):
+        self.budget.update(meta.get("budget", {}))
+
+
+class Remesher:
+    """Remesh check after each move (:func:`lagice.remesh.remesh_if_needed`),
+    target size = the scene's initial resolution, fixed in space."""
+
+    def __init__(self, size_field, mover, min_angle_deg=10.0, **params):
+        from ..remesh import RemeshLog, TriggerParams
+
+        self.size_field = size_field
+        self.mover = mover
+        try:
+            self.trigger = TriggerParams(min_angle_deg=min_angle_deg, **{k: v for k, v in params.items()
+                                                                         if k in TriggerParams.__dataclass_fields__})
+        except TypeError as exc:
+            raise ConfigError(f"[remesh.params]: {exc}") from None
+        self.options = {k: v for k, v in params.items() if k not in TriggerParams.__dataclass_fields__}
+        self.log = RemeshLog()
+
+    def __call__(self, state, solver):
+        from ..remesh import remesh_if_needed
+
+        return remesh_if_needed(state, self.size_field, solver=solver, params=self.trigger,
+                                flagged=self.mover.last_flagged if self.mover else None, log=self.log,
+                                **self.options)
+
+
 def build_mover(cfg, mesh):
-    raise ConfigError("lagrangian.enabled: mesh motion is not available in this build")
+    return Mover()
 
 
-def build_remesher(cfg, mesh):
-    raise ConfigError("remesh.enabled: remeshing is not available in this build")
+def build_remesher(cfg, mesh, mover=None):
+    from .config import spatial_values
+
+    res = cfg["domain"]["resolution_m"]
+    size = res if not isinstance(res, str) else (
+        lambda x, y: spatial_values(res, np.atleast_1d(x), np.atleast_1d(y), "domain.resolution_m"))
+    return Remesher(size, mover, cfg["remesh"]["min_angle_deg"], **cfg["remesh"]["params"])
