@@ -10,6 +10,8 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit, prange
 
+from ._numba import serial_copy
+
 
 @njit(cache=True, parallel=True)
 def shape_gradients(nodes, tri):
@@ -160,3 +162,15 @@ def assemble_elasticity(entry_map, b, c, coef, nu, nnz):
                 data[entry_map[e, base + 7]] += w * (ca * cj + d33 * ba * bj)
     return data
 
+
+
+#: serial builds of the prange kernels above (cheaper on small meshes and on a
+#: busy machine; the solvers pick with :func:`lagice._numba.pick`)
+shape_gradients_serial = serial_copy(shape_gradients)
+strain_rate_serial = serial_copy(strain_rate)
+nodal_force_from_stress_serial = serial_copy(nodal_force_from_stress)
+lumped_mass_serial = serial_copy(lumped_mass)
+SHAPE_GRADIENTS = (shape_gradients_serial, shape_gradients)
+STRAIN_RATE = (strain_rate_serial, strain_rate)
+NODAL_FORCE = (nodal_force_from_stress_serial, nodal_force_from_stress)
+LUMPED_MASS = (lumped_mass_serial, lumped_mass)

@@ -18,6 +18,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from ._numba import pick, serial_copy
 from .errors import ConfigError
 from .params import MaxwellEBParams
 
@@ -129,6 +130,9 @@ def damage_update_kernel(sigma, damage, cohesion, dt, td, heal_rate, q, denom, m
     return n_capped
 
 
+DAMAGE_UPDATE = (serial_copy(damage_update_kernel), damage_update_kernel)
+
+
 def draw_cohesion(n_elements: int, params: MaxwellEBParams, rng: np.random.Generator) -> np.ndarray:
     """Cohesion C [Pa] per element, uniform in [C_min, C_max] from a seeded generator
     (quenched disorder, seed 004 §2.2)."""
@@ -179,7 +183,8 @@ class MaxwellEB:
     def damage_update(self, sigma, damage, cohesion, dt, td, heal_rate):
         """Apply the damage/healing update in place; returns d_crit per element."""
         out = np.empty(len(damage))
-        n = damage_update_kernel(sigma, damage, cohesion, float(dt), np.ascontiguousarray(td),
+        kernel = pick(DAMAGE_UPDATE, len(damage))
+        n = kernel(sigma, damage, cohesion, float(dt), np.ascontiguousarray(td),
                                  np.ascontiguousarray(heal_rate), self.q, self._denom,
                                  self.params.max_damage, out)
         self.n_capped_total += int(n)

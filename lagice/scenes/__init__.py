@@ -12,6 +12,8 @@ from ..errors import ConfigError
 
 SCENES = {
     "uniaxial_compression": "lagice.scenes.compression",
+    "shear_channel": "lagice.scenes.shear_channel",
+    "wind_square": "lagice.scenes.wind_square",
 }
 DEFAULT_SCENE = "uniaxial_compression"
 

@@ -78,7 +78,9 @@ def build(n_across: int = 40, seed: int = 0, solver: str = "implicit", healing: 
                              cohesion_pa=draw_cohesion(mesh.n_elements, params, rng))
     state.counters["seed"] = seed
     bcs = [VelocityBC("top", v=-push_speed_m_s), VelocityBC("bottom", v=0.0)]
-    solv = SOLVERS[solver](rheo, mesh, bcs=bcs, linear_solver=linear_solver, **solver_options)
+    if solver == "implicit":  # solver-specific options (explicit: substeps=, safety=, ...)
+        solver_options["linear_solver"] = linear_solver
+    solv = SOLVERS[solver](rheo, mesh, bcs=bcs, **solver_options)
     el, ln = edge_elements(mesh, "top")
     return CompressionScene(mesh, state, solv, float(dt_s), dx, n_across, el, ln, width, length_m,
                             push_speed_m_s)

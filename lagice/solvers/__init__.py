@@ -1,7 +1,8 @@
 """Time steppers of the Maxwell-EB rheology; a scene picks one by name."""
 from .base import DirichletSet, StepInfo, VelocityBC
+from .explicit import ExplicitSolver
 from .implicit import ImplicitSolver
 
-SOLVERS = {"implicit": ImplicitSolver}
+SOLVERS = {"implicit": ImplicitSolver, "explicit": ExplicitSolver}
 
-__all__ = ["DirichletSet", "StepInfo", "VelocityBC", "ImplicitSolver", "SOLVERS"]
+__all__ = ["DirichletSet", "StepInfo", "VelocityBC", "ImplicitSolver", "ExplicitSolver", "SOLVERS"]

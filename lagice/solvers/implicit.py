@@ -23,7 +23,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ConfigError, SolverError
-from ..fem import SparsityPattern, assemble_elasticity, lumped_mass, nodal_force_from_stress, shape_gradients, strain_rate
+from .._numba import pick
+from ..fem import LUMPED_MASS, NODAL_FORCE, SHAPE_GRADIENTS, STRAIN_RATE, SparsityPattern, assemble_elasticity
 from ..rheology import MaxwellEB
 from ..state import IceState
 from .base import DirichletSet, StepInfo, Timer
@@ -79,7 +80,7 @@ class ImplicitSolver:
     def update_geometry(self) -> None:
         """Recompute shape gradients and td after nodes moved (Lagrangian step)."""
         m = self.mesh
-        self.b, self.c, self.area = shape_gradients(m.nodes, m.triangles)
+        self.b, self.c, self.area = pick(SHAPE_GRADIENTS, m.n_elements)(m.nodes, m.triangles)
         if np.any(self.area <= 0):
             raise SolverError(f"{int(np.sum(self.area <= 0))} inverted elements in the mesh")
         self.td = self.rheology.damage_time(np.sqrt(2.0 * self.area))
@@ -94,6 +95,10 @@ class ImplicitSolver:
         t_new = state.time_s + dt
         ptr, elems, local = mesh.node_elements
         h = state.thickness
+        n_el = mesh.n_elements
+        lumped_mass = pick(LUMPED_MASS, n_el)
+        nodal_force_from_stress = pick(NODAL_FORCE, n_el)
+        strain_rate = pick(STRAIN_RATE, n_el)
         with Timer(tm, "assembly"):
             E, lam = self.rheology.moduli(state.damage, state.concentration)
             gamma = lam / (lam + dt)

@@ -1,0 +1,429 @@
+"""Explicit Maxwell-EB time stepper, neXtSIM BBM style (DESIGN.md §4.2).
+
+One outer step Δt (forcing evaluated, lumped mass, geometry, moduli) is split
+into N elastic sub-steps Δt_s = Δt/N. Each sub-step is two numba kernels,
+both parallel over their *own* entities so that no loop scatters:
+
+1. **node kernel** (velocity): the internal force f_i = −Σ_e area h σ_e·∇φ_i is
+   gathered through the node→element adjacency, then momentum with lumped
+   mass m_i is advanced semi-implicitly,
+
+       (m/Δt_s + a c_d Rθ + ½ m f J) u^{k+1}
+           = (m/Δt_s − ½ m f J) u^k + f_i + a (τa + c_d Rθ Uw),
+
+   with c_d = ρw Cw |Uw − u^k| (drag coefficient from the previous sub-step,
+   drag itself implicit), J = k× = [[0, −1], [1, 0]] and the Coriolis term
+   Crank–Nicolson, so pure inertial oscillations keep their speed exactly
+   (the update is a Cayley rotation). a is the node's lumped area. A 2×2
+   solve per node; prescribed components (VelocityBC, coast) are set to their
+   value, linearly interpolated in time across the outer step.
+
+2. **element kernel** (stress and damage): strain rate ε̇(u^{k+1}), Maxwell
+   update σ ← (σ + Δt_s E K:ε̇) λ/(λ+Δt_s) (seed 004 eq. 1, same
+   discretisation as the implicit solver), then the damage/stress correction
+   and healing of seed 004 eqs. 9-11 with Δt_s — the same arithmetic as
+   :func:`lagice.rheology.damage_update_kernel`, built on its numba core
+   ``_dcrit`` (a test checks both agree bit for bit). E = E0 (1−d) g and
+   λ = λ0 ((1−d) g)^(α−1), g = exp(−c*(1−A)) (the rheology's formulas; a test
+   checks them against ``MaxwellEB.moduli``) are recomputed only where damage
+   changed.
+
+Stability: the sub-step is limited by elastic waves, Δt_s ≲ C Δx / sqrt(E/ρ);
+C was measured (``benchmarks/stability.py``) and ships in
+``lagice/data/stability_limits.json`` (see :mod:`lagice.stability`).
+``substeps=None`` picks N from that limit with a safety factor.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from numba import njit, prange
+
+from ..errors import ConfigError, SolverError
+from .._numba import PARALLEL_MIN_SIZE, serial_copy
+from ..fem import lumped_mass, lumped_mass_serial, shape_gradients, shape_gradients_serial, strain_rate, strain_rate_serial
+from ..forces import explicit_terms
+from ..rheology import MaxwellEB, _dcrit
+from ..state import IceState
+from .base import DirichletSet, StepInfo
+
+
+#: keys of ``ExplicitSolver.kernel_timings`` / ``StepInfo.kernel_timings`` [s]
+KERNELS = ("forcing", "setup", "node_velocity", "element_stress_damage")
+
+
+def _adjacency_weights(tri, b, c, area, h, ptr, elems, local):
+    """Per adjacency entry p (node i, element e, local vertex k): area·h·∂φk/∂x and
+    area·h·∂φk/∂y [m² per m], so that the internal force on node i is
+    f_i = −Σ_p (wb σxx + wc σxy, wb σxy + wc σyy)."""
+    n = ptr.shape[0] - 1
+    wb = np.empty(elems.shape[0])
+    wc = np.empty(elems.shape[0])
+    for i in prange(n):
+        for p in range(ptr[i], ptr[i + 1]):
+            e = elems[p]
+            k = local[p]
+            w = area[e] * h[e]
+            wb[p] = w * b[e, k]
+            wc[p] = w * c[e, k]
+    return wb, wc
+
+
+def _node_velocity(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
+                   half_mf, fixed, pres0, pres1, w_time):
+    """One semi-implicit momentum sub-step in place on ``vel`` (n, 2) (module doc, step 1).
+
+    m_dt = m/Δt_s [kg s-1]; fext = a τ [N] (velocity-independent);
+    cda = a ρw Cw [kg m-1]; current Uw [m s-1]; half_mf = ½ m f [kg s-1];
+    fixed (n, 2) int8 flags of prescribed components; pres0/pres1 their values at
+    the start/end of the outer step, weighted (1 − w_time, w_time). The new
+    velocity is also added to ``vel_sum`` (outer-step mean velocity).
+    """
+    n = ptr.shape[0] - 1
+    for i in prange(n):
+        fx0 = fixed[i, 0]
+        fx1 = fixed[i, 1]
+        if fx0 and fx1:
+            vel[i, 0] = pres0[i, 0] + w_time * (pres1[i, 0] - pres0[i, 0])
+            vel[i, 1] = pres0[i, 1] + w_time * (pres1[i, 1] - pres0[i, 1])
+            vel_sum[i, 0] += vel[i, 0]
+            vel_sum[i, 1] += vel[i, 1]
+            continue
+        fx = 0.0
+        fy = 0.0
+        for p in range(ptr[i], ptr[i + 1]):
+            e = elems[p]
+            sxx = sigma[e, 0]
+            syy = sigma[e, 1]
+            sxy = sigma[e, 2]
+            fx -= wb[p] * sxx + wc[p] * sxy
+            fy -= wb[p] * sxy + wc[p] * syy
+        u = vel[i, 0]
+        v = vel[i, 1]
+        md = m_dt[i]
+        uwx = current[i, 0]
+        uwy = current[i, 1]
+        ru = uwx - u
+        rv = uwy - v
+        cd = cda[i] * math.sqrt(ru * ru + rv * rv)
+        hf = half_mf[i]
+        a11 = md + cd * cos_t
+        a12 = -cd * sin_t - hf
+        a21 = cd * sin_t + hf
+        a22 = md + cd * cos_t
+        rx = md * u + fx + fext[i, 0] + cd * (cos_t * uwx - sin_t * uwy) + hf * v
+        ry = md * v + fy + fext[i, 1] + cd * (sin_t * uwx + cos_t * uwy) - hf * u
+        if fx0:
+            un = pres0[i, 0] + w_time * (pres1[i, 0] - pres0[i, 0])
+            vn = (ry - a21 * un) / a22 if a22 != 0.0 else 0.0
+        elif fx1:
+            vn = pres0[i, 1] + w_time * (pres1[i, 1] - pres0[i, 1])
+            un = (rx - a12 * vn) / a11 if a11 != 0.0 else 0.0
+        else:
+            det = a11 * a22 - a12 * a21
+            if det != 0.0:
+                un = (a22 * rx - a12 * ry) / det
+                vn = (a11 * ry - a21 * rx) / det
+            else:
+                un = 0.0
+                vn = 0.0
+        vel[i, 0] = un
+        vel[i, 1] = vn
+        vel_sum[i, 0] += un
+        vel_sum[i, 1] += vn
+
+
+def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c, sigma_t,
+                           td, heal_rate, e_dt, gamma, dt_s, kxx, kxy, kss, q, denom,
+                           max_damage, E0, lambda0, alpha, damaged_flag):
+    """Maxwell stress update and damage/healing of one sub-step, in place (module doc, step 2).
+
+    e_dt = Δt_s E [Pa s], gamma = λ/(λ+Δt_s) per element, refreshed here where
+    damage changes from E = E0 (1−d) g, λ = λ0 ((1−d) g)^(α−1) with
+    g = conc_factor = exp(−c*(1−A)) (rheology.young_modulus/relaxation_time;
+    an integer α−1 is taken as repeated products). kxx = 1/(1−ν²), kxy = ν/(1−ν²), kss = (1−ν)/(1−ν²) are the
+    entries of K; sigma_c = 2C/denom and sigma_t = sigma_c/q [Pa] (seed 004 eqs. 4, 6)
+    per element. Returns the number of elements whose damage hit the cap.
+    """
+    m = tri.shape[0]
+    n_capped = 0
+    for e in prange(m):
+        exx = 0.0
+        eyy = 0.0
+        exy = 0.0
+        for k in range(3):
+            u = vel[tri[e, k], 0]
+            v = vel[tri[e, k], 1]
+            exx += b[e, k] * u
+            eyy += c[e, k] * v
+            exy += c[e, k] * u + b[e, k] * v
+        exy *= 0.5
+        ed = e_dt[e]
+        g = gamma[e]
+        sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * g
+        syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * g
+        sxy = (sigma[e, 2] + ed * (kss * exy)) * g
+        # damage and stress correction: same arithmetic as rheology.damage_update_kernel.
+        # Cheap test first: strictly inside the envelope (s1 < σT and q s1 − s2 < σc, with
+        # σc = 2C/denom, σT = σc/q precomputed) _dcrit returns exactly 1.
+        mm = 0.5 * (sxx + syy)
+        rr = math.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
+        s1 = mm + rr
+        if s1 < sigma_t[e] and q * s1 - (mm - rr) < sigma_c[e]:
+            dc = 1.0
+        else:
+            dc = _dcrit(sxx, syy, sxy, cohesion[e], q, denom)
+        d0 = damage[e]
+        d = d0
+        if dc < 1.0:
+            r = min(1.0, dt_s / td[e]) * (1.0 - dc)
+            d = 1.0 - (1.0 - d) * (1.0 - r)
+            f = 1.0 - r
+            sxx *= f
+            syy *= f
+            sxy *= f
+            damaged_flag[e] = 1
+        d -= dt_s * heal_rate[e]
+        if d < 0.0:
+            d = 0.0
+        if d > max_damage:
+            d = max_damage
+            n_capped += 1
+        sigma[e, 0] = sxx
+        sigma[e, 1] = syy
+        sigma[e, 2] = sxy
+        if d != d0:
+            damage[e] = d
+            x = (1.0 - d) * conc_factor[e]
+            if alpha == 4.0:
+                lam = lambda0 * (x * x * x)
+            elif alpha == 5.0:
+                lam = lambda0 * (x * x) * (x * x)
+            else:
+                lam = lambda0 * x ** (alpha - 1.0)
+            e_dt[e] = dt_s * (E0 * x)
+            gamma[e] = lam / (lam + dt_s)
+    return n_capped
+
+
+def _serial(func):
+    """Serial numba variant of a prange kernel (see :mod:`lagice._numba`)."""
+    return serial_copy(func, error_model="numpy")
+
+
+adjacency_weights = njit(cache=True, parallel=True)(_adjacency_weights)
+adjacency_weights_serial = _serial(_adjacency_weights)
+
+#: compiled variants: parallel (numba prange over own entities, no races) and serial
+#: (cheaper below ~PARALLEL_MIN_ELEMENTS, and on a loaded machine where fork/join waits)
+node_velocity_kernel = njit(cache=True, parallel=True, error_model="numpy")(_node_velocity)
+node_velocity_kernel_serial = _serial(_node_velocity)
+element_stress_damage_kernel = njit(cache=True, parallel=True, error_model="numpy")(
+    _element_stress_damage)
+element_stress_damage_kernel_serial = _serial(_element_stress_damage)
+PARALLEL_MIN_ELEMENTS = PARALLEL_MIN_SIZE
+
+
+class ExplicitSolver:
+    """Explicit (sub-stepped, lumped-mass) Maxwell-EB solver.
+
+    Args:
+        rheology: :class:`~lagice.rheology.MaxwellEB`.
+        mesh: the mesh (node positions are read at each :meth:`update_geometry`).
+        bcs: list of :class:`~lagice.solvers.base.VelocityBC`; coast nodes are no-slip.
+        forces: external forces (:mod:`lagice.forces`: ``WindStress``,
+            ``OceanDrag``, ``Coriolis`` or anything with ``add_explicit_terms``).
+        substeps: N elastic sub-steps per outer step, or None: the smallest N with
+            Δt/N ≤ ``safety`` × the measured stability limit (:mod:`lagice.stability`).
+        heal_rate: callable ``(state) -> (m,) [s-1]`` or None for the rheology's constant rate.
+        safety: fraction of the measured sub-step limit used when ``substeps`` is None.
+        allow_unstable: run (with a :class:`~lagice.stability.StabilityWarning`)
+            when Δt_s is beyond the measured limit instead of raising ConfigError.
+        parallel: True/False, or None (default): parallel kernels from
+            ``PARALLEL_MIN_ELEMENTS`` elements up (fork/join costs more than it
+            saves on small meshes; measured in ``benchmarks/bench_explicit.py``).
+
+    After a step, ``state.velocity`` is the last sub-step's velocity (the dynamic
+    state), :attr:`mean_velocity` the mean over the sub-steps (what nodes move
+    with: it filters the elastic waves that the sub-steps resolve) and
+    :attr:`last_strain_rate` the strain rate of that mean velocity.
+
+    Per-kernel wall times [s] are accumulated in :attr:`kernel_timings` and
+    returned per step in ``StepInfo.kernel_timings``; ``StepInfo.timings`` maps
+    them onto the implicit solver's keys (assembly = forcing + setup,
+    solve = node_velocity, damage = element_stress_damage) so scenes can sum
+    either. ``StepInfo.iterations`` is the number of sub-steps.
+    """
+
+    name = "explicit"
+
+    def __init__(self, rheology: MaxwellEB, mesh, bcs=(), forces=(), substeps: int | None = None,
+                 heal_rate=None, safety: float = 0.7, allow_unstable: bool = False,
+                 parallel: bool | None = None):
+        if not isinstance(rheology, MaxwellEB):
+            raise ConfigError(f"rheology must be MaxwellEB; got {type(rheology).__name__}")
+        if substeps is not None:
+            if int(substeps) != substeps or int(substeps) < 1:
+                raise ConfigError(f"substeps = {substeps!r} must be an integer >= 1 (or None: automatic)")
+            substeps = int(substeps)
+        if not 0.0 < safety <= 1.0:
+            raise ConfigError(f"safety = {safety!r} must be in (0, 1]")
+        self.rheology = rheology
+        self.bcs = list(bcs)
+        self.forces = list(forces)
+        self.substeps = substeps
+        self.safety = float(safety)
+        self.allow_unstable = bool(allow_unstable)
+        self.heal_rate = heal_rate
+        self.parallel = parallel
+        self.kernel_timings = {k: 0.0 for k in KERNELS}
+        self._checked = set()
+        self.last_strain_rate = None
+        self.mean_velocity = None
+        self.last_substeps = None
+        self.reset_topology(mesh)
+
+    # -- geometry/topology caches ------------------------------------------------
+    def reset_topology(self, mesh) -> None:
+        """Rebuild everything that depends on connectivity (after a remesh)."""
+        self.mesh = mesh
+        self.mean_velocity = None
+        self.dirichlet = DirichletSet(mesh, self.bcs)
+        fixed = np.zeros((mesh.n_nodes, 2), np.int8)
+        fixed.reshape(-1)[self.dirichlet.dofs] = 1
+        self.fixed = fixed
+        self.update_geometry()
+
+    def update_geometry(self) -> None:
+        """Recompute shape gradients, areas and td after nodes moved (Lagrangian step)."""
+        m = self.mesh
+        sg = shape_gradients if self._parallel_for(m) else shape_gradients_serial
+        self.b, self.c, self.area = sg(m.nodes, m.triangles)
+        if np.any(self.area <= 0):
+            raise SolverError(f"{int(np.sum(self.area <= 0))} inverted elements in the mesh")
+        self.td = self.rheology.damage_time(np.sqrt(2.0 * self.area))
+        self.dx_min = float(np.sqrt(2.0 * self.area.min()))
+
+    def _parallel_for(self, mesh) -> bool:
+        return self.parallel if self.parallel is not None else mesh.n_elements >= PARALLEL_MIN_ELEMENTS
+
+    # -- sub-step choice -------------------------------------------------------------
+    def substeps_for(self, dt: float, E_max: float | None = None) -> int:
+        """N for an outer step dt [s]: the fixed ``substeps``, or the smallest N with
+        dt/N <= safety × the measured limit for the stiffest element (E_max [Pa],
+        default E0)."""
+        if self.substeps is not None:
+            return self.substeps
+        from ..stability import explicit_substep_limit
+
+        E_max = self.rheology.params.E0 if E_max is None else E_max
+        lim = explicit_substep_limit(self.dx_min, E_max, self.rheology.params)
+        return max(1, int(math.ceil(dt / (self.safety * lim) - 1e-9)))
+
+    def _check_stability(self, dt_s: float, E_max: float) -> None:
+        key = (round(dt_s, 9), round(self.dx_min, 3), round(E_max, 3))
+        if key in self._checked:
+            return
+        from ..stability import check_explicit_substep
+
+        check_explicit_substep(dt_s, self.dx_min, E_max, self.rheology.params,
+                               allow_unstable=self.allow_unstable)
+        if len(self._checked) > 1000:
+            self._checked.clear()
+        self._checked.add(key)
+
+    # -- one step -----------------------------------------------------------------
+    def step(self, state: IceState, dt: float) -> StepInfo:
+        if not dt > 0:
+            raise ConfigError(f"dt = {dt!r} s must be > 0")
+        kt = {k: 0.0 for k in KERNELS}
+        mesh, p = self.mesh, self.rheology.params
+        t0 = time.perf_counter()
+        E, lam = self.rheology.moduli(state.damage, state.concentration)
+        E_max = float(E.max()) if len(E) else p.E0
+        n_sub = self.substeps_for(dt, E_max)
+        dt_s = dt / n_sub
+        self._check_stability(dt_s, E_max)
+        t_new = state.time_s + dt
+        terms = explicit_terms(self.forces, t_new, mesh.nodes)
+        pres0 = np.zeros((mesh.n_nodes, 2))
+        pres1 = np.zeros((mesh.n_nodes, 2))
+        if len(self.dirichlet.dofs):
+            pres0.reshape(-1)[self.dirichlet.dofs] = self.dirichlet.values(state.time_s)
+            pres1.reshape(-1)[self.dirichlet.dofs] = self.dirichlet.values(t_new)
+        t1 = time.perf_counter()
+        kt["forcing"] = t1 - t0
+
+        ptr, elems, local = mesh.node_elements
+        tri = mesh.triangles
+        par = self._parallel_for(mesh)
+        h = np.ascontiguousarray(state.thickness, np.float64)
+        lm = lumped_mass if par else lumped_mass_serial
+        mass = lm(ptr, elems, self.area, p.rho_ice * h)
+        node_area = lm(ptr, elems, self.area, np.ones_like(h))
+        wb, wc = (adjacency_weights if par else adjacency_weights_serial)(
+            tri, self.b, self.c, self.area, h, ptr, elems, local)
+        m_dt = mass / dt_s
+        fext = terms.tau * node_area[:, None]
+        cda = terms.drag_coef * node_area
+        half_mf = 0.5 * mass * terms.coriolis
+        e_dt = dt_s * E
+        gamma = lam / (lam + dt_s)
+        rh = self.rheology
+        heal = (self.heal_rate(state) if self.heal_rate is not None
+                else self.rheology.constant_heal_rate(mesh.n_elements))
+        heal = np.ascontiguousarray(heal, np.float64)
+        nu = p.poisson
+        kxx, kxy, kss = 1.0 / (1.0 - nu * nu), nu / (1.0 - nu * nu), (1.0 - nu) / (1.0 - nu * nu)
+        vel = np.ascontiguousarray(state.velocity, np.float64).copy()
+        sigma = np.array(state.stress, np.float64, order="C")  # copies: the state is left
+        damage = np.array(state.damage, np.float64)  # untouched if the step fails
+        conc_factor = np.exp(-p.concentration_c * (1.0 - np.asarray(state.concentration, np.float64)))
+        coh = np.ascontiguousarray(state.cohesion, np.float64)
+        sig_c = 2.0 * coh / rh._denom
+        sig_t = sig_c / rh.q
+        flag = np.zeros(mesh.n_elements, np.int8)
+        vel_sum = np.zeros_like(vel)
+        t2 = time.perf_counter()
+        kt["setup"] = t2 - t1
+
+        n_capped = 0
+        tn = tm = 0.0
+        node_k = node_velocity_kernel if par else node_velocity_kernel_serial
+        elem_k = element_stress_damage_kernel if par else element_stress_damage_kernel_serial
+        for k in range(n_sub):
+            ta = time.perf_counter()
+            node_k(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, terms.current,
+                   terms.cos_turn, terms.sin_turn, half_mf, self.fixed, pres0, pres1, (k + 1) / n_sub)
+            tb = time.perf_counter()
+            n_capped += elem_k(
+                tri, self.b, self.c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, self.td, heal,
+                e_dt, gamma, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0,
+                p.relaxation_time_s, float(p.alpha), flag)
+            tc = time.perf_counter()
+            tn += tb - ta
+            tm += tc - tb
+        kt["node_velocity"] = tn
+        kt["element_stress_damage"] = tm
+        if not np.all(np.isfinite(vel)):
+            raise SolverError(f"non-finite velocity at t = {t_new:.6g} s (explicit solver, Δt = {dt:g} s, "
+                              f"{n_sub} sub-steps of {dt_s:.3g} s): sub-step beyond the stability limit?")
+        state.velocity = vel
+        state.stress = sigma
+        state.damage = damage
+        state.time_s = t_new
+        state.step += 1
+        self.mean_velocity = vel_sum / n_sub
+        self.last_strain_rate = (strain_rate if par else strain_rate_serial)(tri, self.b, self.c,
+                                                                            self.mean_velocity)
+        self.last_substeps = n_sub
+        rh.n_capped_total += int(n_capped)
+        for k, v in kt.items():
+            self.kernel_timings[k] += v
+        info = StepInfo(iterations=n_sub, residual=0.0, n_damaged=int(flag.sum()), n_capped=int(n_capped))
+        info.timings = {"assembly": kt["forcing"] + kt["setup"], "solve": kt["node_velocity"],
+                        "damage": kt["element_stress_damage"]}
+        info.kernel_timings = kt
+        return info
