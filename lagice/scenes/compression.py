@@ -108,7 +108,7 @@ def macro_stress(scene: CompressionScene) -> float:
 
 
 def run(out_dir="runs/uniaxial_compression", n_across: int = 40, seed: int = 0,
-        max_strain: float = 6e-4, n_snapshots: int = 8, progress: bool = True, plot: bool = True,
+        max_strain: float = 5e-4, n_snapshots: int = 8, progress: bool = True, plot: bool = True,
         **build_kw) -> dict:
     """Run the compression scene up to macroscopic strain ``max_strain`` and write outputs.
 

@@ -1,0 +1,309 @@
+"""Remeshing: trigger, local gmsh patches, conservative remapping (DESIGN.md §5).
+
+The entry point is :func:`remesh_if_needed`, called once per outer step after
+the Lagrangian move (:func:`lagice.lagrangian.move_mesh`)::
+
+    event = remesh_if_needed(state, size_field, solver=solver, log=log)
+
+It checks the trigger (:mod:`.trigger`), remeshes a patch around the bad
+elements (:mod:`.patch`; larger patches, then a global remesh, when gmsh
+fails or patches grow too large), remaps all element fields of the
+:class:`~lagice.state.IceState` conservatively (:mod:`.remap`), interpolates
+the velocity at new nodes, replaces ``state.mesh`` and calls
+``solver.reset_topology(new_mesh)``. It returns a :class:`RemeshEvent`
+(diagnostics) or None when nothing needed remeshing.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ConfigError, MeshError
+from ..mesh import Mesh, angles_deg, signed_areas
+from .patch import Stitch, grow_patch, make_manifold, mesh_patch, patch_boundary, stitch
+from .remap import interpolate_nodal, intersect_triangles, locate_points, remap_field, remap_weights
+from .trigger import TriggerParams, TriggerResult, check_trigger, evaluate_size
+
+__all__ = [
+    "RemeshEvent", "RemeshLog", "TriggerParams", "TriggerResult", "check_trigger", "evaluate_size",
+    "remesh_if_needed", "remesh_region", "apply_remesh", "remesh_global", "intersect_triangles", "remap_field",
+    "remap_weights", "interpolate_nodal", "locate_points", "grow_patch", "element_fields", "totals",
+]
+
+#: element fields of IceState that are remapped, and how (all area-weighted convex
+#: combinations; see remap.py): extensive totals are h·a, A·a, hs·a.
+ELEMENT_FIELDS = ("thickness", "concentration", "damage", "stress", "cohesion", "snow")
+
+
+@dataclass
+class RemeshEvent:
+    """Diagnostics of one remesh event (times in s, areas m², volumes m³)."""
+
+    time_s: float
+    step: int
+    kind: str                      # "local", "global" or "failed"
+    attempts: list = field(default_factory=list)   # what was tried, with failure reasons
+    trigger_counts: dict = field(default_factory=dict)
+    n_bad: int = 0
+    n_patch_old: int = 0           # elements replaced
+    n_patch_new: int = 0           # elements created
+    n_nodes_removed: int = 0
+    n_nodes_added: int = 0
+    n_elements_before: int = 0
+    n_elements_after: int = 0
+    t_trigger_s: float = 0.0
+    t_gmsh_s: float = 0.0
+    t_remap_s: float = 0.0
+    t_total_s: float = 0.0
+    totals_before: dict = field(default_factory=dict)
+    totals_after: dict = field(default_factory=dict)
+    rel_change: dict = field(default_factory=dict)
+    extrema_before: dict = field(default_factory=dict)   # over the patch: name -> (min, max)
+    extrema_after: dict = field(default_factory=dict)
+    min_angle_before: float = 0.0   # in the patch [deg]
+    min_angle_after: float = 0.0
+    kept_elements: np.ndarray | None = field(default=None, repr=False)  # old index of new element k < len
+    kept_nodes: np.ndarray | None = field(default=None, repr=False)     # old index of new node k < len
+
+    @property
+    def elements_touched(self) -> int:
+        return self.n_patch_old + self.n_patch_new
+
+    def as_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+@dataclass
+class RemeshLog:
+    """Accumulates :class:`RemeshEvent` s."""
+
+    events: list = field(default_factory=list)
+
+    def append(self, ev: RemeshEvent) -> None:
+        self.events.append(ev)
+
+    def __len__(self):
+        return len(self.events)
+
+    def summary(self) -> dict:
+        ev = self.events
+        if not ev:
+            return {"n_events": 0}
+        rel = [max(abs(v) for v in e.rel_change.values()) if e.rel_change else 0.0 for e in ev]
+        return {
+            "n_events": len(ev),
+            "n_local": sum(e.kind == "local" for e in ev),
+            "n_global": sum(e.kind == "global" for e in ev),
+            "n_failed": sum(e.kind == "failed" for e in ev),
+            "elements_touched": int(sum(e.elements_touched for e in ev)),
+            "t_gmsh_s": float(sum(e.t_gmsh_s for e in ev)),
+            "t_remap_s": float(sum(e.t_remap_s for e in ev)),
+            "t_total_s": float(sum(e.t_total_s for e in ev)),
+            "max_rel_change": float(max(rel)),
+        }
+
+
+def element_fields(state) -> dict:
+    """The element fields of ``state`` that are remapped (name -> array):
+    :data:`ELEMENT_FIELDS` plus any names listed in ``state.extra_element_fields``
+    (other per-element arrays, remapped as area-weighted means)."""
+    out = {}
+    for name in (*ELEMENT_FIELDS, *getattr(state, "extra_element_fields", ())):
+        v = getattr(state, name, None)
+        if v is not None:
+            out[name] = v
+    return out
+
+
+def totals(mesh: Mesh, state) -> dict:
+    """Ice volume [m³], ice area [m²] and snow volume [m³] of the whole mesh."""
+    from ..lagrangian import _signed_areas_kernel
+
+    a = np.empty(mesh.n_elements)
+    _signed_areas_kernel(mesh.nodes, mesh.triangles, a)
+    t = {"ice_volume_m3": float(np.sum(state.thickness * a)),
+         "ice_area_m2": float(np.sum(state.concentration * a))}
+    if state.snow is not None:
+        t["snow_volume_m3"] = float(np.sum(state.snow * a))
+    return t
+
+
+def _extrema(fields: dict, sel) -> dict:
+    out = {}
+    for k, v in fields.items():
+        w = v[sel]
+        if w.size:
+            out[k] = (float(w.min()), float(w.max()))
+    return out
+
+
+def remesh_region(state, mask: np.ndarray, size_field, *, algorithm: int = 6,
+                  remap_method: str = "auto", damage_remap: str = "area"):
+    """Remesh the elements in ``mask`` (made manifold first) and remap ``state``.
+
+    Returns ``(new_mesh, new_fields, new_velocity, stitch, timings)``; ``state``
+    is not modified. Raises :class:`MeshError` on any gmsh/stitch/remap failure.
+
+    ``damage_remap``: ``"area"`` (default) remaps d as an area-weighted mean
+    (conserves ∫d da); ``"compliance"`` remaps the compliance 1/(1 − d)
+    (keeps the series stiffness across thin damage bands, seed 003 eq. 1,
+    at the price of raising ∫d da; see docs/remeshing.md).
+    """
+    if damage_remap not in ("area", "compliance"):
+        raise ConfigError(f"damage_remap = {damage_remap!r}; expected 'area' or 'compliance'")
+    mesh = state.mesh
+    mask = make_manifold(mesh, np.asarray(mask, bool))
+    t0 = time.perf_counter()
+    bnd = patch_boundary(mesh, mask)
+    new_xy, new_tri = mesh_patch(mesh, bnd, size_field, algorithm=algorithm)
+    t_gmsh = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    st: Stitch = stitch(mesh, mask, new_xy, new_tri)
+    nm = st.mesh
+    k0 = len(st.kept_elements)
+    a_new = signed_areas(nm.nodes, nm.triangles[k0:])
+    a_old = signed_areas(mesh.nodes, mesh.triangles[st.patch_elements])
+    if np.any(a_new <= 0):
+        raise MeshError(f"gmsh patch has {int(np.sum(a_new <= 0))} inverted triangles")
+    rel = abs(a_new.sum() - a_old.sum()) / a_old.sum()
+    if rel > 1e-9:
+        raise MeshError(f"new patch area differs from the old one by {rel:.3g} (relative)")
+    i_old, j_new, w = intersect_triangles(mesh.nodes, mesh.triangles[st.patch_elements],
+                                          nm.nodes, nm.triangles[k0:], method=remap_method)
+    S = remap_weights(i_old, j_new, w, len(a_new), new_areas=a_new)
+    fields = {}
+    for name, v in element_fields(state).items():
+        if name == "damage" and damage_remap == "compliance":
+            c = remap_field(1.0 / (1.0 - v[st.patch_elements]), i_old, j_new, w, S)
+            vp = 1.0 - 1.0 / c
+        else:
+            vp = remap_field(v[st.patch_elements], i_old, j_new, w, S)
+        fields[name] = np.concatenate([v[st.kept_elements], vp])
+    # velocity: kept nodes keep theirs; new nodes interpolated in the old patch
+    nk = len(st.kept_nodes)
+    vel_new = interpolate_nodal(mesh.nodes, mesh.triangles[st.patch_elements], state.velocity,
+                                nm.nodes[nk:])
+    velocity = np.concatenate([state.velocity[st.kept_nodes], vel_new])
+    t_remap = time.perf_counter() - t0
+    return nm, fields, velocity, st, {"gmsh": t_gmsh, "remap": t_remap}
+
+
+def apply_remesh(state, nm, fields, velocity, solver=None):
+    """Install the result of :func:`remesh_region` in ``state`` (mesh, element
+    fields, velocity, ``counters["remesh_events"]``) and reset the solver topology."""
+    state.mesh = nm
+    for k, v in fields.items():
+        setattr(state, k, v)
+    state.velocity = velocity
+    state.counters["remesh_events"] = int(state.counters.get("remesh_events", 0)) + 1
+    if solver is not None:
+        solver.reset_topology(nm)
+
+
+def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | None = None,
+                     rings: int = 2, max_retries: int = 2, max_patch_fraction: float = 0.5,
+                     flagged=None, log: RemeshLog | None = None, algorithm: int = 6,
+                     remap_method: str = "auto", damage_remap: str = "area",
+                     force_global: bool = False) -> RemeshEvent | None:
+    """Check the trigger and, if needed, remesh and remap ``state`` in place.
+
+    Args:
+        state: :class:`~lagice.state.IceState`; its mesh and element/node fields are replaced.
+        size_field: target element size [m] (number or vectorised ``f(x, y)``), fixed in space.
+        solver: object with ``reset_topology(mesh)`` (e.g. ImplicitSolver) or None.
+        params: trigger thresholds (:class:`TriggerParams`).
+        rings: rings of neighbours added around the bad elements.
+        max_retries: larger patches (one more ring each) tried after a failure
+            before the global remesh.
+        max_patch_fraction: a patch larger than this fraction of the mesh is
+            replaced by a global remesh.
+        flagged: elements flagged by the Lagrangian inversion guard (indices or mask).
+        log: :class:`RemeshLog` to append the event to.
+        algorithm: gmsh 2-D algorithm (6 Frontal-Delaunay, 5 Delaunay).
+        remap_method: ``"auto"``, ``"clip"`` or ``"celltree"`` (:func:`intersect_triangles`).
+        damage_remap: ``"area"`` or ``"compliance"`` (:func:`remesh_region`).
+        force_global: remesh everything (regardless of the trigger).
+
+    Returns:
+        :class:`RemeshEvent`, or None when the trigger found nothing.
+        A failed global remesh keeps the old mesh (event kind ``"failed"``).
+    """
+    if int(rings) < 0:
+        raise ConfigError(f"rings = {rings!r} must be >= 0")
+    if not 0.0 < max_patch_fraction <= 1.0:
+        raise ConfigError(f"max_patch_fraction = {max_patch_fraction!r} must be in (0, 1]")
+    t_start = time.perf_counter()
+    mesh = state.mesh
+    trig = check_trigger(mesh, size_field, params, flagged)
+    t_trig = time.perf_counter() - t_start
+    if not trig.any and not force_global:
+        return None
+    m = mesh.n_elements
+    ev = RemeshEvent(time_s=float(state.time_s), step=int(state.step), kind="failed",
+                     trigger_counts=dict(trig.counts), n_bad=int(trig.bad.sum()),
+                     n_elements_before=m, t_trigger_s=t_trig)
+    fields_before = element_fields(state)
+    ev.totals_before = totals(mesh, state)
+    result = None
+    def candidates():
+        if not force_global:
+            mask = trig.seeds if trig.seeds is not None else trig.bad
+            for r in range(int(rings) + int(max_retries) + 1):
+                if r > 0:
+                    mask = grow_patch(mesh, mask, 1)
+                if r >= int(rings):
+                    yield "local", r, mask
+        yield "global", -1, np.ones(m, bool)
+
+    for kind, r, mask in candidates():
+        if kind == "local" and mask.sum() > max_patch_fraction * m:
+            ev.attempts.append(f"local rings={r}: patch of {int(mask.sum())} elements > "
+                               f"{max_patch_fraction:g} of the mesh")
+            continue
+        try:
+            result = remesh_region(state, mask, size_field, algorithm=algorithm, remap_method=remap_method,
+                                   damage_remap=damage_remap)
+        except MeshError as exc:
+            ev.attempts.append(f"{kind} rings={r}: {exc}")
+            continue
+        ev.attempts.append(f"{kind} rings={r}: ok")
+        ev.kind = kind
+        break
+    if result is None:
+        ev.t_total_s = time.perf_counter() - t_start
+        ev.n_elements_after = m
+        if log is not None:
+            log.append(ev)
+        return ev
+    nm, fields, velocity, st, tm = result
+    pe = st.patch_elements
+    ev.extrema_before = _extrema(fields_before, pe)
+    ang_old = angles_deg(mesh.nodes, mesh.triangles[pe])
+    ev.min_angle_before = float(np.nanmin(ang_old)) if ang_old.size else 0.0
+    apply_remesh(state, nm, fields, velocity, solver)
+    k0 = len(st.kept_elements)
+    ev.extrema_after = _extrema(element_fields(state), slice(k0, None))
+    ev.min_angle_after = float(np.nanmin(angles_deg(nm.nodes, nm.triangles[k0:])))
+    ev.totals_after = totals(nm, state)
+    ev.rel_change = {k: (ev.totals_after[k] - v) / v if v != 0 else ev.totals_after[k] - v
+                     for k, v in ev.totals_before.items()}
+    ev.n_patch_old = len(pe)
+    ev.kept_elements = st.kept_elements
+    ev.kept_nodes = st.kept_nodes
+    ev.n_patch_new = st.n_new_elements
+    ev.n_nodes_removed = mesh.n_nodes - len(st.kept_nodes)
+    ev.n_nodes_added = st.n_new_nodes
+    ev.n_elements_after = nm.n_elements
+    ev.t_gmsh_s = tm["gmsh"]
+    ev.t_remap_s = tm["remap"]
+    ev.t_total_s = time.perf_counter() - t_start
+    if log is not None:
+        log.append(ev)
+    return ev
+
+
+def remesh_global(state, size_field, **kw) -> RemeshEvent:
+    """Remesh the whole domain (boundary nodes kept) and remap ``state``."""
+    return remesh_if_needed(state, size_field, force_global=True, **kw)
