@@ -154,6 +154,8 @@ def test_sigkill_during_checkpoint_keeps_previous(tmp_path):
     ({"initial.thickness_m": "1 + undefined_name*x"}, "initial.thickness_m"),
     ({"domain.kind": "file", "domain.file": "no/such/coast.geojson"}, "file not found"),
     ({"healing.law": "magic"}, "healing.law = 'magic'"),
+    ({"solver.name": "magic"}, "solver.name = 'magic'"),
+    ({"solver.substeps": 5}, "solver.substeps does not apply to solver 'implicit'"),
 ])
 def test_bad_scene_fails_before_work_naming_key(override, match, tmp_path, monkeypatch):
     import lagice.scenes.toml_scene as ts

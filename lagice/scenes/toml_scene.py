@@ -114,6 +114,7 @@ def validate_components(cfg: dict) -> None:
     for key, val in cfg["initial"].items():
         if val is not None and not (key == "cohesion_pa" and val == "random"):
             spatial_values(val, *probe, f"initial.{key}")
+    solver_options(cfg["solver"])
     components.validate(cfg)
 
 
@@ -146,9 +147,7 @@ def build_model(cfg: dict) -> Model:
     duration = parse_duration(cfg["run"]["duration"], "run.duration")
     parts = components.build(cfg, mesh, state, rheo, duration)
     sv = cfg["solver"]
-    opts = {k: sv[k] for k in ("linear_solver", "tol", "max_iter", "substeps") if sv[k] is not None}
-    if sv["name"] == "explicit":
-        opts.pop("linear_solver", None)
+    opts = solver_options(sv)
     return Model(state, rheology=rheo, solver=sv["name"], solver_options=opts, bcs=bcs,
                  forces=parts["forces"], thermo=parts["thermo"], healing=parts["healing"],
                  mover=parts["mover"], remesher=parts["remesher"], drifters=build_drifters(cfg, poly),
@@ -176,6 +175,26 @@ def build_drifters(cfg, poly):
         if inner.contains(shapely.Point(p)):
             pts.append(p)
     return Drifters(pts)
+
+
+def solver_options(sv: dict) -> dict:
+    """The [solver] options the named solver's constructor accepts; a set option
+    it does not accept is an error naming it."""
+    import inspect
+
+    from ..solvers import SOLVERS
+
+    if sv["name"] not in SOLVERS:
+        raise ConfigError(f"solver.name = {sv['name']!r}: expected one of {sorted(SOLVERS)}")
+    accepted = set(inspect.signature(SOLVERS[sv["name"]].__init__).parameters)
+    opts = {}
+    for k in ("linear_solver", "tol", "max_iter", "substeps", "allow_unstable"):
+        if sv[k] is None or (k == "allow_unstable" and sv[k] is False):
+            continue
+        if k not in accepted:
+            raise ConfigError(f"solver.{k} does not apply to solver {sv['name']!r}")
+        opts[k] = sv[k]
+    return opts
 
 
 def build_simulation(cfg: dict, out_dir=None, progress: bool | None = None) -> Simulation:
