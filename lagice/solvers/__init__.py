@@ -6,4 +6,4 @@ from .implicit import ImplicitSolver
 
 SOLVERS = {"implicit": ImplicitSolver, "explicit": ExplicitSolver, "evp": EVPSolver}
 
-__all__ = ["DirichletSet", "StepInfo", "VelocityBC", "ImplicitSolver", "ExplicitSolver", "SOLVERS"]
+__all__ = ["DirichletSet", "StepInfo", "VelocityBC", "ImplicitSolver", "ExplicitSolver", "EVPSolver", "SOLVERS"]
