@@ -92,3 +92,42 @@ class Timer:
 
     def __exit__(self, *exc):
         self.t[self.k] = self.t.get(self.k, 0.0) + time.perf_counter() - self.t0
+
+
+class LumpedMassSolver:
+    """What the sub-stepped, lumped-mass solvers (explicit Maxwell-EB, EVP) share:
+    prescribed-dof masks, geometry caches and the serial/parallel kernel choice.
+
+    Subclasses set ``bcs``, ``parallel`` and call :meth:`reset_topology`; they
+    add their own derived geometry in :meth:`_geometry_extras`.
+    """
+
+    def reset_topology(self, mesh) -> None:
+        """Rebuild everything that depends on connectivity (after a remesh)."""
+        self.mesh = mesh
+        self.mean_velocity = None
+        self.dirichlet = DirichletSet(mesh, self.bcs)
+        fixed = np.zeros((mesh.n_nodes, 2), np.int8)
+        fixed.reshape(-1)[self.dirichlet.dofs] = 1
+        self.fixed = fixed
+        self.update_geometry()
+
+    def update_geometry(self) -> None:
+        """Recompute shape gradients and areas after nodes moved (Lagrangian step)."""
+        from ..errors import SolverError
+        from ..fem import SHAPE_GRADIENTS
+
+        m = self.mesh
+        sg = SHAPE_GRADIENTS[1] if self._parallel_for(m) else SHAPE_GRADIENTS[0]
+        self.b, self.c, self.area = sg(m.nodes, m.triangles)
+        if np.any(self.area <= 0):
+            raise SolverError(f"{int(np.sum(self.area <= 0))} inverted elements in the mesh")
+        self._geometry_extras()
+
+    def _geometry_extras(self) -> None:
+        """Hook for solver-specific geometry (called by :meth:`update_geometry`)."""
+
+    def _parallel_for(self, mesh) -> bool:
+        from .._numba import PARALLEL_MIN_SIZE
+
+        return self.parallel if self.parallel is not None else mesh.n_elements >= PARALLEL_MIN_SIZE

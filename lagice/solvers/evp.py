@@ -45,10 +45,10 @@ from numba import njit, prange
 
 from .._numba import PARALLEL_MIN_SIZE, serial_copy
 from ..errors import ConfigError, SolverError
-from ..fem import lumped_mass, lumped_mass_serial, shape_gradients, shape_gradients_serial, strain_rate, strain_rate_serial
+from ..fem import lumped_mass, lumped_mass_serial, strain_rate, strain_rate_serial
 from ..forces import explicit_terms
 from ..state import IceState
-from .base import DirichletSet, StepInfo
+from .base import LumpedMassSolver, StepInfo
 from .explicit import adjacency_weights, adjacency_weights_serial
 
 #: P* [N m-2], C* [-], e [-], Δmin [s-1] defaults
@@ -206,7 +206,7 @@ def vp_stress_of(eps, P, ellipse: float = ELLIPSE, delta_min: float = DELTA_MIN,
     return out, zeta
 
 
-class EVPSolver:
+class EVPSolver(LumpedMassSolver):
     """Hibler VP rheology (elliptical yield curve) by mEVP iterations.
 
     Args:
@@ -271,27 +271,9 @@ class EVPSolver:
         self.kernel_timings = {"forcing": 0.0, "setup": 0.0, "node_velocity": 0.0, "element_stress": 0.0}
         self.reset_topology(mesh)
 
-    def reset_topology(self, mesh) -> None:
-        """Rebuild everything that depends on connectivity (after a remesh)."""
-        self.mesh = mesh
-        self.mean_velocity = None
-        self.dirichlet = DirichletSet(mesh, self.bcs)
-        fixed = np.zeros((mesh.n_nodes, 2), np.int8)
-        fixed.reshape(-1)[self.dirichlet.dofs] = 1
-        self.fixed = fixed
-        self.update_geometry()
-
-    def update_geometry(self) -> None:
-        """Recompute shape gradients and areas after nodes moved."""
-        m = self.mesh
-        sg = shape_gradients if self._parallel_for(m) else shape_gradients_serial
-        self.b, self.c, self.area = sg(m.nodes, m.triangles)
-        if np.any(self.area <= 0):
-            raise SolverError(f"{int(np.sum(self.area <= 0))} inverted elements in the mesh")
+    def _geometry_extras(self) -> None:
+        """Σ|∇φ|² per element (adaptive mEVP relaxation) after nodes moved."""
         self.grad2 = np.sum(self.b ** 2 + self.c ** 2, axis=1)
-
-    def _parallel_for(self, mesh) -> bool:
-        return self.parallel if self.parallel is not None else mesh.n_elements >= PARALLEL_MIN_ELEMENTS
 
     def strength(self, state: IceState) -> np.ndarray:
         """Ice strength P [N m-1] per element."""

@@ -43,11 +43,11 @@ from numba import njit, prange
 
 from ..errors import ConfigError, SolverError
 from .._numba import PARALLEL_MIN_SIZE, serial_copy
-from ..fem import lumped_mass, lumped_mass_serial, shape_gradients, shape_gradients_serial, strain_rate, strain_rate_serial
+from ..fem import lumped_mass, lumped_mass_serial, strain_rate, strain_rate_serial
 from ..forces import explicit_terms
 from ..rheology import MaxwellEB, _dcrit
 from ..state import IceState
-from .base import DirichletSet, StepInfo
+from .base import LumpedMassSolver, StepInfo
 
 
 #: keys of ``ExplicitSolver.kernel_timings`` / ``StepInfo.kernel_timings`` [s]
@@ -226,7 +226,7 @@ element_stress_damage_kernel_serial = _serial(_element_stress_damage)
 PARALLEL_MIN_ELEMENTS = PARALLEL_MIN_SIZE
 
 
-class ExplicitSolver:
+class ExplicitSolver(LumpedMassSolver):
     """Explicit (sub-stepped, lumped-mass) Maxwell-EB solver.
 
     Args:
@@ -286,28 +286,10 @@ class ExplicitSolver:
         self.reset_topology(mesh)
 
     # -- geometry/topology caches ------------------------------------------------
-    def reset_topology(self, mesh) -> None:
-        """Rebuild everything that depends on connectivity (after a remesh)."""
-        self.mesh = mesh
-        self.mean_velocity = None
-        self.dirichlet = DirichletSet(mesh, self.bcs)
-        fixed = np.zeros((mesh.n_nodes, 2), np.int8)
-        fixed.reshape(-1)[self.dirichlet.dofs] = 1
-        self.fixed = fixed
-        self.update_geometry()
-
-    def update_geometry(self) -> None:
-        """Recompute shape gradients, areas and td after nodes moved (Lagrangian step)."""
-        m = self.mesh
-        sg = shape_gradients if self._parallel_for(m) else shape_gradients_serial
-        self.b, self.c, self.area = sg(m.nodes, m.triangles)
-        if np.any(self.area <= 0):
-            raise SolverError(f"{int(np.sum(self.area <= 0))} inverted elements in the mesh")
+    def _geometry_extras(self) -> None:
+        """td and the smallest element size after nodes moved (Lagrangian step)."""
         self.td = self.rheology.damage_time(np.sqrt(2.0 * self.area))
         self.dx_min = float(np.sqrt(2.0 * self.area.min()))
-
-    def _parallel_for(self, mesh) -> bool:
-        return self.parallel if self.parallel is not None else mesh.n_elements >= PARALLEL_MIN_ELEMENTS
 
     # -- sub-step choice -------------------------------------------------------------
     def substeps_for(self, dt: float, E_max: float | None = None) -> int:
