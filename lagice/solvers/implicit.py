@@ -70,6 +70,7 @@ class ImplicitSolver:
     def reset_topology(self, mesh) -> None:
         """Rebuild everything that depends on connectivity (after a remesh)."""
         self.mesh = mesh
+        self.last_strain_rate = None  # belonged to the old mesh
         self.pattern = SparsityPattern(mesh.triangles, mesh.n_nodes)
         self.dirichlet = DirichletSet(mesh, self.bcs)
         self.entry_prescribed = (self.dirichlet.mask[self.pattern.row_of]
