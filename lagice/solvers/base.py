@@ -127,6 +127,21 @@ class LumpedMassSolver:
     def _geometry_extras(self) -> None:
         """Hook for solver-specific geometry (called by :meth:`update_geometry`)."""
 
+    def _prescribed_velocity(self, t_s: float) -> np.ndarray:
+        """(n, 2) prescribed velocities at time t [s] (0 where free; see ``self.fixed``)."""
+        out = np.zeros((self.mesh.n_nodes, 2))
+        if len(self.dirichlet.dofs):
+            out.reshape(-1)[self.dirichlet.dofs] = self.dirichlet.values(t_s)
+        return out
+
+    def _lumped(self, h: np.ndarray, rho: float, par: bool):
+        """Lumped nodal mass [kg] and nodal area [m²] for thickness h [m]."""
+        from ..fem import LUMPED_MASS
+
+        lm = LUMPED_MASS[1] if par else LUMPED_MASS[0]
+        ptr, elems, _local = self.mesh.node_elements
+        return lm(ptr, elems, self.area, rho * h), lm(ptr, elems, self.area, np.ones_like(h))
+
     def _parallel_for(self, mesh) -> bool:
         from .._numba import PARALLEL_MIN_SIZE
 

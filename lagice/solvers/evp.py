@@ -45,7 +45,7 @@ from numba import njit, prange
 
 from .._numba import PARALLEL_MIN_SIZE, serial_copy
 from ..errors import ConfigError, SolverError
-from ..fem import lumped_mass, lumped_mass_serial, strain_rate, strain_rate_serial
+from ..fem import strain_rate, strain_rate_serial
 from ..forces import explicit_terms
 from ..state import IceState
 from .base import LumpedMassSolver, StepInfo
@@ -287,9 +287,7 @@ class EVPSolver(LumpedMassSolver):
         t0 = time.perf_counter()
         t_new = state.time_s + dt
         terms = explicit_terms(self.forces, t_new, mesh.nodes)
-        pres = np.zeros((mesh.n_nodes, 2))
-        if len(self.dirichlet.dofs):
-            pres.reshape(-1)[self.dirichlet.dofs] = self.dirichlet.values(t_new)
+        pres = self._prescribed_velocity(t_new)
         t1 = time.perf_counter()
         kt["forcing"] = t1 - t0
 
@@ -297,9 +295,7 @@ class EVPSolver(LumpedMassSolver):
         tri = mesh.triangles
         par = self._parallel_for(mesh)
         h = np.ascontiguousarray(state.thickness, np.float64)
-        lm = lumped_mass if par else lumped_mass_serial
-        mass = lm(ptr, elems, self.area, self.rho_ice * h)
-        node_area = lm(ptr, elems, self.area, np.ones_like(h))
+        mass, node_area = self._lumped(h, self.rho_ice, par)
         wb, wc = (adjacency_weights if par else adjacency_weights_serial)(
             tri, self.b, self.c, self.area, np.ones_like(h), ptr, elems, local)
         m_dt = mass / dt

@@ -43,7 +43,7 @@ from numba import njit, prange
 
 from ..errors import ConfigError, SolverError
 from .._numba import PARALLEL_MIN_SIZE, serial_copy
-from ..fem import lumped_mass, lumped_mass_serial, strain_rate, strain_rate_serial
+from ..fem import strain_rate, strain_rate_serial
 from ..forces import explicit_terms
 from ..rheology import MaxwellEB, _dcrit
 from ..state import IceState
@@ -330,11 +330,8 @@ class ExplicitSolver(LumpedMassSolver):
         self._check_stability(dt_s, E_max)
         t_new = state.time_s + dt
         terms = explicit_terms(self.forces, t_new, mesh.nodes)
-        pres0 = np.zeros((mesh.n_nodes, 2))
-        pres1 = np.zeros((mesh.n_nodes, 2))
-        if len(self.dirichlet.dofs):
-            pres0.reshape(-1)[self.dirichlet.dofs] = self.dirichlet.values(state.time_s)
-            pres1.reshape(-1)[self.dirichlet.dofs] = self.dirichlet.values(t_new)
+        pres0 = self._prescribed_velocity(state.time_s)
+        pres1 = self._prescribed_velocity(t_new)
         t1 = time.perf_counter()
         kt["forcing"] = t1 - t0
 
@@ -342,9 +339,7 @@ class ExplicitSolver(LumpedMassSolver):
         tri = mesh.triangles
         par = self._parallel_for(mesh)
         h = np.ascontiguousarray(state.thickness, np.float64)
-        lm = lumped_mass if par else lumped_mass_serial
-        mass = lm(ptr, elems, self.area, p.rho_ice * h)
-        node_area = lm(ptr, elems, self.area, np.ones_like(h))
+        mass, node_area = self._lumped(h, p.rho_ice, par)
         wb, wc = (adjacency_weights if par else adjacency_weights_serial)(
             tri, self.b, self.c, self.area, h, ptr, elems, local)
         m_dt = mass / dt_s
