@@ -37,24 +37,32 @@ def shape_gradients(nodes, tri):
     return b, c, area
 
 
+@njit(cache=True, inline="always")
+def element_strain_rate(tri, b, c, vel, e):
+    """(ε̇xx, ε̇yy, ε̇xy) [s-1] of element e from nodal velocity (n, 2); the one
+    place this arithmetic lives (fused solver kernels inline it)."""
+    exx = 0.0
+    eyy = 0.0
+    exy = 0.0
+    for k in range(3):
+        u = vel[tri[e, k], 0]
+        v = vel[tri[e, k], 1]
+        exx += b[e, k] * u
+        eyy += c[e, k] * v
+        exy += c[e, k] * u + b[e, k] * v
+    return exx, eyy, 0.5 * exy
+
+
 @njit(cache=True, parallel=True)
 def strain_rate(tri, b, c, vel):
     """Element strain rate (ε̇xx, ε̇yy, ε̇xy) [s-1] from nodal velocity (n, 2)."""
     m = tri.shape[0]
     out = np.empty((m, 3))
     for e in prange(m):
-        exx = 0.0
-        eyy = 0.0
-        exy = 0.0
-        for k in range(3):
-            u = vel[tri[e, k], 0]
-            v = vel[tri[e, k], 1]
-            exx += b[e, k] * u
-            eyy += c[e, k] * v
-            exy += c[e, k] * u + b[e, k] * v
+        exx, eyy, exy = element_strain_rate(tri, b, c, vel, e)
         out[e, 0] = exx
         out[e, 1] = eyy
-        out[e, 2] = 0.5 * exy
+        out[e, 2] = exy
     return out
 
 

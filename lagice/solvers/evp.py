@@ -45,7 +45,7 @@ from numba import njit, prange
 
 from .._numba import PARALLEL_MIN_SIZE, serial_copy
 from ..errors import ConfigError, SolverError
-from ..fem import strain_rate, strain_rate_serial
+from ..fem import element_strain_rate, strain_rate, strain_rate_serial
 from ..forces import explicit_terms
 from ..state import IceState
 from .base import LumpedMassSolver, StepInfo
@@ -83,16 +83,7 @@ def _element_evp(tri, b, c, vel, S, P, alpha_e, alpha, adapt_coef, e2inv, delta_
     α_e = max(α, sqrt(adapt_coef_e ζ_e)) where adapt_coef_e > 0 (adaptive)."""
     m = tri.shape[0]
     for e in prange(m):
-        exx = 0.0
-        eyy = 0.0
-        exy = 0.0
-        for k in range(3):
-            u = vel[tri[e, k], 0]
-            v = vel[tri[e, k], 1]
-            exx += b[e, k] * u
-            eyy += c[e, k] * v
-            exy += c[e, k] * u + b[e, k] * v
-        exy *= 0.5
+        exx, eyy, exy = element_strain_rate(tri, b, c, vel, e)
         sxx, syy, sxy, zeta = vp_stress(exx, eyy, exy, P[e], e2inv, delta_min, repl)
         a = alpha
         ac = adapt_coef[e]

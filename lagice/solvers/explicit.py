@@ -43,7 +43,7 @@ from numba import njit, prange
 
 from ..errors import ConfigError, SolverError
 from .._numba import PARALLEL_MIN_SIZE, serial_copy
-from ..fem import strain_rate, strain_rate_serial
+from ..fem import element_strain_rate, strain_rate, strain_rate_serial
 from ..forces import explicit_terms
 from ..rheology import MaxwellEB, _dcrit
 from ..state import IceState
@@ -150,16 +150,7 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     m = tri.shape[0]
     n_capped = 0
     for e in prange(m):
-        exx = 0.0
-        eyy = 0.0
-        exy = 0.0
-        for k in range(3):
-            u = vel[tri[e, k], 0]
-            v = vel[tri[e, k], 1]
-            exx += b[e, k] * u
-            eyy += c[e, k] * v
-            exy += c[e, k] * u + b[e, k] * v
-        exy *= 0.5
+        exx, eyy, exy = element_strain_rate(tri, b, c, vel, e)
         ed = e_dt[e]
         g = gamma[e]
         sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * g
