@@ -4,7 +4,8 @@
     lagice resume CHECKPOINT                              continue a run (file or directory)
     lagice plot OUTPUT                                    plot a run directory or snapshot folder
     lagice info FILE                                      describe a netCDF output or checkpoint
-    lagice diagnose OUTPUT [--window-steps K]             deformation statistics (JSON + PNG)
+    lagice diagnose OUTPUT [--window-steps K] [--coast-buffer-km B]
+                                                          deformation statistics (JSON + PNG)
     lagice scenes                                         list bundled scenes
 """
 from __future__ import annotations
@@ -63,15 +64,8 @@ def _resume(args) -> int:
     return 0
 
 
-def _snap_dir(p: Path) -> Path:
-    if (p / "index.json").exists():
-        return p
-    if (p / "snapshots" / "index.json").exists():
-        return p / "snapshots"
-    raise LagiceError(f"{p} is not a run directory or snapshot folder (no index.json)")
-
-
 def _plot(args) -> int:
+    from .io.snapshots import snapshot_dir
     from .plotting import plot_run
 
     p = Path(args.output)
@@ -84,7 +78,7 @@ def _plot(args) -> int:
                 print(f"  plot: {out.resolve()}")
                 return 0
         p = p.parent
-    snaps = _snap_dir(p)
+    snaps = snapshot_dir(p)
     summary = None
     for cand in (snaps.parent / "summary.json", snaps / "summary.json"):
         if cand.exists():
@@ -114,29 +108,34 @@ def _info(args) -> int:
 
 def _diagnose(args) -> int:
     import numpy as np
-    import xarray as xr
 
     from .diagnostics import diagnose_arrays
+    from .diagnostics.faults import interior_triangles
+    from .io.snapshots import load_window, read_index, snapshot_dir
 
-    snaps = _snap_dir(Path(args.output))
-    index = json.loads((snaps / "index.json").read_text())
-    last = index[-1]
-    same = [e for e in index if e["mesh_epoch"] == last["mesh_epoch"]]
-    if len(same) < 2:
-        raise LagiceError(f"{snaps}: need two snapshots on the same mesh to diagnose deformation "
-                          f"(found {len(same)} in the last mesh epoch)")
-    k = min(args.window_steps, len(same) - 1)
-    e0, e1 = same[-1 - k], same[-1]
-    d0 = xr.load_dataset(snaps / e0["file"], decode_times=False)
-    d1 = xr.load_dataset(snaps / e1["file"], decode_times=False)
-    xy0 = np.column_stack([d0["mesh_node_x"].values, d0["mesh_node_y"].values])
-    xy1 = np.column_stack([d1["mesh_node_x"].values, d1["mesh_node_y"].values])
-    tri = d1["mesh_face_nodes"].values.astype(np.int64)
-    dt = e1["time_s"] - e0["time_s"]
-    if np.allclose(xy0, xy1):  # fixed mesh: use the mean velocity over the window instead
-        vel = 0.5 * (np.column_stack([d0["velocity_x"].values[0], d0["velocity_y"].values[0]])
-                     + np.column_stack([d1["velocity_x"].values[0], d1["velocity_y"].values[0]]))
-        xy1 = xy0 + vel * dt
+    snaps = snapshot_dir(args.output)
+    if args.window_steps < 1:
+        raise LagiceError(f"--window-steps = {args.window_steps}: expected an integer >= 1")
+    if not args.coast_buffer_km >= 0:
+        raise LagiceError(f"--coast-buffer-km = {args.coast_buffer_km}: expected a distance >= 0 km")
+    index = read_index(snaps)
+    if len(index) < 2:
+        raise LagiceError(f"{snaps}: need two snapshots to diagnose deformation (found {len(index)})")
+    k = min(args.window_steps, len(index) - 1)
+    w = load_window(snaps, index[-1 - k]["time_s"], index[-1]["time_s"])
+    if w["remesh_events"]:
+        print(f"  {w['remesh_events']} remesh event(s) in the window: nodes followed by node_id, "
+              f"{w['n_elements_lost']} remeshed elements left out")
+    xy0, xy1, tri, dt = w["xy0"], w["xy1"], w["triangles"], w["dt_s"]
+    if w["fixed_mesh"]:  # fixed mesh: use the mean velocity over the window instead
+        xy1 = xy0 + 0.5 * (w["velocity0"] + w["velocity1"]) * dt
+    if args.coast_buffer_km > 0:
+        keep = interior_triangles(*w["start_mesh"], args.coast_buffer_km * 1e3)[w["kept_elements"]]
+        if keep.sum() < 10:
+            raise LagiceError(f"--coast-buffer-km = {args.coast_buffer_km}: only {int(keep.sum())} elements "
+                              f"lie that far from the boundary; use a smaller buffer")
+        print(f"  {int(keep.sum())} of {tri.shape[0]} elements are >= {args.coast_buffer_km:g} km from the boundary")
+        tri = tri[keep]
     out = Path(args.out or snaps.parent / "diagnostics")
     res = diagnose_arrays(xy0, xy1, tri, dt, out)
     print(f"  diagnostics over a {dt / 86400:.2f}-day window -> {out.resolve()}/diagnostics.json")
@@ -180,6 +179,8 @@ def main(argv=None) -> int:
     d = sub.add_parser("diagnose", help="deformation statistics of a run (JSON + PNG)")
     d.add_argument("output")
     d.add_argument("--window-steps", type=int, default=1, help="snapshots spanned by the window")
+    d.add_argument("--coast-buffer-km", type=float, default=0.0,
+                   help="analyse only elements this far from the mesh boundary (seed 000: 150 km)")
     d.add_argument("--out")
     d.set_defaults(func=_diagnose)
     sc = sub.add_parser("scenes", help="list bundled scenes")

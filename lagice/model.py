@@ -139,6 +139,8 @@ class Model:
             arrays[name] = getattr(st, name)
         if st.snow is not None:
             arrays["snow"] = st.snow
+        if st.node_id is not None:
+            arrays["node_id"] = st.node_id
         for name, arr in self.extra_arrays().items():
             arrays[f"extra_{name}"] = arr
         return arrays
@@ -173,6 +175,7 @@ class Model:
         st = IceState(mesh=mesh, velocity=arrays["velocity"].copy(),
                       **{name: arrays[name].copy() for name in STATE_FIELDS},
                       snow=arrays["snow"].copy() if "snow" in arrays else None,
+                      node_id=arrays["node_id"].copy() if "node_id" in arrays else None,
                       time_s=float(meta["time_s"]), step=int(meta["step"]),
                       counters=dict(meta["counters"]))
         self.state = st

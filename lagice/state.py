@@ -18,6 +18,11 @@ class IceState:
     ``concentration`` A [-], ``damage`` d [-] (0 undamaged), ``stress``
     (m, 3) = (σxx, σyy, σxy) [Pa, tension positive], ``cohesion`` C [Pa],
     ``snow`` hs snow volume per unit area [m].
+    ``node_id`` (n,) int64: persistent node identifiers. Remeshing keeps the
+    identifiers of the nodes it keeps and gives new nodes new ones
+    (``counters["next_node_id"]``), so Lagrangian diagnostics can follow the
+    nodes across remesh events (:func:`lagice.io.snapshots.load_window`).
+    ``None`` when continuity is unknown.
     """
 
     mesh: Mesh
@@ -28,6 +33,7 @@ class IceState:
     stress: np.ndarray
     cohesion: np.ndarray
     snow: np.ndarray | None = None
+    node_id: np.ndarray | None = None
     time_s: float = 0.0
     step: int = 0
     counters: dict = field(default_factory=dict)
@@ -46,7 +52,7 @@ class IceState:
                  concentration=field_of("concentration", concentration),
                  damage=field_of("damage", damage), stress=np.zeros((m, 3)),
                  cohesion=field_of("cohesion_pa", 0.0 if cohesion_pa is None else cohesion_pa),
-                 time_s=float(time_s))
+                 node_id=np.arange(n, dtype=np.int64), time_s=float(time_s))
         st.validate()
         return st
 

@@ -62,3 +62,21 @@ def test_cli_diagnose_real_output(tmp_path):
     assert res["dt_s"] == 1500.0
     assert res["mean_shear_s"] > 0 and 0 < res["localisation_half_shear_area_fraction"] <= 0.5
     assert any(p.suffix == ".png" for p in (out / "diagnostics").iterdir())
+    # away from the boundary: only the elements >= 40 km from the edge of the 200 km box
+    d2 = run_cli("diagnose", str(out), "--coast-buffer-km", "40", "--out", str(tmp_path / "diag40"))
+    assert d2.returncode == 0, d2.stderr
+    res40 = json.loads((tmp_path / "diag40" / "diagnostics.json").read_text())
+    idx = json.loads((out / "snapshots" / "index.json").read_text())
+    ds0 = xr.load_dataset(out / "snapshots" / idx[-2]["file"])
+    xy = np.column_stack([ds0["mesh_node_x"].values, ds0["mesh_node_y"].values])
+    c = xy[ds0["mesh_face_nodes"].values].mean(axis=1)
+    tri = ds0["mesh_face_nodes"].values
+    e = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+    u, n = np.unique(e, axis=0, return_counts=True)
+    a, b = xy[u[n == 1, 0]], xy[u[n == 1, 1]]  # boundary segments (edges of one triangle)
+    ab = b - a  # brute-force point-segment distance, every centroid to every boundary edge
+    t = np.clip(np.einsum("pkd,kd->pk", c[:, None, :] - a[None], ab) / np.einsum("kd,kd->k", ab, ab), 0, 1)
+    dist = np.linalg.norm(c[:, None, :] - (a[None] + t[..., None] * ab[None]), axis=2).min(axis=1)
+    assert res40["n_elements"] == int(np.sum(dist >= 40e3)) < res["n_elements"]
+    bad = run_cli("diagnose", str(out), "--coast-buffer-km", "500")
+    assert bad.returncode == 2 and "use a smaller buffer" in bad.stderr

@@ -110,3 +110,23 @@ def test_unknown_tag_error(plate_mesh):
     with pytest.raises(ConfigError, match="unknown boundary tag 'north'"):
         plate_mesh.nodes_with_tag("north")
     assert issubclass(ConfigError, LagiceError) and issubclass(MeshError, LagiceError)
+
+
+def test_segment_off_the_boundary_is_refused_before_meshing(monkeypatch):
+    """A segment whose points are 0.4 m off the coast (rounded coordinates)
+    used to tag no edge at all, silently; it is refused before gmsh runs, and
+    a segment on the boundary's own vertices tags exactly its edges."""
+    import lagice.mesh.generate as gen
+
+    ring = [(0.0, 0.0), (1000.3, 0.0), (1000.3, 800.7), (0.0, 800.7)]
+    poly = Polygon(ring)
+    called = []
+    real_session = gen.gmsh_session
+    monkeypatch.setattr(gen, "gmsh_session", lambda: called.append(1) or real_session())
+    with pytest.raises(ConfigError, match="segment 'open' leaves the domain boundary.*0.3"):
+        generate_mesh(poly, 200.0, segments={"open": LineString([(1000.0, 0.0), (1000.0, 800.0)])})
+    assert not called
+    mesh = generate_mesh(poly, 200.0, segments={"open": LineString([(1000.3, 0.0), (1000.3, 800.7)])})
+    assert called
+    e = mesh.edges_with_tag("open")
+    assert len(e) >= 4 and np.allclose(mesh.nodes[e.ravel(), 0], 1000.3)

@@ -26,7 +26,8 @@ FAST = {"run.duration": 1600.0, "solver.dt": 40.0, "output.every": 800.0, "check
 def fields(model):
     st = model.state
     return {"nodes": st.mesh.nodes, "velocity": st.velocity, "stress": st.stress, "damage": st.damage,
-            "thickness": st.thickness, "concentration": st.concentration, "cohesion": st.cohesion}
+            "thickness": st.thickness, "concentration": st.concentration, "cohesion": st.cohesion,
+            "node_id": st.node_id}
 
 
 def test_resume_is_bit_identical(tmp_path):

@@ -111,6 +111,15 @@ def generate_mesh(polygon: Polygon, size, *, segments: dict | None = None,
             raise ConfigError(f"segment {name!r} must be a shapely geometry; got {type(geom).__name__}")
         if polygon.boundary.distance(geom) > 1e-9 * max(1.0, polygon.length):
             raise ConfigError(f"segment {name!r} does not touch the domain boundary")
+        tol = 1e-7 * max(1.0, np.sqrt(polygon.area))  # the tolerance of tag_boundary_edges
+        coords = np.asarray(shapely.get_coordinates(geom))
+        probe = np.concatenate([coords, 0.5 * (coords[1:] + coords[:-1])]) if len(coords) > 1 else coords
+        off = shapely.distance(shapely.points(probe), polygon.boundary)
+        if off.max() > tol:
+            k = int(np.argmax(off))
+            raise ConfigError(f"segment {name!r} leaves the domain boundary: point {probe[k].tolist()} is "
+                              f"{off[k]:.3g} m from it (tolerance {tol:.3g} m); give the boundary's own "
+                              f"vertices, with the same coordinates")
 
     lc0 = size_v if not callable(size_v) else 1.0
     with gmsh_session() as gmsh:
@@ -191,6 +200,11 @@ def tag_boundary_edges(nodes, edges, polygon, segments, exterior_tag=COAST, isla
     for name, geom in segments.items():
         on = ((shapely.distance(mids, geom) < tol) & (shapely.distance(p0, geom) < tol)
               & (shapely.distance(p1, geom) < tol) & ~assigned)
+        if not on.any():
+            d = float(shapely.distance(mids, geom).min()) if len(edges) else float("nan")
+            raise ConfigError(f"segment {name!r} tags no boundary edge: no edge lies on it within {tol:.3g} m "
+                              f"(nearest edge midpoint {d:.3g} m away); a segment must follow the domain "
+                              f"boundary through its vertices, with the same coordinates")
         tags[on] = names.index(name)
         assigned |= on
     if len(polygon.interiors):

@@ -190,9 +190,21 @@ def remesh_region(state, mask: np.ndarray, size_field, *, algorithm: int = 6,
     return nm, fields, velocity, st, {"gmsh": t_gmsh, "remap": t_remap}
 
 
-def apply_remesh(state, nm, fields, velocity, solver=None):
+def apply_remesh(state, nm, fields, velocity, solver=None, kept_nodes=None):
     """Install the result of :func:`remesh_region` in ``state`` (mesh, element
-    fields, velocity, ``counters["remesh_events"]``) and reset the solver topology."""
+    fields, velocity, ``counters["remesh_events"]``) and reset the solver topology.
+
+    ``kept_nodes`` (old indices of the first new nodes, :class:`Stitch`) carries
+    the persistent ``state.node_id`` over; the appended nodes get fresh ids.
+    Without it the ids are dropped (``None``: continuity unknown)."""
+    if kept_nodes is not None:
+        old = state.node_id if state.node_id is not None else np.arange(state.mesh.n_nodes, dtype=np.int64)
+        nxt = int(state.counters.get("next_node_id", int(old.max()) + 1 if old.size else 0))
+        n_new = nm.n_nodes - len(kept_nodes)
+        state.node_id = np.concatenate([old[kept_nodes], nxt + np.arange(n_new, dtype=np.int64)])
+        state.counters["next_node_id"] = nxt + n_new
+    else:
+        state.node_id = None
     state.mesh = nm
     for k, v in fields.items():
         setattr(state, k, v)
@@ -282,7 +294,7 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
     ev.extrema_before = _extrema(fields_before, pe)
     ang_old = angles_deg(mesh.nodes, mesh.triangles[pe])
     ev.min_angle_before = float(np.nanmin(ang_old)) if ang_old.size else 0.0
-    apply_remesh(state, nm, fields, velocity, solver)
+    apply_remesh(state, nm, fields, velocity, solver, kept_nodes=st.kept_nodes)
     k0 = len(st.kept_elements)
     ev.extrema_after = _extrema(element_fields(state), slice(k0, None))
     ev.min_angle_after = float(np.nanmin(angles_deg(nm.nodes, nm.triangles[k0:])))

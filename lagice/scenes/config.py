@@ -29,7 +29,7 @@ ANY = object
 # table -> key -> (type or tuple of types, default). A nested dict is a sub-table;
 # "*" as a key means free-form sub-tables (validated by the builder).
 SCHEMA = {
-    "scene": {"name": (str, None), "description": (str, "")},
+    "scene": {"name": (str, None), "description": (str, ""), "extends": (str, None)},
     "domain": {
         "kind": (str, "rectangle"), "width_m": (NUM, None), "height_m": (NUM, None),
         "x0_m": (NUM, 0.0), "y0_m": (NUM, 0.0), "vertices": (list, None), "islands": (list, []),
@@ -177,13 +177,44 @@ def scene_path(name_or_path) -> Path:
     raise ConfigError(f"unknown scene {name_or_path!r}; bundled scenes: {known}")
 
 
-def load_scene(name_or_path, overrides=None) -> dict:
-    """Read, override and validate a scene; returns the full config dict."""
-    path = scene_path(name_or_path)
+def _merge(base: dict, child: dict) -> dict:
+    """``child`` over ``base``: tables merge key by key, other values replace."""
+    out = copy.deepcopy(base)
+    for k, v in child.items():
+        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else copy.deepcopy(v)
+    return out
+
+
+def read_raw_scene(path: Path, _chain=()) -> dict:
+    """The raw TOML of a scene, with ``[scene] extends = "base.toml"`` resolved:
+    the base scene (path relative to this file) is read first and this file's
+    tables are merged over it, key by key. The base's ``name`` is not inherited."""
+    path = Path(path)
+    if path.resolve() in _chain:
+        raise ConfigError(f"{path}: scene.extends makes a cycle: {' -> '.join(str(p) for p in (*_chain, path))}")
     try:
         raw = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: not valid TOML: {exc}") from exc
+    base_name = raw.get("scene", {}).get("extends") if isinstance(raw.get("scene"), dict) else None
+    if base_name is None:
+        return raw
+    if not isinstance(base_name, str):
+        raise ConfigError(f"{path}: scene.extends = {base_name!r}: expected a scene file name")
+    base_path = path.parent / base_name
+    if not base_path.exists():
+        raise ConfigError(f"{path}: scene.extends = {base_name!r}: file {base_path} does not exist")
+    base = read_raw_scene(base_path, (*_chain, path.resolve()))
+    base.setdefault("scene", {}).pop("name", None)
+    merged = _merge(base, raw)
+    merged["scene"].pop("extends", None)
+    return merged
+
+
+def load_scene(name_or_path, overrides=None) -> dict:
+    """Read, override and validate a scene; returns the full config dict."""
+    path = scene_path(name_or_path)
+    raw = read_raw_scene(path)
     raw = apply_overrides(raw, overrides or {})
     cfg = validate(raw, str(path))
     cfg["scene"]["name"] = cfg["scene"]["name"] or path.stem
