@@ -125,32 +125,25 @@ def _bilinear_weights(gx, gy, ax, ay, ux, uy, clamp, i0, j0, fx, fy):
     return n_out
 
 
+@njit(cache=True, inline="always")
+def _bilinear(r, c, i, j, wx, wy):
+    """Bilinear value of component ``c`` of record ``r (nc, ny, nx)`` in cell (i, j)."""
+    return ((1.0 - wx) * (1.0 - wy) * r[c, j, i] + wx * (1.0 - wy) * r[c, j, i + 1]
+            + (1.0 - wx) * wy * r[c, j + 1, i] + wx * wy * r[c, j + 1, i + 1])
+
+
 def _interp_records(r0, r1, a, i0, j0, fx, fy, out):
     """``out[c, k] = (1-a)·bilinear(r0[c])(k) + a·bilinear(r1[c])(k)``.
 
     ``r0, r1``: records ``(nc, ny, nx)``; returns the count of non-finite
     results (NaN/fill values met in the records).
     """
-    n = i0.shape[0]
-    nc = r0.shape[0]
-    b = 1.0 - a
     n_bad = 0
-    for k in prange(n):
-        i = i0[k]
-        j = j0[k]
-        wx = fx[k]
-        wy = fy[k]
-        w00 = (1.0 - wx) * (1.0 - wy)
-        w10 = wx * (1.0 - wy)
-        w01 = (1.0 - wx) * wy
-        w11 = wx * wy
+    for k in prange(i0.shape[0]):
         bad = 0
-        for c in range(nc):
-            v0 = (w00 * r0[c, j, i] + w10 * r0[c, j, i + 1]
-                  + w01 * r0[c, j + 1, i] + w11 * r0[c, j + 1, i + 1])
-            v1 = (w00 * r1[c, j, i] + w10 * r1[c, j, i + 1]
-                  + w01 * r1[c, j + 1, i] + w11 * r1[c, j + 1, i + 1])
-            v = b * v0 + a * v1
+        for c in range(r0.shape[0]):
+            v = ((1.0 - a) * _bilinear(r0, c, i0[k], j0[k], fx[k], fy[k])
+                 + a * _bilinear(r1, c, i0[k], j0[k], fx[k], fy[k]))
             if not np.isfinite(v):
                 bad = 1
             out[c, k] = v
@@ -161,22 +154,11 @@ def _interp_records(r0, r1, a, i0, j0, fx, fy, out):
 def _interp_record(r, i0, j0, fx, fy, out):
     """``out[c, k] = bilinear(r[c])(k)`` for one record ``(nc, ny, nx)``;
     returns the count of non-finite results."""
-    n = i0.shape[0]
-    nc = r.shape[0]
     n_bad = 0
-    for k in prange(n):
-        i = i0[k]
-        j = j0[k]
-        wx = fx[k]
-        wy = fy[k]
-        w00 = (1.0 - wx) * (1.0 - wy)
-        w10 = wx * (1.0 - wy)
-        w01 = (1.0 - wx) * wy
-        w11 = wx * wy
+    for k in prange(i0.shape[0]):
         bad = 0
-        for c in range(nc):
-            v = (w00 * r[c, j, i] + w10 * r[c, j, i + 1]
-                 + w01 * r[c, j + 1, i] + w11 * r[c, j + 1, i + 1])
+        for c in range(r.shape[0]):
+            v = _bilinear(r, c, i0[k], j0[k], fx[k], fy[k])
             if not np.isfinite(v):
                 bad = 1
             out[c, k] = v

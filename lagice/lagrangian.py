@@ -43,7 +43,7 @@ import numpy as np
 from numba import njit
 
 from .errors import ConfigError, SolverError
-from .mesh import COAST, OPEN, Mesh
+from .mesh import OPEN, Mesh
 
 
 def new_budget() -> dict:
@@ -61,12 +61,9 @@ def new_budget() -> dict:
 
 
 def fixed_node_mask(mesh: Mesh) -> np.ndarray:
-    """(n,) bool: nodes that never move (on ``"coast"`` or ``"open"`` edges)."""
-    fixed = np.zeros(mesh.n_nodes, dtype=bool)
-    for name in (COAST, OPEN):
-        if mesh.has_tag(name):
-            fixed[mesh.nodes_with_tag(name)] = True
-    return fixed
+    """(n,) bool: nodes that never move (on ``"coast"`` or ``"open"`` edges);
+    :attr:`Mesh.fixed_node_mask`, cached on the mesh."""
+    return mesh.fixed_node_mask
 
 
 @njit(cache=True)
@@ -185,10 +182,7 @@ def move_mesh(state, dt_s: float, budget: dict | None = None, *, solver=None,
     if not 0.0 < min_area_ratio < 1.0:
         raise ConfigError(f"min_area_ratio = {min_area_ratio!r} must be in (0, 1)")
     mesh = state.mesh
-    fixed = getattr(mesh, "_lagice_fixed", None)
-    if fixed is None or len(fixed) != mesh.n_nodes:
-        fixed = fixed_node_mask(mesh)
-        mesh._lagice_fixed = fixed
+    fixed = mesh.fixed_node_mask
     tri = mesh.triangles
     area_old = np.empty(mesh.n_elements)
     _signed_areas_kernel(mesh.nodes, tri, area_old)

@@ -78,6 +78,7 @@ class Mesh:
     boundary_tags: np.ndarray
     tag_names: tuple
     _adj: tuple | None = field(default=None, repr=False)
+    _fixed: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self):
         self.nodes = np.ascontiguousarray(self.nodes, dtype=np.float64)
@@ -138,6 +139,18 @@ class Mesh:
 
     def has_tag(self, name: str) -> bool:
         return name in self.tag_names
+
+    @property
+    def fixed_node_mask(self) -> np.ndarray:
+        """(n,) bool, cached: nodes on ``"coast"`` or ``"open"`` edges (they never
+        move with the ice; the tags of a mesh do not change, its node positions may)."""
+        if self._fixed is None:
+            fixed = np.zeros(self.n_nodes, dtype=bool)
+            for name in (COAST, OPEN):
+                if self.has_tag(name):
+                    fixed[self.nodes_with_tag(name)] = True
+            self._fixed = fixed
+        return self._fixed
 
     def coast_nodes(self) -> np.ndarray:
         return self.nodes_with_tag(COAST) if self.has_tag(COAST) else np.zeros(0, np.int64)

@@ -208,7 +208,10 @@ class EVPSolver(LumpedMassSolver):
         bcs: list of :class:`~lagice.solvers.base.VelocityBC`; coast nodes are no-slip.
         forces: external forces (``WindStress``, ``OceanDrag``, ``Coriolis``: anything
             with ``add_explicit_terms``; :func:`lagice.forces.explicit_terms`).
-        substeps: N, the number of mEVP iterations per outer step (default 300).
+        substeps: N, the number of mEVP iterations per outer step (default 300); the
+            most iterations when ``tol`` is set.
+        tol: stop the iterations of a step once max |u^{p+1} − u^p| < ``tol`` [m s-1]
+            (None, the default: always N iterations, the usual fixed-N mEVP).
         alpha, beta: mEVP relaxation parameters α, β (default 300 each); with
             ``adaptive`` they are lower bounds.
         adaptive: aEVP (Kimmritz et al. 2016): α_e = max(α, sqrt(4 γ_e)), β_i =
@@ -221,7 +224,8 @@ class EVPSolver(LumpedMassSolver):
 
     ``state.stress`` holds the depth-averaged stress S/h [Pa] (0 where h = 0);
     :attr:`last_stress_integrated` the vertically integrated S [N m-1].
-    ``StepInfo.iterations`` = N, ``StepInfo.residual`` = max |u^N − u^{N−1}| [m s-1].
+    ``StepInfo.iterations`` = iterations done (N without ``tol``), ``StepInfo.residual`` =
+    max |u^p − u^{p−1}| of the last one [m s-1].
     """
 
     name = "evp"
@@ -230,7 +234,7 @@ class EVPSolver(LumpedMassSolver):
                  alpha: float = 300.0, beta: float = 300.0, adaptive: bool = True,
                  p_star: float = P_STAR, c_star: float = C_STAR, ellipse: float = ELLIPSE,
                  delta_min: float = DELTA_MIN, replacement_pressure: bool = False,
-                 heal_rate=None, parallel: bool | None = None):
+                 heal_rate=None, parallel: bool | None = None, tol: float | None = None):
         if mesh is None:
             raise ConfigError("EVPSolver needs a mesh")
         if substeps is None:
@@ -241,6 +245,8 @@ class EVPSolver(LumpedMassSolver):
                             ("ellipse", ellipse, 0.0), ("delta_min", delta_min, 0.0)):
             if not (np.isfinite(val) and val > lo):
                 raise ConfigError(f"{nm} = {val!r} must be > {lo:g}")
+        if tol is not None and not (np.isfinite(tol) and tol > 0):
+            raise ConfigError(f"tol = {tol!r} m s-1 (mEVP convergence) must be > 0, or None")
         if not (np.isfinite(c_star) and c_star >= 0):
             raise ConfigError(f"c_star = {c_star!r} must be >= 0")
         self.rheology = rheology
@@ -249,6 +255,7 @@ class EVPSolver(LumpedMassSolver):
         self.bcs = list(bcs)
         self.forces = list(forces)
         self.substeps = int(substeps)
+        self.tol = None if tol is None else float(tol)
         self.alpha, self.beta, self.adaptive = float(alpha), float(beta), bool(adaptive)
         self.p_star, self.c_star = float(p_star), float(c_star)
         self.ellipse, self.delta_min = float(ellipse), float(delta_min)
@@ -311,6 +318,7 @@ class EVPSolver(LumpedMassSolver):
         elem_k = element_evp_kernel if par else element_evp_kernel_serial
         tn = tm = 0.0
         res = 0.0
+        used = 0
         for _ in range(self.substeps):
             ta = time.perf_counter()
             elem_k(tri, self.b, self.c, vel, S, P, alpha_e, self.alpha, adapt, e2inv, self.delta_min,
@@ -321,11 +329,14 @@ class EVPSolver(LumpedMassSolver):
             tc = time.perf_counter()
             tm += tb - ta
             tn += tc - tb
+            used += 1
+            if self.tol is not None and res < self.tol:
+                break
         kt["element_stress"] = tm
         kt["node_velocity"] = tn
         if not (np.all(np.isfinite(vel)) and np.all(np.isfinite(S))):
             raise SolverError(f"non-finite velocity or stress at t = {t_new:.6g} s (EVP solver, Δt = {dt:g} s, "
-                              f"{self.substeps} iterations, α = {self.alpha:g}, β = {self.beta:g})")
+                              f"{used} iterations, α = {self.alpha:g}, β = {self.beta:g})")
         state.velocity = vel
         with np.errstate(divide="ignore", invalid="ignore"):
             state.stress = np.where(h[:, None] > 0, S / h[:, None], 0.0)
@@ -334,10 +345,10 @@ class EVPSolver(LumpedMassSolver):
         self.last_stress_integrated = S
         self.mean_velocity = vel.copy()
         self.last_strain_rate = (strain_rate if par else strain_rate_serial)(tri, self.b, self.c, vel)
-        self.last_substeps = self.substeps
+        self.last_substeps = used
         for k, v in kt.items():
             self.kernel_timings[k] += v
-        info = StepInfo(iterations=self.substeps, residual=float(res))
+        info = StepInfo(iterations=used, residual=float(res))
         info.timings = {"assembly": kt["forcing"] + kt["setup"], "solve": tn + tm, "damage": 0.0}
         info.kernel_timings = kt
         return info
