@@ -24,7 +24,7 @@ Observed ranges (``TARGETS``) come from the seeds; where a seed gives a single
 value, the band around it is ours and is written next to it in the report. No
 parameter is tuned per metric: both scenes run with their shipped settings.
 
-    python benchmarks/validate.py                 # full: 13-day basin runs + N = 40 compression (~15 min on 2 cores)
+    python benchmarks/validate.py                 # full: 28-day basin runs + N = 40 compression (~35 min on 2 cores)
     python benchmarks/validate.py --quick         # 4-day basin, N = 20 compression (~3 min)
     python benchmarks/validate.py --analyse-only  # re-analyse the runs already in --out
 
@@ -63,8 +63,8 @@ DAY = 86400.0
 TARGETS = {
     "beta_space": (0.17, 0.20, "RGPS, 3 days (seed 000; seed 001 ch. 2: 0.18; Marsan et al. 2004: 0.2)",
                    "band from the issue; EB in seed 000 gave 0.10"),
-    "pdf_tail_exponent_divergence": (2.2, 2.8, "RGPS |divergence|, 10 km, 3 days: 2.5 (seed 000)",
-                                     "±0.3 is ours (the RGPS shear–divergence difference)"),
+    "pdf_tail_exponent_divergence": (2.2, 2.8, "RGPS \\|divergence\\|, 10 km, 3 days: 2.5 (seed 000)",
+                                     "±0.3 is ours: the RGPS shear–divergence difference"),
     "pdf_tail_exponent_shear": (1.9, 2.5, "RGPS shear, 10 km, 3 days: 2.2 (seed 000)", "±0.3 is ours"),
     "localisation_half_shear_area_fraction": (0.04, 0.08, "RGPS 10 km: 6 % (seed 000; EB 4 %, VP > 20 %)",
                                               "±2 points is ours"),
@@ -77,6 +77,12 @@ LABELS = {
     "localisation_half_shear_area_fraction": "area holding half of the shear",
     "shear_divergence_r2": "shear–\\|divergence\\| R²",
 }
+#: Maxwell-EB sensitivity runs (``--sensitivity``): the closed basin with one parameter
+#: changed, reported apart from the headline and not used to pick any value
+SENSITIVITY = {
+    "alpha5": ("closed", ["rheology.alpha=5"], "α = 5 (neXtSIM BBM value, DESIGN §9)"),
+    "alpha7": ("closed", ["rheology.alpha=7"], "α = 7 (the largest α seed 004 §3.1.5 keeps memory effects for)"),
+}
 RHEOLOGIES = {
     "maxwell_eb": {"label": "Maxwell-EB", "overrides": []},
     "evp": {"label": "EVP (mEVP, Hibler ellipse)",
@@ -85,19 +91,26 @@ RHEOLOGIES = {
 
 
 # -- winter basin ---------------------------------------------------------------------
+def _run_command(scene_path: Path, out_dir: Path, days: float, resolution_m: float | None, overrides):
+    sets = [f"run.duration={days:g}d", "output.every=1d", *overrides]
+    if resolution_m:
+        sets.append(f"domain.resolution_m={resolution_m:g}")
+    cmd = [sys.executable, "-m", "lagice.cli", "run", str(scene_path), "--out", str(out_dir)]
+    for a in sets:
+        cmd += ["--set", a]
+    return cmd
+
+
 def basin_commands(out: Path, days: float, resolution_m: float | None):
     """``lagice run`` command lines {(scene, rheology): argv} of the basin runs."""
-    cmds = {}
-    for scene, path in SCENES.items():
-        for key, spec in RHEOLOGIES.items():
-            sets = [f"run.duration={days:g}d", "output.every=1d", *spec["overrides"]]
-            if resolution_m:
-                sets.append(f"domain.resolution_m={resolution_m:g}")
-            cmd = [sys.executable, "-m", "lagice.cli", "run", str(path), "--out", str(out / f"{scene}_{key}")]
-            for a in sets:
-                cmd += ["--set", a]
-            cmds[(scene, key)] = cmd
-    return cmds
+    return {(scene, key): _run_command(path, out / f"{scene}_{key}", days, resolution_m, spec["overrides"])
+            for scene, path in SCENES.items() for key, spec in RHEOLOGIES.items()}
+
+
+def sensitivity_commands(out: Path, days: float, resolution_m: float | None):
+    return {f"sensitivity_{name}": _run_command(SCENES[scene], out / f"sensitivity_{name}", days, resolution_m,
+                                                sets)
+            for name, (scene, sets, _) in SENSITIVITY.items()}
 
 
 def window_stats(run_dir: Path, start_s: float, window_s: float, buffer_m: float) -> dict:
@@ -124,25 +137,24 @@ def window_stats(run_dir: Path, start_s: float, window_s: float, buffer_m: float
     return out
 
 
-def analyse_basin(out: Path, scene: str, days: float, buffer_m: float, window_days: float = 3.0,
-                  spinup_days: float = 1.0):
-    res = {}
+def analyse_run(run: Path, days: float, buffer_m: float, window_days: float = 3.0, spinup_days: float = 1.0):
+    """Window statistics of one basin run and their median, min and max over the windows."""
     starts = np.arange(spinup_days, days - window_days + 1e-9, window_days)
-    for key in RHEOLOGIES:
-        run = out / f"{scene}_{key}"
-        idx = read_index(run)
-        epochs = sorted({e["mesh_epoch"] for e in idx})
-        windows = [window_stats(run, t * DAY, window_days * DAY, buffer_m) for t in starts]
-        summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").exists() else {}
-        res[key] = {"windows": windows, "mesh_epochs": epochs,
-                    "wall_s": summary.get("wall_s"), "remesh_events": idx[-1]["mesh_epoch"] - idx[0]["mesh_epoch"],
-                    "outflow_m3": summary.get("volume_budget", {}).get("outflow_m3"),
-                    "mean_speed_m_s": mean_speeds(run),
-                    "median": {k: float(np.median([w["interior"][k] for w in windows])) for k in TARGETS},
-                    "min": {k: float(np.min([w["interior"][k] for w in windows])) for k in TARGETS},
-                    "max": {k: float(np.max([w["interior"][k] for w in windows])) for k in TARGETS},
-                    "median_all_elements": {k: float(np.median([w["all"][k] for w in windows])) for k in TARGETS}}
-    return res
+    idx = read_index(run)
+    windows = [window_stats(run, t * DAY, window_days * DAY, buffer_m) for t in starts]
+    summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").exists() else {}
+    return {"windows": windows, "mesh_epochs": sorted({e["mesh_epoch"] for e in idx}),
+            "wall_s": summary.get("wall_s"), "remesh_events": idx[-1]["mesh_epoch"] - idx[0]["mesh_epoch"],
+            "outflow_m3": summary.get("volume_budget", {}).get("outflow_m3"),
+            "mean_speed_m_s": mean_speeds(run),
+            "median": {k: float(np.median([w["interior"][k] for w in windows])) for k in TARGETS},
+            "min": {k: float(np.min([w["interior"][k] for w in windows])) for k in TARGETS},
+            "max": {k: float(np.max([w["interior"][k] for w in windows])) for k in TARGETS},
+            "median_all_elements": {k: float(np.median([w["all"][k] for w in windows])) for k in TARGETS}}
+
+
+def analyse_basin(out: Path, scene: str, days: float, buffer_m: float):
+    return {key: analyse_run(out / f"{scene}_{key}", days, buffer_m) for key in RHEOLOGIES}
 
 
 def mean_speeds(run_dir: Path) -> list:
@@ -293,9 +305,11 @@ def figures_basin(basin: dict, fig_dir: Path, scene: str) -> list[Path]:
     for ax, slope in ((ax2, 2.2), (ax3, 2.5)):
         xs = np.geomspace(0.02, 0.3, 5)
         ax.loglog(xs, 0.3 * (xs / 0.02) ** -slope, "k--", label=f"RGPS tail exponent {slope}")
+    from matplotlib.ticker import NullFormatter
     for ax in (ax1, ax2, ax3):
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
+        ax.xaxis.set_minor_formatter(NullFormatter())
     fig.suptitle(SCENE_LABELS[scene], fontsize=10)
     fig.tight_layout()
     p = fig_dir / f"validation_{scene}_scaling_pdfs.png"
@@ -366,6 +380,9 @@ def figure_compression(c: dict, fig_dir: Path) -> Path:
     for b, (L, m, fit) in d["scale_curves"].items():
         ax2.loglog(L / 1e3, m / m[0], "o-", label=f"block {b}: β = {fit.exponent:.2f}")
     ax2.set(xlabel="scale L (km)", ylabel="⟨ε̇tot⟩ / ⟨ε̇tot⟩(L/N)", title="spatial scaling at the macro-rupture")
+    from matplotlib.ticker import NullFormatter
+    ax2.xaxis.set_minor_formatter(NullFormatter())
+    ax2.yaxis.set_minor_formatter(NullFormatter())
     ax2.grid(True, which="both", alpha=0.3)
     ax2.legend(fontsize=8)
     nodes, tri = d["nodes"], d["tri"]
@@ -380,9 +397,11 @@ def figure_compression(c: dict, fig_dir: Path) -> Path:
     ax3.set_xlim(nodes[:, 0].min() / 1e3, nodes[:, 0].max() / 1e3)
     ax3.set_ylim(nodes[:, 1].min() / 1e3, nodes[:, 1].max() / 1e3)
     ax3.set_aspect("equal")
-    ax3.set_title(f"log10 ε̇tot over the rupture block; faults at "
-                  f"{', '.join(f'{a:.1f}°' for a in c['fault_angles_rate_deg'])} from the axis "
-                  f"(Mohr–Coulomb {c['mohr_coulomb_angle_deg']:.1f}°)", fontsize=8)
+    ax3.set_title(f"log10 ε̇tot over the rupture block\nfaults (dashed) "
+                  f"{', '.join(f'{a:.1f}°' for a in c['fault_angles_rate_deg'])} from the y axis,\n"
+                  f"Mohr–Coulomb {c['mohr_coulomb_angle_deg']:.1f}°", fontsize=9)
+    ax3.set_xlabel("x (km)")
+    ax3.set_ylabel("y (km), compression along y")
     fig.tight_layout()
     p = fig_dir / "validation_compression.png"
     fig.savefig(p, dpi=110)
@@ -459,8 +478,8 @@ def write_report(res: dict, md: Path, figs: dict):
               f"{res['resolution_km']:g} km with their shipped settings: Maxwell-EB with the explicit solver, "
               f"cohesion 10–20 kPa (seeds 000/001), thermodynamic healing; EVP on the same mesh with the same "
               f"forcing, thermodynamics and mesh motion, `solver.name = \"evp\"`, Δt = 30 min, 300 mEVP iterations "
-              f"(`docs/evp.md`). The cyclone schedule depends on the run length, so it is the same for all "
-              f"four runs but not the one of a 28-day run.",
+              f"(`docs/evp.md`). The cyclone schedule is drawn for the run length, so all "
+              f"four runs see the same winds.",
               f"* Deformation as RGPS measures it: Lagrangian rates from the node displacements over back-to-back "
               f"3-day windows from day 1 on (the first day is spin-up), nodes followed through remeshing by their "
               f"ids (`load_window`), on the elements ≥ {res['coast_buffer_km']:g} km from the coast (seed 000 "
@@ -472,6 +491,20 @@ def write_report(res: dict, md: Path, figs: dict):
               "* No parameter was tuned to any metric.", ""]
     for scene, b in res["basin"].items():
         lines += _basin_section(scene, b, res, figs[scene])
+    if res.get("sensitivity"):
+        base = res["basin"]["closed"]["maxwell_eb"]
+        lines += ["## Sensitivity of Maxwell-EB to α (closed basin; not a calibration)", "",
+                  "α sets how fast the Maxwell viscosity η ∝ (1 − d)^α of damaged ice falls with damage. "
+                  "These runs change α alone and are reported for what they show; no value was chosen from them.",
+                  "", "| run | " + " | ".join(LABELS[k] for k in TARGETS) + " | ⟨ε̇tot⟩ (day⁻¹) | mean speed (m s⁻¹) |",
+                  "|---|" + "---|" * (len(TARGETS) + 2)]
+        rows = [("α = 4 (shipped, seed 004)", base)] + [(SENSITIVITY[n][2], r) for n, r in res["sensitivity"].items()]
+        for label, r in rows:
+            mt = np.median([w["interior"]["mean_total_s"] for w in r["windows"]]) * DAY
+            lines.append(f"| {label} | " + " | ".join(
+                f"{_fmt(k, r['median'][k])} ({_inside(k, r['median'][k])})" for k in TARGETS)
+                + f" | {mt:.2g} | {np.mean(r['mean_speed_m_s'][1:]):.2g} |")
+        lines.append("")
     c = res["compression"]
     lines += ["## Uniaxial compression (seed 004 §4–5)", "",
               f"N = {c['n_across']} ({c['steps']} steps of {c['dt_s']:.1f} s, {c['wall_s']:.0f} s wall), seed 0, "
@@ -554,7 +587,7 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="4-day basins at 20 km, N = 20 compression")
     ap.add_argument("--analyse-only", action="store_true", help="re-analyse the runs in --out")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "out" / "validate")
-    ap.add_argument("--days", type=float, default=None, help="basin run length (default 13, quick 4)")
+    ap.add_argument("--days", type=float, default=None, help="basin run length in days (default 28, the scene's own; quick 4)")
     ap.add_argument("--coast-buffer-km", type=float, default=100.0)
     ap.add_argument("--n-across", type=int, default=None, help="compression N (default 40, quick 20)")
     ap.add_argument("--max-strain", type=float, default=1e-3)
@@ -563,9 +596,13 @@ def main(argv=None):
     ap.add_argument("--fig-dir", type=Path, default=ROOT / "docs" / "figures")
     ap.add_argument("--discussion", type=Path, default=ROOT / "benchmarks" / "validation_discussion.md",
                     help="hand-written summary and 'where the model misses' text, placed in the report")
+    ap.add_argument("--sensitivity", action="store_true",
+                    help="also run the Maxwell-EB sensitivity runs (SENSITIVITY: α = 5, 7 on the closed basin)")
+    ap.add_argument("--only-sensitivity", action="store_true",
+                    help="run only the sensitivity runs (the others are already in --out), then analyse all")
     ap.add_argument("--compression-job", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
-    days = args.days or (4.0 if args.quick else 13.0)
+    days = args.days or (4.0 if args.quick else 28.0)
     n_across = args.n_across or (20 if args.quick else 40)
     resolution = 20e3 if args.quick else None
     out = args.out.resolve()
@@ -579,14 +616,20 @@ def main(argv=None):
         jobs = {"compression": [sys.executable, str(Path(__file__).resolve()), "--compression-job", "--out", str(out),
                                 "--n-across", str(n_across), "--max-strain", str(args.max_strain)]}
         jobs.update({f"{s}_{k}": cmd for (s, k), cmd in basin_commands(out, days, resolution).items()})
+        if args.only_sensitivity:
+            jobs = {}
+        if args.sensitivity or args.only_sensitivity:
+            jobs.update(sensitivity_commands(out, days, resolution))
         run_jobs(jobs, out, max(1, args.jobs))
     basin = {s: analyse_basin(out, s, days, args.coast_buffer_km * 1e3) for s in SCENES}
+    sens = {name: analyse_run(out / f"sensitivity_{name}", days, args.coast_buffer_km * 1e3)
+            for name in SENSITIVITY if (out / f"sensitivity_{name}" / "snapshots" / "index.json").exists()}
     comp = analyse_compression(comp_path)
     figs = {s: figures_basin(basin[s], args.fig_dir, s) for s in SCENES}
     figs["compression"] = figure_compression(comp, args.fig_dir)
     res = {"quick": args.quick, "date": time.strftime("%Y-%m-%d"), "wall_s": time.perf_counter() - t0,
            "basin_days": days, "resolution_km": (resolution or 10e3) / 1e3, "coast_buffer_km": args.coast_buffer_km,
-           "basin": basin, "compression": comp, "targets": {k: list(v) for k, v in TARGETS.items()},
+           "basin": basin, "sensitivity": sens, "compression": comp, "targets": {k: list(v) for k, v in TARGETS.items()},
            "json": str((out / "validation.json").relative_to(ROOT)) if out.is_relative_to(ROOT) else str(out)}
     if args.discussion.exists():
         text = args.discussion.read_text()

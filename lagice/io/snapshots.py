@@ -174,7 +174,7 @@ def load_window(path, start_s: float, end_s: float) -> dict:
     exist at the end (those outside every remeshed patch), renumbered, and
     ``n_elements_lost`` counts the others. Files without ``node_id`` cannot be
     matched: :class:`~lagice.errors.LagiceError` names the epochs.
-    ``fixed_mesh`` is True when the nodes did not move (a Eulerian run): the
+    ``fixed_mesh`` is True when no node moved at all (a Eulerian run): the
     caller should then use the velocities.
     """
     from ..errors import LagiceError
@@ -226,7 +226,7 @@ def load_window(path, start_s: float, end_s: float) -> dict:
                           f"but have {xy0.shape[0]} and {xy1.shape[0]} nodes")
     return {"xy0": xy0, "xy1": xy1, "triangles": tri,
             "dt_s": float(e1["time_s"] - e0["time_s"]), "start_s": float(e0["time_s"]),
-            "end_s": float(e1["time_s"]), "fixed_mesh": bool(np.allclose(xy0, xy1)),
+            "end_s": float(e1["time_s"]), "fixed_mesh": bool(np.array_equal(xy0, xy1)),
             "velocity0": v0, "velocity1": v1, "n_elements_lost": lost, "kept_elements": kept,
             "start_mesh": start_mesh,
             "remesh_events": int(e1["mesh_epoch"] - e0["mesh_epoch"]), "datasets": (ds0, ds1)}
