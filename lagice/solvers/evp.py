@@ -18,11 +18,12 @@ mEVP, per outer step Δt from u^n, S^n, for p = 0 … N−1:
 
 1. **element kernel**: S^{p+1} = S^p + (S_VP(u^p) − S^p)/α_e
 2. **node kernel**: β_i (u^{p+1} − u^p) = −(u^{p+1} − u^n)
-   + (Δt/m_i)(f_i(S^{p+1}) + a_i τa + τw(u^{p+1}) − m_i f k×u^{p+1}),
+   + (Δt/m_i)(f_i(S^{p+1}) + a_i τa + τw(u^{p+1}) − m_i f k×(u^{p+1} + u^n)/2),
 
    the ocean drag with the coefficient c_d = a ρw Cw |Uw − u^p| of the previous
-   iterate, drag and Coriolis implicit (a 2×2 solve per node), as in
-   :mod:`lagice.solvers.explicit`; f_i = −Σ_e area_e S_e·∇φ_i gathered through
+   iterate and implicit in u^{p+1}, Coriolis Crank–Nicolson (half at u^{p+1},
+   half at u^n: inertial oscillations keep their amplitude), a 2×2 solve per
+   node, as in :mod:`lagice.solvers.explicit`; f_i = −Σ_e area_e S_e·∇φ_i gathered through
    the node→element adjacency. Prescribed components (coast no-slip,
    :class:`VelocityBC`) take their value at the end of the outer step.
 
@@ -103,7 +104,8 @@ def _node_evp(vel, vel_n, S, ptr, elems, wb, wc, alpha_e, beta, m_dt, fext, cda,
     """One mEVP velocity update in place on ``vel`` (n, 2) (module doc, step 2).
 
     m_dt = m/Δt [kg s-1]; fext = a τa [N]; cda = a ρw Cw [kg m-1]; mf = m f
-    [kg s-1]; wb, wc = area ∂φ/∂x, area ∂φ/∂y per adjacency entry [m]; β_i =
+    [kg s-1] (Coriolis Crank–Nicolson: ½ m f k×(u^{p+1} + u^n)); wb, wc = area ∂φ/∂x,
+    area ∂φ/∂y per adjacency entry [m]; β_i =
     max(beta, α_e of its elements). Returns max |u^{p+1} − u^p| [m s-1]."""
     n = ptr.shape[0] - 1
     dmax = 0.0
@@ -131,14 +133,16 @@ def _node_evp(vel, vel_n, S, ptr, elems, wb, wc, alpha_e, beta, m_dt, fext, cda,
         ru = uwx - u
         rv = uwy - v
         cd = cda[i] * math.sqrt(ru * ru + rv * rv)
-        hf = mf[i]
+        hf = 0.5 * mf[i]
         diag = (bi + 1.0) * md + cd * cos_t
         a11 = diag
         a12 = -cd * sin_t - hf
         a21 = cd * sin_t + hf
         a22 = diag
-        rx = bi * md * u + md * vel_n[i, 0] + fx + fext[i, 0] + cd * (cos_t * uwx - sin_t * uwy)
-        ry = bi * md * v + md * vel_n[i, 1] + fy + fext[i, 1] + cd * (sin_t * uwx + cos_t * uwy)
+        rx = (bi * md * u + md * vel_n[i, 0] + fx + fext[i, 0] + cd * (cos_t * uwx - sin_t * uwy)
+              + hf * vel_n[i, 1])
+        ry = (bi * md * v + md * vel_n[i, 1] + fy + fext[i, 1] + cd * (sin_t * uwx + cos_t * uwy)
+              - hf * vel_n[i, 0])
         if fx0:
             un = pres[i, 0]
             vn = (ry - a21 * un) / a22 if a22 != 0.0 else 0.0
