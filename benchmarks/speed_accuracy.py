@@ -335,7 +335,7 @@ def write_markdown(runs, meta, md, png):
             lines.append(txt + ".")
         fr = sorted([r for r in rs if r.get("pareto")], key=lambda r: r["wall_s"])
         if fr:
-            lines.append(f"  Pareto front: " + "; ".join(
+            lines.append("  Pareto front: " + "; ".join(
                 f"{r['solver']} Δx={r['resolution_m'] / 1e3:g} km Δt={r['dt_s']:.0f} s "
                 f"({r['wall_s']:.2f} s, err {_f(r.get('vel_err_own'))})" for r in fr) + ".")
     lines.append("")

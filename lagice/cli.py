@@ -107,8 +107,6 @@ def _info(args) -> int:
 
 
 def _diagnose(args) -> int:
-    import numpy as np
-
     from .diagnostics import diagnose_arrays
     from .diagnostics.faults import interior_triangles
     from .io.snapshots import load_window, read_index, snapshot_dir

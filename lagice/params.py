@@ -5,7 +5,7 @@ Values and sources follow ``DESIGN.md`` §9 and seed 004 Table 1.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, fields, replace
 
 from .errors import ConfigError, check_range
 

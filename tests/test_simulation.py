@@ -1,6 +1,5 @@
 """Simulation API: schedules, bit-identical resume, damaged checkpoints, kill
 during checkpoint writing, scene (TOML) validation."""
-import json
 import os
 import signal
 import subprocess

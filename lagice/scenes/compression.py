@@ -164,8 +164,6 @@ def run(out_dir="runs/uniaxial_compression", n_across: int = 40, seed: int = 0,
 
 
 def write_netcdf(path, sc: CompressionScene, ts, snaps, timings, wall, n_capped) -> Path:
-    import xarray as xr
-
     from ..io.ugrid import mesh_dataset
 
     ds = mesh_dataset(sc.mesh)

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ConfigError
-from ..mesh import COAST, Mesh
+from ..mesh import Mesh
 
 
 @dataclass(frozen=True)
