@@ -142,6 +142,28 @@ class LumpedMassSolver:
         ptr, elems, _local = self.mesh.node_elements
         return lm(ptr, elems, self.area, rho * h), lm(ptr, elems, self.area, np.ones_like(h))
 
+    def _node_setup(self, state, terms, rho: float, dt_sub: float, thickness_weights: bool):
+        """What every sub-step of a lumped-mass solver needs per node, from the state
+        and the external terms ``terms`` (:func:`lagice.forces.explicit_terms`).
+
+        Returns ``(h, mass, wb, wc, m_dt, fext, cda, par)``: thickness h [m], lumped
+        mass [kg], adjacency weights area·∂φ/∂x, area·∂φ/∂y (times h if
+        ``thickness_weights``: depth-averaged stress) [m or m²], m/Δt_sub [kg s-1],
+        wind force a·τa [N], drag coefficient a·ρw·Cw [kg m-1] and the parallel flag.
+        """
+        from .explicit import adjacency_weights, adjacency_weights_serial
+
+        mesh = self.mesh
+        ptr, elems, local = mesh.node_elements
+        par = self._parallel_for(mesh)
+        h = np.ascontiguousarray(state.thickness, np.float64)
+        mass, node_area = self._lumped(h, rho, par)
+        wb, wc = (adjacency_weights if par else adjacency_weights_serial)(
+            mesh.triangles, self.b, self.c, self.area, h if thickness_weights else np.ones_like(h),
+            ptr, elems, local)
+        return (h, mass, wb, wc, mass / dt_sub, terms.tau * node_area[:, None],
+                terms.drag_coef * node_area, par)
+
     def _parallel_for(self, mesh) -> bool:
         from .._numba import PARALLEL_MIN_SIZE
 

@@ -50,7 +50,6 @@ from ..fem import element_strain_rate, strain_rate, strain_rate_serial
 from ..forces import explicit_terms
 from ..state import IceState
 from .base import LumpedMassSolver, StepInfo
-from .explicit import adjacency_weights, adjacency_weights_serial
 
 #: P* [N m-2], C* [-], e [-], Δmin [s-1] defaults
 P_STAR = 27.5e3
@@ -293,16 +292,10 @@ class EVPSolver(LumpedMassSolver):
         t1 = time.perf_counter()
         kt["forcing"] = t1 - t0
 
-        ptr, elems, local = mesh.node_elements
+        ptr, elems, _ = mesh.node_elements
         tri = mesh.triangles
-        par = self._parallel_for(mesh)
-        h = np.ascontiguousarray(state.thickness, np.float64)
-        mass, node_area = self._lumped(h, self.rho_ice, par)
-        wb, wc = (adjacency_weights if par else adjacency_weights_serial)(
-            tri, self.b, self.c, self.area, np.ones_like(h), ptr, elems, local)
-        m_dt = mass / dt
-        fext = terms.tau * node_area[:, None]
-        cda = terms.drag_coef * node_area
+        # S is vertically integrated: adjacency weights without h
+        h, mass, wb, wc, m_dt, fext, cda, par = self._node_setup(state, terms, self.rho_ice, dt, False)
         mf = mass * terms.coriolis
         P = self.strength(state)
         if self.adaptive:

@@ -326,16 +326,9 @@ class ExplicitSolver(LumpedMassSolver):
         t1 = time.perf_counter()
         kt["forcing"] = t1 - t0
 
-        ptr, elems, local = mesh.node_elements
+        ptr, elems, _ = mesh.node_elements
         tri = mesh.triangles
-        par = self._parallel_for(mesh)
-        h = np.ascontiguousarray(state.thickness, np.float64)
-        mass, node_area = self._lumped(h, p.rho_ice, par)
-        wb, wc = (adjacency_weights if par else adjacency_weights_serial)(
-            tri, self.b, self.c, self.area, h, ptr, elems, local)
-        m_dt = mass / dt_s
-        fext = terms.tau * node_area[:, None]
-        cda = terms.drag_coef * node_area
+        h, mass, wb, wc, m_dt, fext, cda, par = self._node_setup(state, terms, p.rho_ice, dt_s, True)
         half_mf = 0.5 * mass * terms.coriolis
         e_dt = dt_s * E
         gamma = lam / (lam + dt_s)
