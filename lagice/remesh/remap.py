@@ -94,16 +94,20 @@ def _bboxes(nodes, tri):
     return np.column_stack([p[:, :, 0].min(1), p[:, :, 0].max(1), p[:, :, 1].min(1), p[:, :, 1].max(1)])
 
 
+@njit(cache=True, inline="always")
+def _cell_range(bb, k, x0, y0, cell, nx, ny):
+    """Grid cells (i0, i1, j0, j1), inclusive and clamped, overlapped by bounding box bb[k]."""
+    return (min(max(int((bb[k, 0] - x0) / cell), 0), nx - 1), min(max(int((bb[k, 1] - x0) / cell), 0), nx - 1),
+            min(max(int((bb[k, 2] - y0) / cell), 0), ny - 1), min(max(int((bb[k, 3] - y0) / cell), 0), ny - 1))
+
+
 @njit(cache=True)
 def _build_grid(bb, x0, y0, cell, nx, ny):
     """CSR bucket grid: triangle k (bbox bb[k]) is listed in every cell its box overlaps."""
     m = bb.shape[0]
     count = np.zeros(nx * ny + 1, np.int64)
     for k in range(m):
-        i0 = min(max(int((bb[k, 0] - x0) / cell), 0), nx - 1)
-        i1 = min(max(int((bb[k, 1] - x0) / cell), 0), nx - 1)
-        j0 = min(max(int((bb[k, 2] - y0) / cell), 0), ny - 1)
-        j1 = min(max(int((bb[k, 3] - y0) / cell), 0), ny - 1)
+        i0, i1, j0, j1 = _cell_range(bb, k, x0, y0, cell, nx, ny)
         for j in range(j0, j1 + 1):
             for i in range(i0, i1 + 1):
                 count[j * nx + i + 1] += 1
@@ -111,10 +115,7 @@ def _build_grid(bb, x0, y0, cell, nx, ny):
     fill = ptr[:-1].copy()
     items = np.empty(ptr[-1], np.int64)
     for k in range(m):
-        i0 = min(max(int((bb[k, 0] - x0) / cell), 0), nx - 1)
-        i1 = min(max(int((bb[k, 1] - x0) / cell), 0), nx - 1)
-        j0 = min(max(int((bb[k, 2] - y0) / cell), 0), ny - 1)
-        j1 = min(max(int((bb[k, 3] - y0) / cell), 0), ny - 1)
+        i0, i1, j0, j1 = _cell_range(bb, k, x0, y0, cell, nx, ny)
         for j in range(j0, j1 + 1):
             for i in range(i0, i1 + 1):
                 items[fill[j * nx + i]] = k
@@ -138,10 +139,7 @@ def _grid_intersect(nodes_a, tri_a, bba, nodes_b, tri_b, bbb, ptr, items, x0, y0
     qy = np.empty(3)
     n = 0
     for j in range(tri_b.shape[0]):
-        i0 = min(max(int((bbb[j, 0] - x0) / cell), 0), nx - 1)
-        i1 = min(max(int((bbb[j, 1] - x0) / cell), 0), nx - 1)
-        j0 = min(max(int((bbb[j, 2] - y0) / cell), 0), ny - 1)
-        j1 = min(max(int((bbb[j, 3] - y0) / cell), 0), ny - 1)
+        i0, i1, j0, j1 = _cell_range(bbb, j, x0, y0, cell, nx, ny)
         tb = tri_b[j]
         ox, oy = nodes_b[tb[0], 0], nodes_b[tb[0], 1]
         for v in range(3):
