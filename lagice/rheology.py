@@ -95,6 +95,29 @@ def _dcrit_kernel(sigma, cohesion, q, denom, out):
         out[e] = _dcrit(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom)
 
 
+@njit(cache=True, inline="always")
+def damage_step(d, dc, dt, td, heal_rate, max_damage):
+    """One element's damage update (seed 004 eqs. 9-11), shared by the kernels.
+
+    Returns ``(d_new, f, capped)``: r = min(1, dt/td)(1 − dc), 1 − d ← (1 − d)(1 − r)
+    where dc < 1; the stress factor f = 1 − r (1 without a damage event); then
+    healing d ← d − dt·heal_rate floored at 0 and the cap at ``max_damage``
+    (capped = 1 when it acted)."""
+    f = 1.0
+    if dc < 1.0:
+        r = min(1.0, dt / td) * (1.0 - dc)
+        d = 1.0 - (1.0 - d) * (1.0 - r)
+        f = 1.0 - r
+    d -= dt * heal_rate
+    if d < 0.0:
+        d = 0.0
+    capped = 0
+    if d > max_damage:
+        d = max_damage
+        capped = 1
+    return d, f, capped
+
+
 @njit(cache=True, parallel=True)
 def damage_update_kernel(sigma, damage, cohesion, dt, td, heal_rate, q, denom, max_damage,
                          dcrit_out):
@@ -112,20 +135,12 @@ def damage_update_kernel(sigma, damage, cohesion, dt, td, heal_rate, q, denom, m
     for e in prange(sigma.shape[0]):
         dc = _dcrit(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom)
         dcrit_out[e] = dc
-        d = damage[e]
+        d, f, capped = damage_step(damage[e], dc, dt, td[e], heal_rate[e], max_damage)
         if dc < 1.0:
-            r = min(1.0, dt / td[e]) * (1.0 - dc)
-            d = 1.0 - (1.0 - d) * (1.0 - r)
-            f = 1.0 - r
             sigma[e, 0] *= f
             sigma[e, 1] *= f
             sigma[e, 2] *= f
-        d -= dt * heal_rate[e]
-        if d < 0.0:
-            d = 0.0
-        if d > max_damage:
-            d = max_damage
-            n_capped += 1
+        n_capped += capped
         damage[e] = d
     return n_capped
 

@@ -45,7 +45,7 @@ from ..errors import ConfigError, SolverError
 from .._numba import PARALLEL_MIN_SIZE, serial_copy
 from ..fem import element_strain_rate, strain_rate, strain_rate_serial
 from ..forces import explicit_terms
-from ..rheology import MaxwellEB, _dcrit
+from ..rheology import MaxwellEB, _dcrit, damage_step
 from ..state import IceState
 from .base import LumpedMassSolver, StepInfo
 
@@ -156,7 +156,7 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
         sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * g
         syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * g
         sxy = (sigma[e, 2] + ed * (kss * exy)) * g
-        # damage and stress correction: same arithmetic as rheology.damage_update_kernel.
+        # damage and stress correction: rheology.damage_step, as in rheology.damage_update_kernel.
         # Cheap test first: strictly inside the envelope (s1 < σT and q s1 − s2 < σc, with
         # σc = 2C/denom, σT = σc/q precomputed) _dcrit returns exactly 1.
         mm = 0.5 * (sxx + syy)
@@ -167,21 +167,13 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
         else:
             dc = _dcrit(sxx, syy, sxy, cohesion[e], q, denom)
         d0 = damage[e]
-        d = d0
+        d, f, capped = damage_step(d0, dc, dt_s, td[e], heal_rate[e], max_damage)
         if dc < 1.0:
-            r = min(1.0, dt_s / td[e]) * (1.0 - dc)
-            d = 1.0 - (1.0 - d) * (1.0 - r)
-            f = 1.0 - r
             sxx *= f
             syy *= f
             sxy *= f
             damaged_flag[e] = 1
-        d -= dt_s * heal_rate[e]
-        if d < 0.0:
-            d = 0.0
-        if d > max_damage:
-            d = max_damage
-            n_capped += 1
+        n_capped += capped
         sigma[e, 0] = sxx
         sigma[e, 1] = syy
         sigma[e, 2] = sxy
