@@ -50,6 +50,7 @@ from ..fem import element_strain_rate, strain_rate, strain_rate_serial
 from ..forces import explicit_terms
 from ..state import IceState
 from .base import LumpedMassSolver, StepInfo
+from .explicit import solve_node_2x2
 
 #: P* [N m-2], C* [-], e [-], Δmin [s-1] defaults
 P_STAR = 27.5e3
@@ -142,20 +143,7 @@ def _node_evp(vel, vel_n, S, ptr, elems, wb, wc, alpha_e, beta, m_dt, fext, cda,
               + hf * vel_n[i, 1])
         ry = (bi * md * v + md * vel_n[i, 1] + fy + fext[i, 1] + cd * (sin_t * uwx + cos_t * uwy)
               - hf * vel_n[i, 0])
-        if fx0:
-            un = pres[i, 0]
-            vn = (ry - a21 * un) / a22 if a22 != 0.0 else 0.0
-        elif fx1:
-            vn = pres[i, 1]
-            un = (rx - a12 * vn) / a11 if a11 != 0.0 else 0.0
-        else:
-            det = a11 * a22 - a12 * a21
-            if det != 0.0:
-                un = (a22 * rx - a12 * ry) / det
-                vn = (a11 * ry - a21 * rx) / det
-            else:
-                un = 0.0
-                vn = 0.0
+        un, vn = solve_node_2x2(a11, a12, a21, a22, rx, ry, fx0, fx1, pres[i, 0], pres[i, 1])
         dmax = max(dmax, max(abs(un - u), abs(vn - v)))  # prange max-reduction form
         vel[i, 0] = un
         vel[i, 1] = vn

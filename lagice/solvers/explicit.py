@@ -54,6 +54,21 @@ from .base import LumpedMassSolver, StepInfo
 KERNELS = ("forcing", "setup", "node_velocity", "element_stress_damage")
 
 
+@njit(cache=True, inline="always")
+def solve_node_2x2(a11, a12, a21, a22, rx, ry, fixed_u, fixed_v, pu, pv):
+    """New velocity (u, v) of one node from the 2×2 system [[a11, a12], [a21, a22]]
+    (u, v) = (rx, ry), with u = pu where ``fixed_u`` or v = pv where ``fixed_v``
+    (a prescribed component; callers handle both fixed). 0 for a singular system."""
+    if fixed_u:
+        return pu, ((ry - a21 * pu) / a22 if a22 != 0.0 else 0.0)
+    if fixed_v:
+        return ((rx - a12 * pv) / a11 if a11 != 0.0 else 0.0), pv
+    det = a11 * a22 - a12 * a21
+    if det != 0.0:
+        return (a22 * rx - a12 * ry) / det, (a11 * ry - a21 * rx) / det
+    return 0.0, 0.0
+
+
 def _adjacency_weights(tri, b, c, area, h, ptr, elems, local):
     """Per adjacency entry p (node i, element e, local vertex k): area·h·∂φk/∂x and
     area·h·∂φk/∂y [m² per m], so that the internal force on node i is
@@ -115,20 +130,9 @@ def _node_velocity(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, cur
         a22 = md + cd * cos_t
         rx = md * u + fx + fext[i, 0] + cd * (cos_t * uwx - sin_t * uwy) + hf * v
         ry = md * v + fy + fext[i, 1] + cd * (sin_t * uwx + cos_t * uwy) - hf * u
-        if fx0:
-            un = pres0[i, 0] + w_time * (pres1[i, 0] - pres0[i, 0])
-            vn = (ry - a21 * un) / a22 if a22 != 0.0 else 0.0
-        elif fx1:
-            vn = pres0[i, 1] + w_time * (pres1[i, 1] - pres0[i, 1])
-            un = (rx - a12 * vn) / a11 if a11 != 0.0 else 0.0
-        else:
-            det = a11 * a22 - a12 * a21
-            if det != 0.0:
-                un = (a22 * rx - a12 * ry) / det
-                vn = (a11 * ry - a21 * rx) / det
-            else:
-                un = 0.0
-                vn = 0.0
+        pu = pres0[i, 0] + w_time * (pres1[i, 0] - pres0[i, 0]) if fx0 else 0.0
+        pv = pres0[i, 1] + w_time * (pres1[i, 1] - pres0[i, 1]) if fx1 else 0.0
+        un, vn = solve_node_2x2(a11, a12, a21, a22, rx, ry, fx0, fx1, pu, pv)
         vel[i, 0] = un
         vel[i, 1] = vn
         vel_sum[i, 0] += un
