@@ -2,7 +2,7 @@
 
     lagice run SCENE [--out DIR] [--set key=value ...]   run a bundled scene or a TOML file
     lagice resume CHECKPOINT                              continue a run (file or directory)
-    lagice plot OUTPUT                                    plot a run directory or snapshot folder
+    lagice plot RUN_DIR                                   redraw the run's own figure
     lagice info FILE                                      describe a netCDF output or checkpoint
     lagice diagnose OUTPUT [--window-steps K] [--coast-buffer-km B]
                                                           deformation statistics (JSON + PNG)
@@ -19,26 +19,16 @@ from .errors import LagiceError
 
 
 def _run(args) -> int:
-    from .scenes import DEFAULT_SCENE, SCENES, parse_overrides, scene_module
+    from .scenes import DEFAULT_SCENE
+    from .scenes.builder import build_simulation, finish
+    from .scenes.config import load_scene
 
     name = args.scene or DEFAULT_SCENE
-    if name in SCENES:
-        mod = scene_module(name)
-        options = parse_overrides(args.set, mod.run)
-        out = Path(args.out or Path("runs") / name)
-        print(f"lagice: running scene {name!r} -> {out}/", flush=True)
-        res = mod.run(out_dir=out, **options)
-    else:
-        from .scenes.config import load_scene
-        from .scenes.toml_scene import build_simulation, finish
-
-        cfg = load_scene(name, args.set)
-        out = Path(args.out or Path("runs") / cfg["scene"]["name"])
-        cfg["_out_dir"] = str(out)
-        print(f"lagice: running scene {cfg['scene']['name']!r} ({cfg['scene']['source']}) -> {out}/", flush=True)
-        sim = build_simulation(cfg, out)
-        res = finish(sim)
-    _report(res)
+    cfg = load_scene(name, args.set)
+    out = Path(args.out or Path("runs") / cfg["scene"]["name"])
+    print(f"lagice: running scene {cfg['scene']['name']!r} ({cfg['scene']['source']}) -> {out}/", flush=True)
+    sim = build_simulation(cfg, out)
+    _report(finish(sim))
     return 0
 
 
@@ -50,42 +40,50 @@ def _report(res):
 
 
 def _resume(args) -> int:
-    from .scenes.toml_scene import finish
+    from .scenes.builder import finish
     from .simulation import Simulation
 
     ck = Path(args.checkpoint)
     ck_dir = ck if ck.is_dir() else ck.parent
     run_dir = ck_dir.parent if ck_dir.name == "checkpoints" else ck_dir
     sim = Simulation.resume(ck, out_dir=run_dir)
-    st = sim.model.state
+    clock = sim.model.clock
     print(f"lagice: resuming {sim.model.config.get('scene', {}).get('name', '?')!r} from "
-          f"{sim.resumed_from} (step {st.step}, day {st.time_s / 86400:.3f}) -> {run_dir}/", flush=True)
+          f"{sim.resumed_from} (step {clock.iteration}, day {clock.time_s / 86400:.3f}) -> {run_dir}/", flush=True)
     _report(finish(sim))
     return 0
 
 
 def _plot(args) -> int:
     from .io.snapshots import snapshot_dir
-    from .plotting import plot_run
+    from .scenes.builder import plot_scene
 
-    p = Path(args.output)
-    if p.suffix == ".nc" and p.exists():
-        import xarray as xr
-        with xr.open_dataset(p) as ds:
-            if "macro_stress" in ds:
-                from .scenes.compression import plot_compression
-                out = plot_compression(p, p.with_suffix(".png"))
-                print(f"  plot: {out.resolve()}")
-                return 0
-        p = p.parent
-    snaps = snapshot_dir(p)
+    snaps = snapshot_dir(args.output)
+    run_dir = snaps.parent if snaps.name == "snapshots" else snaps
     summary = None
-    for cand in (snaps.parent / "summary.json", snaps / "summary.json"):
-        if cand.exists():
-            summary = json.loads(cand.read_text())
-    out = plot_run(snaps, Path(args.png or snaps.parent / "plot.png"), summary)
-    print(f"  plot: {out.resolve()}")
+    if (run_dir / "summary.json").exists():
+        summary = json.loads((run_dir / "summary.json").read_text())
+    cfg = _run_config(snaps)
+    png = plot_scene(cfg, run_dir, summary)
+    if args.png and png is not None:
+        Path(png).replace(args.png)
+        png = Path(args.png)
+    print(f"  plot: {Path(png).resolve() if png else '(this scene has no plot)'}")
     return 0
+
+
+def _run_config(snaps: Path) -> dict:
+    """The scene configuration a run was made with (from its first snapshot)."""
+    import xarray as xr
+
+    from .io.snapshots import read_index
+
+    idx = read_index(snaps)
+    with xr.open_dataset(snaps / idx[0]["file"], decode_times=False) as ds:
+        raw = ds.attrs.get("lagice_config")
+    if raw is None:
+        raise LagiceError(f"{snaps}: the snapshots carry no scene configuration (lagice_config attribute)")
+    return json.loads(raw)
 
 
 def _info(args) -> int:
@@ -95,7 +93,8 @@ def _info(args) -> int:
     if p.suffix == ".npz":
         from .io.checkpoint import read_checkpoint
         arrays, meta = read_checkpoint(p)
-        print(f"checkpoint {p}: step {meta['step']}, t = {meta['time_s']:.1f} s, lagice {meta.get('lagice_version')}, "
+        print(f"checkpoint {p}: step {meta['step']}, t = {meta['clock']['time_s']:.1f} s, "
+              f"format {meta.get('format_version')}, lagice {meta.get('lagice_version')}, "
               f"scene {meta.get('config', {}).get('scene', {}).get('name')}, fingerprint {meta.get('scene_fingerprint')}")
         for k, a in arrays.items():
             print(f"  {k}: {a.dtype} {a.shape}")
@@ -145,13 +144,12 @@ def _diagnose(args) -> int:
 
 
 def _scenes(args) -> int:
-    from .scenes import SCENES
-    from .scenes.config import SCENE_DIR
+    from .scenes import DEFAULT_SCENE
+    from .scenes.config import list_scenes
 
-    for name in sorted(SCENES):
-        print(f"  {name}  (python scene)")
-    for p in sorted(SCENE_DIR.glob("*.toml")):
-        print(f"  {p.stem}  ({p})")
+    for name, (path, desc) in list_scenes().items():
+        mark = " (default)" if name == DEFAULT_SCENE else ""
+        print(f"  {name}{mark}: {desc}\n      {path}")
     return 0
 
 
@@ -162,12 +160,12 @@ def main(argv=None) -> int:
     r.add_argument("scene", nargs="?", help="scene name or path.toml (default: uniaxial_compression)")
     r.add_argument("--out", help="output directory (default runs/SCENE)")
     r.add_argument("--set", action="append", metavar="KEY=VALUE",
-                   help="override a scene key (TOML scenes: dotted, e.g. run.duration=2d)")
+                   help="override a scene key: table.key=value (e.g. run.duration=2d)")
     r.set_defaults(func=_run)
     s = sub.add_parser("resume", help="resume from a checkpoint file or directory")
     s.add_argument("checkpoint")
     s.set_defaults(func=_resume)
-    p = sub.add_parser("plot", help="plot a run directory, snapshot folder or compression output")
+    p = sub.add_parser("plot", help="redraw the figure of a run directory (or its snapshot folder)")
     p.add_argument("output")
     p.add_argument("--png")
     p.set_defaults(func=_plot)

@@ -1,16 +1,23 @@
 """P1/P0 finite-element building blocks: shape-function gradients, strain
-rates, nodal forces, lumped mass, and assembly on a fixed sparsity pattern.
+rates, nodal forces, lumped mass, assembly on a fixed sparsity pattern, and the
+lumped-mass node system the sub-stepped time steppers compose
+(:class:`NodeSystem`: prescribed dofs, geometry, lumped mass, adjacency weights,
+and the 2×2 node solve :func:`solve_node_2x2`).
 
 Degrees of freedom are interleaved: dof 2i is u (x velocity) of node i and
 dof 2i+1 is v. All loops over elements are numba kernels.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import scipy.sparse as sp
 from numba import njit, prange
 
-from ._numba import serial_copy
+from ._numba import PARALLEL_MIN_SIZE, serial_copy
+from .boundary import DirichletSet
+from .errors import SolverError
 
 
 @njit(cache=True, parallel=True)
@@ -182,3 +189,131 @@ SHAPE_GRADIENTS = (shape_gradients_serial, shape_gradients)
 STRAIN_RATE = (strain_rate_serial, strain_rate)
 NODAL_FORCE = (nodal_force_from_stress_serial, nodal_force_from_stress)
 LUMPED_MASS = (lumped_mass_serial, lumped_mass)
+
+
+# -- the lumped-mass node system ------------------------------------------------------
+@njit(cache=True, inline="always")
+def solve_node_2x2(a11, a12, a21, a22, rx, ry, fixed_u, fixed_v, pu, pv):
+    """New velocity (u, v) of one node from the 2×2 system [[a11, a12], [a21, a22]]
+    (u, v) = (rx, ry), with u = pu where ``fixed_u`` or v = pv where ``fixed_v``
+    (a prescribed component; callers handle both fixed). 0 for a singular system."""
+    if fixed_u:
+        return pu, ((ry - a21 * pu) / a22 if a22 != 0.0 else 0.0)
+    if fixed_v:
+        return ((rx - a12 * pv) / a11 if a11 != 0.0 else 0.0), pv
+    det = a11 * a22 - a12 * a21
+    if det != 0.0:
+        return (a22 * rx - a12 * ry) / det, (a11 * ry - a21 * rx) / det
+    return 0.0, 0.0
+
+
+def _adjacency_weights(tri, b, c, area, h, ptr, elems, local):
+    """Per adjacency entry p (node i, element e, local vertex k): area·h·∂φk/∂x and
+    area·h·∂φk/∂y [m² per m], so that the internal force on node i is
+    f_i = −Σ_p (wb σxx + wc σxy, wb σxy + wc σyy)."""
+    n = ptr.shape[0] - 1
+    wb = np.empty(elems.shape[0])
+    wc = np.empty(elems.shape[0])
+    for i in prange(n):
+        for p in range(ptr[i], ptr[i + 1]):
+            e = elems[p]
+            k = local[p]
+            w = area[e] * h[e]
+            wb[p] = w * b[e, k]
+            wc[p] = w * c[e, k]
+    return wb, wc
+
+
+adjacency_weights = njit(cache=True, parallel=True)(_adjacency_weights)
+adjacency_weights_serial = serial_copy(_adjacency_weights)
+ADJACENCY_WEIGHTS = (adjacency_weights_serial, adjacency_weights)
+
+
+@dataclass
+class NodeSetup:
+    """What every sub-step of a lumped-mass stepper needs per node (one outer step).
+
+    h thickness [m] (m,); mass lumped nodal mass [kg]; wb, wc adjacency weights
+    area·∂φ/∂x, area·∂φ/∂y (times h for depth-averaged stress) [m or m²];
+    m_dt = m/Δt_sub [kg s-1]; fext = a·τa [N] (n, 2); cda = a·ρw·Cw [kg m-1];
+    parallel: whether the parallel kernel builds are used."""
+
+    h: np.ndarray
+    mass: np.ndarray
+    wb: np.ndarray
+    wc: np.ndarray
+    m_dt: np.ndarray
+    fext: np.ndarray
+    cda: np.ndarray
+    parallel: bool
+
+
+class NodeSystem:
+    """The lumped-mass node system of a mesh, composed by the sub-stepped steppers
+    (explicit Maxwell-EB, mEVP): prescribed degrees of freedom (coast no-slip and
+    :class:`~lagice.boundary.VelocityBC`), P1 geometry, lumped mass and adjacency
+    weights, and the serial/parallel kernel choice.
+
+    Args:
+        mesh: the mesh (node positions read at each :meth:`update_geometry`).
+        bcs: list of :class:`~lagice.boundary.VelocityBC`.
+        parallel: True/False, or None: parallel kernel builds from
+            ``lagice._numba.PARALLEL_MIN_SIZE`` elements up.
+        geometry_hook: ``f(node_system)`` called after every geometry update (steppers derive
+            their own per-element quantities there).
+    """
+
+    def __init__(self, mesh, bcs=(), parallel: bool | None = None, geometry_hook=None):
+        self.bcs = list(bcs)
+        self.parallel = parallel
+        self.geometry_hook = geometry_hook
+        self.reset_topology(mesh)
+
+    def reset_topology(self, mesh) -> None:
+        """Rebuild everything that depends on connectivity (after a remesh)."""
+        self.mesh = mesh
+        self.dirichlet = DirichletSet(mesh, self.bcs)
+        fixed = np.zeros((mesh.n_nodes, 2), np.int8)
+        fixed.reshape(-1)[self.dirichlet.dofs] = 1
+        self.fixed = fixed
+        self.update_geometry()
+
+    def update_geometry(self) -> None:
+        """Shape gradients and areas after nodes moved (Lagrangian step)."""
+        m = self.mesh
+        self.b, self.c, self.area = SHAPE_GRADIENTS[int(self.parallel_for(m))](m.nodes, m.triangles)
+        if np.any(self.area <= 0):
+            raise SolverError(f"{int(np.sum(self.area <= 0))} inverted elements in the mesh")
+        if self.geometry_hook is not None:
+            self.geometry_hook(self)
+
+    def parallel_for(self, mesh=None) -> bool:
+        mesh = self.mesh if mesh is None else mesh
+        return self.parallel if self.parallel is not None else mesh.n_elements >= PARALLEL_MIN_SIZE
+
+    def prescribed_velocity(self, t_s: float) -> np.ndarray:
+        """(n, 2) prescribed velocities at time t [s] (0 where free; see ``self.fixed``)."""
+        out = np.zeros((self.mesh.n_nodes, 2))
+        if len(self.dirichlet.dofs):
+            out.reshape(-1)[self.dirichlet.dofs] = self.dirichlet.values(t_s)
+        return out
+
+    def lumped(self, h: np.ndarray, rho: float, par: bool):
+        """Lumped nodal mass [kg] and nodal area [m²] for thickness h [m]."""
+        lm = LUMPED_MASS[int(par)]
+        ptr, elems, _local = self.mesh.node_elements
+        return lm(ptr, elems, self.area, rho * h), lm(ptr, elems, self.area, np.ones_like(h))
+
+    def setup(self, thickness, terms, rho: float, dt_sub: float, thickness_weights: bool) -> NodeSetup:
+        """Per-node quantities of one outer step from the thickness [m] and the external
+        terms ``terms`` (:func:`lagice.forces.explicit_terms`) (see :class:`NodeSetup`)."""
+        mesh = self.mesh
+        ptr, elems, local = mesh.node_elements
+        par = self.parallel_for(mesh)
+        h = np.ascontiguousarray(thickness, np.float64)
+        mass, node_area = self.lumped(h, rho, par)
+        wb, wc = ADJACENCY_WEIGHTS[int(par)](mesh.triangles, self.b, self.c, self.area,
+                                             h if thickness_weights else np.ones_like(h), ptr, elems, local)
+        return NodeSetup(h, mass, wb, wc, mass / dt_sub, terms.tau * node_area[:, None],
+                         terms.drag_coef * node_area, par)
+

@@ -222,7 +222,7 @@ def standard_forces(wind=None, current=None, drag: DragParams | None = None,
     if wind is not None:
         out.append(WindStress(wind, rho_air=p.rho_air, drag=p.air_drag))
     out.append(OceanDrag(current, rho_water=p.rho_water, drag=p.water_drag,
-                         turning_angle_deg=p.turning_angle_deg))
+                         turning_angle_deg=p.turning_angle_deg, min_speed=p.ocean_drag_min_speed_m_s))
     if latitude_deg is not None:
         out.append(Coriolis(latitude_deg=latitude_deg))
     elif coriolis_f is not None or p.coriolis_f != 0.0:

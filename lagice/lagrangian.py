@@ -1,7 +1,8 @@
-"""Lagrangian mesh motion and mass update (DESIGN.md §3 "Lagrangian mass update", §5).
+"""Lagrangian mesh motion and mass update (docs/design.md, "Lagrangian mass update").
 
-Every outer step the nodes move with the ice, ``x ← x + u Δt``, and every
-element keeps the ice it carries:
+Every outer step the nodes move with the ice, ``x ← x + u Δt`` with ``u`` the
+model's transport velocity (:attr:`lagice.model.Model.transport_velocity`),
+and every element keeps the ice it carries:
 
 * ice volume ``V = h·a`` and ice area ``A·a`` are constant, so
   ``h ← h·a_old/a_new`` and ``A ← A·a_old/a_new`` (snow likewise);
@@ -162,14 +163,15 @@ class MoveReport:
     min_area_ratio: float          # min over elements of a_new / a_old
 
 
-def move_mesh(state, dt_s: float, budget: dict | None = None, *, solver=None,
+def move_mesh(state, velocity: np.ndarray, dt_s: float, budget: dict | None = None, *, solver=None,
               min_area_ratio: float = 0.05, max_halvings: int = 8) -> MoveReport:
-    """Move the nodes of ``state.mesh`` with ``state.velocity`` over ``dt_s`` [s]
-    and update thickness, concentration and snow per element (module docstring).
+    """Move the nodes of ``state.mesh`` with ``velocity`` over ``dt_s`` [s] and
+    update thickness, concentration and snow per element (module docstring).
 
     Args:
         state: :class:`~lagice.state.IceState`, modified in place (mesh nodes,
             thickness, concentration, snow).
+        velocity: (n, 2) node velocity [m s-1] over the step (the transport velocity).
         dt_s: time step [s], > 0.
         budget: dict from :func:`new_budget`, updated in place (or None).
         solver: if given, ``solver.update_geometry()`` is called after the move.
@@ -188,7 +190,10 @@ def move_mesh(state, dt_s: float, budget: dict | None = None, *, solver=None,
     _signed_areas_kernel(mesh.nodes, tri, area_old)
     if np.any(area_old <= 0):
         raise SolverError(f"{int(np.sum(area_old <= 0))} inverted elements before the Lagrangian move")
-    disp = state.velocity * dt_s
+    velocity = np.asarray(velocity, np.float64)
+    if velocity.shape != (mesh.n_nodes, 2):
+        raise ConfigError(f"velocity has shape {velocity.shape}; expected ({mesh.n_nodes}, 2)")
+    disp = velocity * dt_s
     disp[fixed] = 0.0
     new_nodes, nlim, flagged = _limit_displacement(mesh.nodes, disp, tri, area_old,
                                                    float(min_area_ratio), int(max_halvings))
@@ -204,7 +209,7 @@ def move_mesh(state, dt_s: float, budget: dict | None = None, *, solver=None,
             d = mesh.nodes[edges[:, 1]] - mesh.nodes[edges[:, 0]]
             # outward normal (times length) of an edge with the domain on its left
             nx, ny = d[:, 1], -d[:, 0]
-            u = 0.5 * (state.velocity[edges[:, 0]] + state.velocity[edges[:, 1]])
+            u = 0.5 * (velocity[edges[:, 0]] + velocity[edges[:, 1]])
             s = (u[:, 0] * nx + u[:, 1] * ny) * dt_s
             np.add.at(swept_signed, owner, s)
             np.add.at(swept_out, owner, np.maximum(s, 0.0))
@@ -243,3 +248,37 @@ def _edge_owner(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
     if not np.all(keys[order][pos] == q):
         raise SolverError("a boundary edge does not belong to any element (mesh inconsistent)")
     return elem[order][pos]
+
+
+class MeshMotion:
+    """Component ``mesh_motion``: moves the nodes with the model's transport velocity
+    (:func:`move_mesh`), refreshes the stepper's geometry and books the outflow
+    through open boundaries in the model's volume ledger. Ridging and the
+    inversion guard are counted in :attr:`budget` (carried in checkpoints)."""
+
+    name = "mesh_motion"
+
+    def __init__(self, min_area_ratio: float = 0.05, max_halvings: int = 8):
+        if not 0.0 < min_area_ratio < 1.0:
+            raise ConfigError(f"lagrangian.min_area_ratio = {min_area_ratio!r} must be in (0, 1)")
+        if int(max_halvings) != max_halvings or max_halvings < 0:
+            raise ConfigError(f"lagrangian.max_halvings = {max_halvings!r} must be an integer >= 0")
+        self.min_area_ratio = float(min_area_ratio)
+        self.max_halvings = int(max_halvings)
+        self.budget = new_budget()
+        self.last_flagged = None
+
+    def advance(self, model, dt_s: float) -> MoveReport:
+        out0 = self.budget["outflow_volume_m3"]
+        rep = move_mesh(model.state, model.transport_velocity, dt_s, self.budget, solver=model.stepper,
+                        min_area_ratio=self.min_area_ratio, max_halvings=self.max_halvings)
+        model.ledger.book("outflow", -(self.budget["outflow_volume_m3"] - out0))
+        self.last_flagged = rep.flagged_elements
+        return rep
+
+    def checkpoint_state(self):
+        return {}, {"budget": dict(self.budget)}
+
+    def restore(self, arrays, meta):
+        self.budget.update(meta.get("budget", {}))
+

@@ -93,6 +93,8 @@ class DragParams:
     water_drag: float = 5.5e-3
     turning_angle_deg: float = 0.0
     coriolis_f: float = 0.0  # s-1; use coriolis_from_latitude for f(lat)
+    #: floor on |Uw − u| [m s-1] in the implicit stepper's drag linearisation (0: none)
+    ocean_drag_min_speed_m_s: float = 0.0
 
 
 def coriolis_from_latitude(lat_deg: float) -> float:

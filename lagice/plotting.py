@@ -18,11 +18,8 @@ def plot_run(snap_dir, png_path, summary: dict | None = None, trajectories=None)
     """Damage, total deformation rate, thickness and concentration of the last
     snapshot, drifter trajectories (if given, list of (n_t, 2) arrays in m) and
     a text panel with the run summary."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     import xarray as xr
+    from matplotlib.figure import Figure
 
     snap_dir = Path(snap_dir)
     index = json.loads((snap_dir / "index.json").read_text())
@@ -33,7 +30,8 @@ def plot_run(snap_dir, png_path, summary: dict | None = None, trajectories=None)
               ("total_deformation_rate", "log10 total deformation rate (s⁻¹)", "viridis", None),
               ("thickness", "thickness h (m)", "Blues", None),
               ("concentration", "concentration A", "cividis", None)]
-    fig, axes = plt.subplots(2, 3, figsize=(15, 9.5))
+    fig = Figure(figsize=(15, 9.5))
+    axes = fig.subplots(2, 3)
     axes = axes.ravel()
     for ax, (name, title, cmap, lim) in zip(axes[:4], panels):
         if name not in ds:
@@ -76,11 +74,11 @@ def plot_run(snap_dir, png_path, summary: dict | None = None, trajectories=None)
         lines.append(f"remesh events: {summary.get('remesh_count', 0)}")
         if "volume_budget" in summary:
             for k, v in summary["volume_budget"].items():
-                lines.append(f"  {k}: {v:.6g}")
+                if isinstance(v, (int, float)):
+                    lines.append(f"  {k}: {v:.6g}")
         lines.append(f"ice volume: {summary.get('ice_volume_m3', float('nan')):.6g} m³")
     lines.append(f"snapshots: {len(index)} (mesh epochs {index[0]['mesh_epoch']}–{index[-1]['mesh_epoch']})")
     ax.text(0.0, 1.0, "\n".join(lines), va="top", family="monospace", fontsize=9)
     fig.tight_layout()
     fig.savefig(png_path, dpi=100)
-    plt.close(fig)
     return Path(png_path)

@@ -1,14 +1,18 @@
-"""``Simulation``: time stepping, output/checkpoint schedules, callbacks, resume.
+"""``Simulation``: the one time loop of lagice, and the activities scheduled on it.
 
     sim = Simulation(model, dt="10min", stop="28d")
-    sim.output(every="1d", path="run/out")
+    sim.output(every="1d", path="run/snapshots")             # UGRID/CF snapshots
     sim.checkpoint(every="2d", path="run/checkpoints", keep=3)
+    sim.add_timeseries("run/timeseries.nc", ["ice_volume", "mean_damage"], every="1h")
+    sim.add_callback(my_function, every="6h")
     sim.run()
-    sim = Simulation.resume("run/checkpoints")        # or a checkpoint file
+    sim = Simulation.resume("run/checkpoints")               # or a checkpoint file
 
-Resuming rebuilds the model from the scene configuration stored in the
-checkpoint (``builder`` = ``"module:function"`` returning a Simulation) and
-continues bit for bit as the uninterrupted run would have.
+The loop is ``model.step(dt)`` followed by every activity whose schedule is due
+(:mod:`lagice.activities`). Resuming rebuilds the model from the scene
+configuration stored in the checkpoint (``builder`` = ``"module:function"``
+returning a Simulation) and continues bit for bit as the uninterrupted run would
+have.
 """
 from __future__ import annotations
 
@@ -18,113 +22,169 @@ import sys
 import time
 from pathlib import Path
 
-
 from . import __version__
+from .activities import (Activity, Callback, Checkpointer, GridOutput, NaNChecker, Progress, SnapshotOutput,
+                         TimeSeriesOutput, VTUOutput)
 from .errors import ConfigError, RestartError
-from .io.checkpoint import latest_valid_checkpoint, read_checkpoint, write_checkpoint
-from .io.snapshots import SnapshotWriter
-from .schedule import TimeInterval, parse_duration
+from .io.checkpoint import FORMAT_VERSION, latest_valid_checkpoint, read_checkpoint, write_checkpoint
+from .schedule import parse_duration
 
 
 class Simulation:
+    """Runs a :class:`~lagice.model.Model` with a fixed outer step ``dt`` until ``stop``.
+
+    Args:
+        model: the model.
+        dt: outer step (duration string or seconds).
+        stop: simulated time to stop at (duration string or seconds since the start).
+        progress: print a progress line every ``progress_every_s`` of wall time.
+        builder: ``"module:function"`` that rebuilds this simulation from
+            ``model.config`` (stored in checkpoints for :meth:`resume`).
+        nan_check: stop with a clear error at the first NaN/Inf in the state.
+    """
+
     def __init__(self, model, dt, stop, progress: bool = True, builder: str | None = None,
-                 progress_every_s: float = 10.0):
+                 progress_every_s: float = 10.0, nan_check: bool = True):
         self.model = model
         self.dt = parse_duration(dt, "dt")
-        self.stop = parse_duration(stop, "stop")
-        if self.dt > self.stop:
-            raise ConfigError(f"dt = {self.dt:g} s is longer than the run ({self.stop:g} s)")
-        self.n_steps = int(round(self.stop / self.dt))
-        if not math.isclose(self.n_steps * self.dt, self.stop, rel_tol=1e-9):
-            raise ConfigError(f"stop = {self.stop:g} s is not a whole number of steps of dt = {self.dt:g} s")
-        self.progress = progress
-        self.progress_every_s = progress_every_s
+        self.stop_time = parse_duration(stop, "stop")
+        if self.dt > self.stop_time:
+            raise ConfigError(f"dt = {self.dt:g} s is longer than the run ({self.stop_time:g} s)")
+        self.n_steps = int(round(self.stop_time / self.dt))
+        if not math.isclose(self.n_steps * self.dt, self.stop_time, rel_tol=1e-9):
+            raise ConfigError(f"stop = {self.stop_time:g} s is not a whole number of steps of dt = {self.dt:g} s")
         self.builder = builder
-        self.writer = None
-        self.output_schedule = None
-        self.ckpt_dir = None
-        self.ckpt_schedule = None
-        self.ckpt_keep = 3
-        self.callbacks = []
-        self.wall = {"output": 0.0, "checkpoint": 0.0}
+        self.activities: dict[str, Activity] = {}
+        if nan_check:
+            self.add(NaNChecker())
+        if progress:
+            self.add(Progress(f"wall {progress_every_s}s"))
         self.wall_total = 0.0
-        self.volume0 = None
+        self._t_run = None
+        self.stop_reason = None
+        self._stop_requested = None
+        self.resumed_from = None
+        self.out_dir = None
 
-    # -- attachments ---------------------------------------------------------------
-    def output(self, every, path, crs_epsg: int | None = 3413, vtu: bool = False,
-               start_date: str = "2000-01-01 00:00:00", grid_resolution_m: float | None = None):
-        self.output_schedule = TimeInterval(every, "output every")
-        self.writer = SnapshotWriter(path, crs_epsg=crs_epsg, vtu=vtu, start_date=start_date,
-                                     grid_resolution_m=grid_resolution_m)
+    @property
+    def stop(self) -> float:
+        return self.stop_time
+
+    # -- activities ----------------------------------------------------------------
+    def add(self, activity: Activity, name: str | None = None) -> "Simulation":
+        """Add an activity (replacing one of the same name)."""
+        name = name or activity.name
+        if name in self.activities:
+            del self.activities[name]
+        self.activities[name] = activity
+        if "progress" in self.activities and name != "progress":  # progress reports after the others
+            self.activities["progress"] = self.activities.pop("progress")
         return self
+
+    def output(self, every, path, crs_epsg: int | None = 3413, vtu: bool = False,
+               start_date: str = "2000-01-01 00:00:00", grid_resolution_m: float | None = None,
+               title: str = "lagice snapshot"):
+        """Snapshots every ``every`` into ``path`` (plus VTU files and regular-grid
+        averages when asked, on the same schedule)."""
+        from .io.snapshots import SnapshotWriter
+
+        path = Path(path)
+        self.add(SnapshotOutput(every, SnapshotWriter(path, crs_epsg, start_date, title)))
+        if vtu:
+            from .io.vtu import VTUWriter
+
+            self.add(VTUOutput(every, VTUWriter(path)))
+        if grid_resolution_m:
+            from .io.gridded import GridWriter
+
+            self.add(GridOutput(every, GridWriter(path, grid_resolution_m, crs_epsg, start_date)))
+        return self
+
+    def add_timeseries(self, path, diagnostics, every, start_date: str = "2000-01-01 00:00:00"):
+        """Record scalar diagnostics (built-in names from :data:`lagice.io.timeseries.BUILTIN`
+        or ``{name: ScalarDiagnostic}``) every ``every`` into the netCDF file ``path``."""
+        from .io.timeseries import BUILTIN, ScalarDiagnostic, TimeSeriesWriter
+
+        diags = {}
+        for k in diagnostics:
+            d = diagnostics[k] if isinstance(diagnostics, dict) else None
+            if d is None:
+                if k not in BUILTIN:
+                    raise ConfigError(f"unknown time-series diagnostic {k!r}; built-in: {sorted(BUILTIN)}")
+                d = BUILTIN[k]
+            if not isinstance(d, ScalarDiagnostic):
+                raise ConfigError(f"time-series diagnostic {k!r} must be a ScalarDiagnostic")
+            diags[k] = d
+        return self.add(TimeSeriesOutput(every, TimeSeriesWriter(path, diags, start_date)))
 
     def checkpoint(self, every, path, keep: int = 3):
-        if int(keep) < 1:
-            raise ConfigError(f"checkpoint keep = {keep!r} must be >= 1")
-        self.ckpt_schedule = TimeInterval(every, "checkpoint every")
-        self.ckpt_dir = Path(path)
-        self.ckpt_keep = int(keep)
-        return self
+        """Checkpoints every ``every`` (simulated time, ``"N steps"`` or ``"wall 55min"``)."""
+        return self.add(Checkpointer(every, path, keep))
 
-    def add_callback(self, fn, every):
-        self.callbacks.append((TimeInterval(every, "callback every"), fn))
-        return self
+    def add_callback(self, fn, every, name: str | None = None):
+        """Call ``fn(sim)`` every ``every``."""
+        return self.add(Callback(fn, every, name or f"callback_{len(self.activities)}"))
+
+    @property
+    def checkpointer(self) -> Checkpointer | None:
+        return self.activities.get("checkpointer")
+
+    @property
+    def ckpt_dir(self):
+        c = self.checkpointer
+        return None if c is None else c.directory
+
+    def request_stop(self, reason: str) -> None:
+        """Stop after the current step (a checkpoint is written first, if any)."""
+        self._stop_requested = reason
 
     # -- running ---------------------------------------------------------------------
     def run(self, n_steps: int | None = None) -> dict:
         """Run to the stop time (or ``n_steps`` more steps); returns a summary."""
         model = self.model
-        st = model.state
-        if self.volume0 is None:
-            self.volume0 = st.counters.setdefault("volume0_m3", st.ice_volume_m3)
-        target = self.n_steps if n_steps is None else min(self.n_steps, st.step + int(n_steps))
-        if st.step == 0 and self.writer is not None:
-            self._write_output()
-        t_wall0 = time.perf_counter()
-        last = t_wall0
-        while st.step < target:
-            t_prev = st.time_s
+        target = self.n_steps if n_steps is None else min(self.n_steps, model.clock.iteration + int(n_steps))
+        self._stop_requested = None
+        self.stop_reason = None
+        self._t_run = time.perf_counter()
+        acts = list(self.activities.values())
+        for act in acts:
+            act.initialize(self)
+        while model.clock.iteration < target:
             model.step(self.dt)
-            st = model.state
-            t_now = st.time_s
-            if self.writer is not None and (self.output_schedule.due(t_prev, t_now) or st.step == self.n_steps):
-                self._write_output()
-            for sched, fn in self.callbacks:
-                if sched.due(t_prev, t_now):
-                    fn(self)
-            if self.ckpt_dir is not None and self.ckpt_schedule.due(t_prev, t_now):
-                self.write_checkpoint()
-            now = time.perf_counter()
-            if self.progress and (now - last > self.progress_every_s or st.step == target):
-                last = now
-                self._print_progress(now - t_wall0)
-        self.wall_total += time.perf_counter() - t_wall0
+            for act in acts:
+                if act.schedule(model):
+                    act.run(self)
+            if self._stop_requested:
+                break
+        if self._stop_requested:
+            self.stop_reason = self._stop_requested
+            if self.checkpointer is not None and self.checkpointer.last_iteration != model.clock.iteration:
+                self.checkpointer.run(self)
+        for act in acts:
+            if act.at_end and (model.clock.iteration == self.n_steps or self._stop_requested):
+                act.finalize(self)
+            elif isinstance(act, TimeSeriesOutput):
+                act.writer.flush()
+        self.wall_total = self.wall_s
+        self._t_run = None
         return self.summary()
 
-    def _write_output(self):
-        t0 = time.perf_counter()
-        eps = getattr(self.model.solver, "last_strain_rate", None)
-        if eps is not None and len(eps) != self.model.mesh.n_elements:
-            eps = None
-        self.writer.write(self.model.state, eps)
-        self.wall["output"] += time.perf_counter() - t0
+    @property
+    def wall_s(self) -> float:
+        """Wall time [s] spent in :meth:`run` over the whole run, resumed parts included."""
+        return self.wall_total + (time.perf_counter() - self._t_run if self._t_run is not None else 0.0)
 
-    def _print_progress(self, wall_s):
-        st = self.model.state
-        days = st.time_s / 86400.0
-        rate = (st.step * self.dt / 86400.0) / max(wall_s, 1e-9) * 3600.0 if wall_s > 0 else float("nan")
-        b = self.model.volume_budget()
-        print(f"  day {days:7.3f}  step {st.step}/{self.n_steps}  {rate:8.1f} sim-days/wall-hour  "
-              f"remeshes {st.counters.get('remesh_count', 0)}  volume {b['current_m3']:.4e} m3 "
-              f"(thermo {b['thermodynamic_m3']:+.2e}, outflow {b['outflow_m3']:.2e}, "
-              f"drift {b['relative_residual']:+.1e})", flush=True)
+    @property
+    def finished(self) -> bool:
+        return self.model.clock.iteration >= self.n_steps
 
     def summary(self) -> dict:
-        st = self.model.state
-        return {"time_s": st.time_s, "steps": st.step, "wall_s": self.wall_total,
-                "timings": {**self.model.timings, **self.wall},
-                "remesh_count": st.counters.get("remesh_count", 0),
-                "ice_volume_m3": st.ice_volume_m3, "volume_budget": self.model.volume_budget()}
+        m = self.model
+        st = m.state
+        return {"time_s": m.clock.time_s, "steps": m.clock.iteration, "wall_s": self.wall_s,
+                "timings": dict(m.timings), "remesh_count": st.counters.get("remesh_count", 0),
+                "ice_volume_m3": st.ice_volume_m3, "volume_budget": m.volume_budget(),
+                "stop_reason": self.stop_reason}
 
     # -- checkpoint / resume ---------------------------------------------------------
     def _meta(self) -> dict:
@@ -132,23 +192,26 @@ class Simulation:
         meta.update({
             "lagice_version": __version__, "scene_fingerprint": self.model.fingerprint(),
             "config": self.model.config, "builder": self.builder,
-            "simulation": {"dt_s": self.dt, "stop_s": self.stop},
+            "simulation": {"dt_s": self.dt, "stop_s": self.stop_time, "wall_s": self.wall_s},
         })
         return meta
 
     def write_checkpoint(self) -> Path:
-        t0 = time.perf_counter()
-        p = write_checkpoint(self.ckpt_dir, self.model.state.step, self.model.state_arrays(), self._meta(),
-                             keep=self.ckpt_keep)
-        self.wall["checkpoint"] += time.perf_counter() - t0
-        return p
+        c = self.checkpointer
+        if c is None:
+            raise ConfigError("this simulation has no checkpointer (sim.checkpoint(every, path))")
+        return write_checkpoint(c.directory, self.model.clock.iteration, self.model.state_arrays(), self._meta(),
+                                keep=c.keep)
 
     @classmethod
     def resume(cls, checkpoint, model=None, builder=None, **builder_kw) -> "Simulation":
         """Resume from a checkpoint file or a checkpoint directory (newest usable one).
 
         The model is rebuilt with the checkpoint's ``builder`` and ``config``
-        (or pass ``model=`` / ``builder=``); the scene fingerprint must match.
+        (or pass ``model=`` / ``builder=``); its fingerprint (the physics) must match.
+        Outputs go to the run folder of the checkpoint (the parent of its
+        ``checkpoints`` folder) unless ``out_dir=`` is given.
+        Checkpoints are read by their format version (:data:`lagice.io.checkpoint.FORMAT_VERSION`).
         """
         path = Path(checkpoint)
         if path.is_dir():
@@ -157,14 +220,13 @@ class Simulation:
                 print(f"lagice: skipped damaged checkpoint: {s}", file=sys.stderr)
         else:
             arrays, meta = read_checkpoint(path)
-        ver = meta.get("lagice_version")
-        if ver != __version__:
-            raise RestartError(f"checkpoint {path} was written by lagice {ver}; this is lagice "
-                               f"{__version__} (incompatible)")
         if model is None:
             spec = builder or meta.get("builder")
             if not spec:
                 raise RestartError(f"checkpoint {path} names no builder; pass model= to resume it")
+            if "out_dir" not in builder_kw:  # the run folder the checkpoint lives in
+                ck_dir = path.parent
+                builder_kw["out_dir"] = ck_dir.parent if ck_dir.name == "checkpoints" else ck_dir
             sim = _call_builder(spec, meta["config"], **builder_kw)
         else:
             sim = cls(model, dt=meta["simulation"]["dt_s"], stop=meta["simulation"]["stop_s"])
@@ -172,7 +234,7 @@ class Simulation:
             raise RestartError(f"checkpoint {path} belongs to another scene or configuration "
                                f"(fingerprint {meta.get('scene_fingerprint')}, model {sim.model.fingerprint()})")
         sim.model.load_state(arrays, meta)
-        sim.volume0 = sim.model.state.counters.get("volume0_m3")
+        sim.wall_total = float(meta.get("simulation", {}).get("wall_s", 0.0))
         sim.resumed_from = path
         return sim
 
@@ -184,3 +246,6 @@ def _call_builder(spec: str, config: dict, **kw):
     except (ImportError, AttributeError) as exc:
         raise RestartError(f"cannot import checkpoint builder {spec!r}: {exc}") from exc
     return fn(config, **kw)
+
+
+__all__ = ["Simulation", "FORMAT_VERSION"]

@@ -1,11 +1,14 @@
-"""Model state as structure of arrays (DESIGN.md §2)."""
+"""Model state as structure of arrays (docs/design.md, "State").
+
+The fields and their units, ranges and remap rules are declared once in
+:mod:`lagice.fields`; simulated time lives in the model's clock
+(:class:`lagice.clock.Clock`), not in the state."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import ConfigError
 from .mesh import Mesh
 
 
@@ -34,13 +37,11 @@ class IceState:
     cohesion: np.ndarray
     snow: np.ndarray | None = None
     node_id: np.ndarray | None = None
-    time_s: float = 0.0
-    step: int = 0
     counters: dict = field(default_factory=dict)
 
     @classmethod
     def uniform(cls, mesh: Mesh, *, thickness_m=1.0, concentration=1.0, cohesion_pa=None,
-                damage=0.0, time_s=0.0) -> "IceState":
+                damage=0.0) -> "IceState":
         n, m = mesh.n_nodes, mesh.n_elements
 
         def field_of(name, v):
@@ -52,28 +53,16 @@ class IceState:
                  concentration=field_of("concentration", concentration),
                  damage=field_of("damage", damage), stress=np.zeros((m, 3)),
                  cohesion=field_of("cohesion_pa", 0.0 if cohesion_pa is None else cohesion_pa),
-                 node_id=np.arange(n, dtype=np.int64), time_s=float(time_s))
+                 node_id=np.arange(n, dtype=np.int64))
         st.validate()
         return st
 
     def validate(self) -> None:
-        """Raise ConfigError on out-of-range initial fields (name, value, range)."""
-        m = self.mesh.n_elements
-        for name in ("thickness", "concentration", "damage", "cohesion"):
-            a = getattr(self, name)
-            if a.shape != (m,):
-                raise ConfigError(f"{name} has shape {a.shape}; expected ({m},) (one value per element)")
-            if not np.all(np.isfinite(a)):
-                raise ConfigError(f"{name} contains NaN or inf")
-        checks = (("thickness", 0.0, None), ("concentration", 0.0, 1.0), ("damage", 0.0, 1.0),
-                  ("cohesion", 0.0, None))
-        for name, lo, hi in checks:
-            a = getattr(self, name)
-            if lo is not None and a.min() < lo or hi is not None and a.max() > hi:
-                raise ConfigError(f"{name} ranges over [{a.min():.6g}, {a.max():.6g}]; expected values "
-                                  f"in [{lo}, {'inf' if hi is None else hi}]")
-        if self.damage.max() >= 1.0:
-            raise ConfigError("damage must be < 1 (1 = fully damaged has zero stiffness)")
+        """Raise ConfigError on missing, misshapen, non-finite or out-of-range fields
+        (the field registry, :mod:`lagice.fields`, gives names, units and ranges)."""
+        from .fields import validate_state
+
+        validate_state(self)
 
     @property
     def ice_volume_m3(self) -> float:

@@ -1,8 +1,10 @@
 """The CLI as a user runs it: a real subprocess writing real files."""
+import json
 import subprocess
 import sys
 
 import numpy as np
+import pytest
 import xarray as xr
 
 
@@ -13,29 +15,46 @@ def run_cli(*args, cwd=None):
 
 def test_cli_run_compression(tmp_path):
     out = tmp_path / "run"
-    r = run_cli("run", "uniaxial_compression", "--out", str(out), "--set", "n_across=8",
-                "--set", "max_strain=5e-5", "--set", "seed=3")
+    r = run_cli("run", "uniaxial_compression", "--out", str(out), "--set", "domain.resolution_m=12500",
+                "--set", "run.duration=10000s", "--set", "run.seed=3")
     assert r.returncode == 0, r.stderr
-    assert "plot:" in r.stdout and "compression.png" in r.stdout
-    png = out / "compression.png"
+    assert "plot:" in r.stdout and "uniaxial_compression.png" in r.stdout
+    png = out / "uniaxial_compression.png"
     assert png.stat().st_size > 10_000 and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    ds = xr.load_dataset(out / "compression.nc")
-    assert ds.attrs["n_across"] == 8 and ds.attrs["seed"] == 3
+    ds = xr.load_dataset(out / "timeseries.nc", decode_times=False)
+    cfg = json.loads(ds.attrs["lagice_config"])
+    assert cfg["domain"]["resolution_m"] == 12500 and cfg["run"]["seed"] == 3
     strain = ds["macro_strain"].values
-    assert strain[-1] >= 5e-5 - 1e-12
-    # elastic phase: macroscopic stress ~ -E0 * strain
-    assert np.allclose(-ds["macro_stress"].values[-10:], ds.attrs["young_modulus_pa"] * strain[-10:], rtol=0.05)
-    info = run_cli("info", str(out / "compression.nc"))
+    assert strain[-1] == pytest.approx(5e-5, rel=1e-12)
+    # elastic phase: macroscopic stress ~ -E0 * strain (E0 = 2 cs^2 (1 + nu) rho = 585 MPa)
+    assert np.allclose(-ds["macro_stress"].values[-10:], 585e6 * strain[-10:], rtol=0.05)
+    info = run_cli("info", str(out / "timeseries.nc"))
     assert info.returncode == 0 and "macro_stress" in info.stdout
+    replot = run_cli("plot", str(out), "--png", str(tmp_path / "again.png"))
+    assert replot.returncode == 0, replot.stderr
+    assert (tmp_path / "again.png").stat().st_size > 10_000
 
 
 def test_cli_bad_override_names_key(tmp_path):
-    r = run_cli("run", "uniaxial_compression", "--out", str(tmp_path), "--set", "cohesion=3")
+    r = run_cli("run", "uniaxial_compression", "--out", str(tmp_path), "--set", "rheology.cohesion=3")
     assert r.returncode == 2
-    assert "--set cohesion: unknown key" in r.stderr
+    assert "unknown key rheology.cohesion" in r.stderr
+    r = run_cli("run", "uniaxial_compression", "--out", str(tmp_path), "--set", "cohesion=3")
+    assert r.returncode == 2 and "expected table.key=value" in r.stderr
     r = run_cli("run", "no_such_scene")
     assert r.returncode == 2 and "unknown scene 'no_such_scene'" in r.stderr
     assert not any(tmp_path.iterdir())
+
+
+def test_cli_scenes_lists_every_bundled_scene_with_a_description():
+    from lagice.scenes.config import list_scenes
+
+    r = run_cli("scenes")
+    assert r.returncode == 0
+    scenes = list_scenes()
+    assert {"uniaxial_compression", "wind_square", "shear_channel", "winter_basin"} <= set(scenes)
+    for name, (_path, desc) in scenes.items():
+        assert name in r.stdout and desc and desc in r.stdout
 
 
 def test_cli_diagnose_real_output(tmp_path):

@@ -1,24 +1,41 @@
-"""Seed 004 uniaxial compression test at N = 10 (issue 2)."""
+"""The uniaxial compression scene of Dansereau et al. (2016) at N = 10, through
+the scene builder and Simulation."""
 import numpy as np
 import pytest
 import xarray as xr
 
+from helpers import compression_overrides, scene_sim
 from lagice.errors import ConfigError
-from lagice.scenes import compression
+from lagice.scenes.builder import finish
 
 N = 10
+STRAIN_S = 1e5 / 5e-4  # seconds per unit macroscopic strain at U = 1 mm/s, L = 200 km
+
+
+def compression_run(out, max_strain, **kw):
+    """Run the scene to ``max_strain``; returns the time series (from timeseries.nc),
+    the simulation and finish()'s result."""
+    ov = compression_overrides(N, **{"run.duration": max_strain * STRAIN_S, **kw})
+    sim = scene_sim("uniaxial_compression", out, ov)
+    res = finish(sim)
+    ds = xr.load_dataset(out / "timeseries.nc", decode_times=False)
+    t = ds["time"].values[1:]
+    md = ds["mean_damage"].values
+    ts = {"time": t, "strain": ds["macro_strain"].values[1:], "stress": ds["macro_stress"].values[1:],
+          "mean_damage": md[1:], "damage_rate": np.diff(md) / np.diff(ds["time"].values),
+          "n_damaged": ds["n_damaged"].values[1:]}
+    return {"timeseries": ts, "sim": sim, "res": res, "out": out}
 
 
 @pytest.fixture(scope="module")
 def heal_run(tmp_path_factory):
-    return compression.run(tmp_path_factory.mktemp("heal"), n_across=N, seed=0, max_strain=4.5e-4,
-                           progress=False, plot=False)
+    return compression_run(tmp_path_factory.mktemp("heal"), 4.5e-4,
+                           **{"output.plot": "lagice.scenes.hooks.compression:plot"})
 
 
 @pytest.fixture(scope="module")
 def noheal_run(tmp_path_factory):
-    return compression.run(tmp_path_factory.mktemp("noheal"), n_across=N, seed=0, max_strain=4.5e-4,
-                           healing=False, progress=False, plot=False)
+    return compression_run(tmp_path_factory.mktemp("noheal"), 4.5e-4, **{"healing.law": "none"})
 
 
 def first_drop(stress_c, frac):
@@ -42,7 +59,7 @@ def test_initial_slope_is_plate_modulus(heal_run):
     macroscopic modulus is E0 (Maxwell relaxation over t << λ0 is < 0.1 %)."""
     ts = heal_run["timeseries"]
     s = -ts["stress"]
-    E0 = heal_run["scene"].solver.rheology.E0
+    E0 = heal_run["sim"].model.rheology.E0
     sel = (s > 0.1 * s.max()) & (s < 0.5 * s.max()) & (np.cumsum(ts["n_damaged"]) == 0)
     assert sel.sum() > 100
     slope = np.polyfit(ts["strain"][sel], s[sel], 1)[0]
@@ -56,8 +73,8 @@ def test_damage_peak_drop_and_localisation(noheal_run):
     first_damage = int(np.argmax(ts["n_damaged"] > 0))
     assert 0 < first_damage < ipk, "damage starts before the macroscopic peak"
     assert ts["damage_rate"][ipk:imin + 1].max() > 10 * ts["damage_rate"][:first_damage + 50].max()
-    st = noheal_run["scene"].state
-    area = noheal_run["scene"].solver.area
+    st = noheal_run["sim"].model.state
+    area = noheal_run["sim"].model.stepper.area
     dmg = np.sort(st.damage * area)[::-1]
     frac = (np.searchsorted(np.cumsum(dmg), 0.5 * dmg.sum()) + 1) / len(dmg)
     assert frac <= 0.20, f"half of the damage in {frac:.1%} of the elements"
@@ -77,11 +94,11 @@ def test_healing_rebuilds_stress_after_drop(heal_run, noheal_run):
 
 
 def test_seed_reproducible_and_seed_dependent(tmp_path):
-    kw = dict(n_across=N, max_strain=3.0e-4, healing=False, progress=False, plot=False)
-    a = compression.run(tmp_path / "a", seed=7, **kw)
-    b = compression.run(tmp_path / "b", seed=7, **kw)
-    c = compression.run(tmp_path / "c", seed=8, **kw)
-    sa, sb, sc = (r["scene"].state for r in (a, b, c))
+    kw = {"healing.law": "none"}
+    a = compression_run(tmp_path / "a", 3.0e-4, **{**kw, "run.seed": 7})
+    b = compression_run(tmp_path / "b", 3.0e-4, **{**kw, "run.seed": 7})
+    c = compression_run(tmp_path / "c", 3.0e-4, **{**kw, "run.seed": 8})
+    sa, sb, sc = (r["sim"].model.state for r in (a, b, c))
     assert sa.damage.max() > 0.5
     assert np.array_equal(sa.damage, sb.damage) and np.array_equal(sa.stress, sb.stress)
     assert np.array_equal(a["timeseries"]["stress"], b["timeseries"]["stress"])
@@ -89,29 +106,34 @@ def test_seed_reproducible_and_seed_dependent(tmp_path):
     assert np.corrcoef(sa.damage, sc.damage)[0, 1] < 0.9
 
 
-def test_netcdf_output_readable(heal_run):
-    ds = xr.load_dataset(heal_run["netcdf"])
+def test_outputs_readable(heal_run):
+    out = heal_run["out"]
+    ds = xr.load_dataset(out / "timeseries.nc")
     assert ds["macro_stress"].attrs["units"] == "Pa"
-    assert ds.sizes["time"] == len(heal_run["timeseries"]["time"])
-    assert ds["damage"].dims == ("snapshot", "mesh_face")
-    assert ds["damage"].shape[1] == heal_run["scene"].mesh.n_elements
-    assert np.array_equal(ds["macro_stress"].values, heal_run["timeseries"]["stress"])
-    assert ds["mesh"].attrs["cf_role"] == "mesh_topology"
-    assert np.all(ds["strain_rate_total"].values >= 0)
+    assert ds.sizes["time"] == len(heal_run["timeseries"]["time"]) + 1
+    assert np.array_equal(ds["macro_stress"].values[1:], heal_run["timeseries"]["stress"])
+    snap = sorted((out / "snapshots").glob("snapshot_*.nc"))
+    assert len(snap) == 9  # the start and 8 snapshots (output.every = 12500 s)
+    last = xr.load_dataset(snap[-1])
+    assert last["damage"].dims == ("time", "mesh_face")
+    assert last["damage"].shape[1] == heal_run["sim"].model.mesh.n_elements
+    assert last["mesh"].attrs["cf_role"] == "mesh_topology"
+    assert np.all(last["total_deformation_rate"].values >= 0)
+    assert heal_run["res"]["png"].exists()
 
 
-@pytest.mark.parametrize("kw,match", [
-    ({"n_across": 0}, "n_across"), ({"n_across": 2.5}, "n_across"),
-    ({"dt_s": -1.0}, "dt_s"), ({"solver": "magic"}, "solver = 'magic'"),
-    ({"rheology": {"poisson": 0.5}}, "poisson"), ({"rheology": {"alpha": 1.0}}, "alpha"),
-    ({"rheology": {"cohesion_min_pa": -5.0}}, "cohesion_min_pa"),
+@pytest.mark.parametrize("ov,match", [
+    ({"domain.resolution_m": 0.0}, "resolution_m"), ({"domain.resolution_m": "x"}, "resolution_m"),
+    ({"solver.dt": -1.0}, "solver.dt"), ({"solver.name": "magic"}, "solver.name = 'magic'"),
+    ({"rheology.poisson": 0.5}, "poisson"), ({"rheology.alpha": 1.0}, "alpha"),
+    ({"rheology.cohesion_min_pa": -5.0}, "cohesion_min_pa"),
 ])
-def test_bad_input_fails_before_meshing(kw, match, monkeypatch):
-    import lagice.scenes.compression as mod
+def test_bad_input_fails_before_meshing(ov, match, monkeypatch, tmp_path):
+    import lagice.scenes.builder as mod
 
     def no_mesh(*a, **k):
         raise AssertionError("meshing started before validation")
 
     monkeypatch.setattr(mod, "generate_mesh", no_mesh)
     with pytest.raises(ConfigError, match=match):
-        compression.build(**kw)
+        scene_sim("uniaxial_compression", tmp_path, ov)

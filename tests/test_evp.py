@@ -5,14 +5,15 @@ iteration, TOML selection."""
 import numpy as np
 import pytest
 
+from helpers import step
 from lagice.errors import ConfigError
 from lagice.forces import Coriolis, OceanDrag, WindStress, free_drift_velocity
 from lagice.mesh import generate_mesh, rectangle_domain
 from lagice.model import Model
 from lagice.params import RHO_AIR, coriolis_from_latitude
-from lagice.rheology import MaxwellEB, principal_stresses
+from lagice.rheology import ViscousPlastic, principal_stresses
 from lagice.scenes.config import load_scene
-from lagice.scenes.toml_scene import build_model
+from lagice.scenes.builder import build_model
 from lagice.solvers import SOLVERS, VelocityBC
 from lagice.solvers.evp import DELTA_MIN, EVPSolver, ice_strength, vp_stress_of
 from lagice.state import IceState
@@ -26,11 +27,11 @@ def run_uniform(mesh, G, steps=6, dt=600.0, **opts):
     the state, the solver and the (exact) strain rate."""
     bcs = [VelocityBC(t, u=lambda t_, x, y: G[0, 0] * x + G[0, 1] * y,
                       v=lambda t_, x, y: G[1, 0] * x + G[1, 1] * y) for t in SIDES]
-    s = EVPSolver(MaxwellEB(), mesh, bcs=bcs, **opts)
+    s = EVPSolver(ViscousPlastic(), mesh, bcs=bcs, **opts)
     st = IceState.uniform(mesh, thickness_m=1.5, concentration=0.95)
     st.velocity = mesh.nodes @ G.T
     for _ in range(steps):
-        s.step(st, dt)
+        step(s, st, dt)
     eps = np.array([G[0, 0], G[1, 1], 0.5 * (G[0, 1] + G[1, 0])])
     return st, s, eps
 
@@ -102,8 +103,8 @@ def test_selectable_by_name_free_drift(free_mesh, repl):
     wind, lat = (10.0, 5.0), 80.0
     st = IceState.uniform(free_mesh, thickness_m=1.0)
     forces = [WindStress(wind), OceanDrag(), Coriolis(latitude_deg=lat)]
-    model = Model(st, MaxwellEB(), solver="evp", forces=forces,
-                  solver_options={"substeps": 200, "replacement_pressure": repl})
+    model = Model(st, ViscousPlastic(replacement_pressure=repl), solver="evp", forces=forces,
+                  solver_options={"substeps": 200})
     assert isinstance(model.solver, EVPSolver)
     for _ in range(72):
         model.step(1200.0)
@@ -126,11 +127,11 @@ def test_coast_box_wind_adaptive_stable():
     poly, segs = rectangle_domain(200e3, 200e3)
     mesh = generate_mesh(poly, 20e3, segments={"top": segs["top"]}, exterior_tag="coast")
     wind = WindStress(lambda t, x, y: (15 * np.sin(np.pi * y / 2e5), 0 * x))
-    s = EVPSolver(MaxwellEB(), mesh, forces=[wind, OceanDrag()], substeps=300,
+    s = EVPSolver(ViscousPlastic(), mesh, forces=[wind, OceanDrag()], substeps=300,
                   bcs=[VelocityBC("top", v=0.0)])
     st = IceState.uniform(mesh, thickness_m=0.5, concentration=0.9)
     for _ in range(12):
-        info = s.step(st, 1800.0)
+        info = step(s, st, 1800.0)
     assert info.iterations == 300 and info.residual < 1e-6
     assert np.all(np.isfinite(st.velocity))
     coast = mesh.coast_nodes()
@@ -145,7 +146,8 @@ def test_coast_box_wind_adaptive_stable():
 
 
 def test_toml_scene_selects_evp():
-    cfg = load_scene("shear_box", {"solver.name": "evp", "solver.substeps": 50, "solver.dt": 600.0,
+    vp = {"solver.name": "evp", "rheology.law": "viscous_plastic", "healing.law": "none"}
+    cfg = load_scene("shear_box", {**vp, "solver.substeps": 50, "solver.dt": 600.0,
                                    "domain.resolution_m": 40e3, "run.progress": False})
     model = build_model(cfg)
     assert isinstance(model.solver, EVPSolver) and model.solver.substeps == 50
@@ -153,10 +155,14 @@ def test_toml_scene_selects_evp():
         model.step(600.0)
     assert np.all(np.isfinite(model.state.velocity)) and np.all(np.isfinite(model.state.stress))
     with pytest.raises(ConfigError, match="linear_solver"):
-        build_model(load_scene("shear_box", {"solver.name": "evp", "solver.linear_solver": "cg"}))
-    m = build_model(load_scene("shear_box", {"solver.name": "evp", "solver.tol": 1e-6,
-                                             "domain.resolution_m": 40e3}))
+        build_model(load_scene("shear_box", {**vp, "solver.linear_solver": "cg"}))
+    m = build_model(load_scene("shear_box", {**vp, "solver.tol": 1e-6, "domain.resolution_m": 40e3}))
     assert m.solver.tol == 1e-6
+    # what is solved must match how: a Maxwell-EB scene cannot use the mEVP stepper, nor keep healing
+    with pytest.raises(ConfigError, match="rheology.law"):
+        build_model(load_scene("shear_box", {"solver.name": "evp"}))
+    with pytest.raises(ConfigError, match="healing.law"):
+        build_model(load_scene("shear_box", {"solver.name": "evp", "rheology.law": "viscous_plastic"}))
 
 
 def test_tolerance_stops_iterations_early():
@@ -170,10 +176,10 @@ def test_tolerance_stops_iterations_early():
     wind = WindStress(lambda t, x, y: (15 * np.sin(np.pi * y / 2e5), 0 * x))
     runs = {}
     for tol in (None, 1e-6, 1e-300):
-        s = EVPSolver(MaxwellEB(), mesh, forces=[wind, OceanDrag()], substeps=300, tol=tol,
+        s = EVPSolver(ViscousPlastic(), mesh, forces=[wind, OceanDrag()], substeps=300, tol=tol,
                       bcs=[VelocityBC("top", v=0.0)])
         st = IceState.uniform(mesh, thickness_m=0.5, concentration=0.9)
-        its = [s.step(st, 1800.0) for _ in range(8)]
+        its = [step(s, st, 1800.0) for _ in range(8)]
         runs[tol] = (st.velocity.copy(), [i.iterations for i in its], [i.residual for i in its])
     assert runs[None][1] == [300] * 8 and runs[1e-300][1] == [300] * 8
     np.testing.assert_array_equal(runs[None][0], runs[1e-300][0])
@@ -194,10 +200,10 @@ def test_coriolis_crank_nicolson_keeps_inertial_oscillations(free_mesh):
     # strengthless ice (P* → 0, so mEVP is stable with small α, β) and uniform,
     # non-adaptive α, β: every node follows the same iteration, which with β = 1
     # contracts by 1/2 per iteration, so 100 iterations converge to round-off
-    s = EVPSolver(MaxwellEB(), free_mesh, forces=[Coriolis(latitude_deg=lat)], substeps=100,
-                  replacement_pressure=True, adaptive=False, alpha=2.0, beta=1.0, p_star=1e-20)
+    s = EVPSolver(ViscousPlastic(replacement_pressure=True, p_star=1e-20), free_mesh,
+                  forces=[Coriolis(latitude_deg=lat)], substeps=100, adaptive=False, alpha=2.0, beta=1.0)
     for _ in range(48):
-        s.step(st, dt)
+        step(s, st, dt)
     u = st.velocity[:, 0] + 1j * st.velocity[:, 1]
     expect = 0.2 * np.exp(-1j * 48 * 2 * np.arctan(f * dt / 2))  # clockwise in the northern hemisphere
     assert np.abs(np.abs(u) - 0.2).max() < 1e-9
@@ -206,14 +212,14 @@ def test_coriolis_crank_nicolson_keeps_inertial_oscillations(free_mesh):
 
 def test_bad_options(plate_mesh):
     with pytest.raises(ConfigError):
-        EVPSolver(MaxwellEB(), plate_mesh, substeps=0)
+        EVPSolver(ViscousPlastic(), plate_mesh, substeps=0)
     with pytest.raises(ConfigError):
-        EVPSolver(MaxwellEB(), plate_mesh, alpha=0.5)
+        EVPSolver(ViscousPlastic(), plate_mesh, alpha=0.5)
     with pytest.raises(ConfigError, match="tol"):
-        EVPSolver(MaxwellEB(), plate_mesh, tol=-1.0)
-    s = EVPSolver(MaxwellEB(), plate_mesh)
+        EVPSolver(ViscousPlastic(), plate_mesh, tol=-1.0)
+    s = EVPSolver(ViscousPlastic(), plate_mesh)
     with pytest.raises(ConfigError):
-        s.step(IceState.uniform(plate_mesh), 0.0)
+        step(s, IceState.uniform(plate_mesh), 0.0)
 
 
 def test_adaptive_converges_where_fixed_alpha_beta_stall():
@@ -225,10 +231,10 @@ def test_adaptive_converges_where_fixed_alpha_beta_stall():
     wind = WindStress(lambda t, x, y: (15 * np.sin(np.pi * y / 2e5), 0 * x))
     res = {}
     for adaptive in (True, False):
-        s = EVPSolver(MaxwellEB(), mesh, forces=[wind, OceanDrag()], substeps=300, adaptive=adaptive)
+        s = EVPSolver(ViscousPlastic(), mesh, forces=[wind, OceanDrag()], substeps=300, adaptive=adaptive)
         st = IceState.uniform(mesh, thickness_m=2.0)
         for _ in range(24):
-            info = s.step(st, 1800.0)
+            info = step(s, st, 1800.0)
         res[adaptive] = (info.residual, np.hypot(st.velocity[:, 0], st.velocity[:, 1]).max())
     assert res[True][0] < 1e-6 and res[True][1] < 2e-4  # converged; strong ice nearly at rest
     assert res[False][0] > 10 * res[True][0]
@@ -242,11 +248,11 @@ def test_parallel_kernels_match_serial():
     wind = WindStress(lambda t, x, y: (15 * np.sin(np.pi * y / 2e5), 0 * x))
     out = []
     for par in (False, True):
-        s = EVPSolver(MaxwellEB(), mesh, forces=[wind, OceanDrag(), Coriolis(latitude_deg=80.0)],
+        s = EVPSolver(ViscousPlastic(), mesh, forces=[wind, OceanDrag(), Coriolis(latitude_deg=80.0)],
                       substeps=50, parallel=par)
         st = IceState.uniform(mesh, thickness_m=0.5, concentration=0.9)
         for _ in range(2):
-            info = s.step(st, 1800.0)
+            info = step(s, st, 1800.0)
         out.append((st.velocity, st.stress, info.residual))
     assert np.array_equal(out[0][0], out[1][0]) and np.array_equal(out[0][1], out[1][1])
     assert out[0][2] == out[1][2]

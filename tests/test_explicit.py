@@ -6,10 +6,10 @@ import warnings
 import numpy as np
 import pytest
 
+from helpers import compression_overrides, scene_sim, series, step
 from lagice.errors import ConfigError
 from lagice.mesh import generate_mesh, rectangle_domain
 from lagice.rheology import MaxwellEB
-from lagice.scenes import compression
 from lagice.solvers import SOLVERS, ExplicitSolver, VelocityBC
 from lagice.solvers.explicit import (element_stress_damage_kernel,
                                      element_stress_damage_kernel_serial)
@@ -77,7 +77,7 @@ def test_patch_uniform_strain_rate(plate_mesh):
     gamma = lam / (lam + dts)
     sigma = np.zeros(3)
     for _ in range(3):
-        s.step(st, 4 * dts)
+        step(s, st, 4 * dts)
         for _ in range(4):
             sigma = gamma * (sigma + dts * rheo.E0 * rheo.K @ eps)
     ref = mesh.nodes @ G.T
@@ -94,7 +94,7 @@ def test_maxwell_relaxation_and_coast_no_slip():
     s0 = np.array([-3e4, 1e4, 5e3])
     st.stress[:] = s0
     for n in range(1, 4):
-        s.step(st, 30.0)
+        step(s, st, 30.0)
         assert np.allclose(st.stress, s0 * (900.0 / 905.0) ** (6 * n), rtol=1e-12, atol=0)
     assert np.abs(st.velocity).max() < 1e-15  # every node is coast here
     assert s.name == "explicit" and SOLVERS["explicit"] is ExplicitSolver
@@ -109,7 +109,7 @@ def test_partial_dirichlet_component():
     s = ExplicitSolver(rheo, mesh, bcs=[VelocityBC("top", v=lambda t, x, y: -1e-6 * t + 0 * x)],
                        substeps=5)
     st = IceState.uniform(mesh, cohesion_pa=1e12)
-    s.step(st, 20.0)
+    step(s, st, 20.0)
     top = mesh.nodes_with_tag("top")
     assert np.allclose(st.velocity[top, 1], -2e-5, rtol=1e-14)
     assert np.abs(st.velocity[top, 0]).max() > 0  # u free (Poisson effect)
@@ -120,7 +120,7 @@ def first_peak(stress_c):
 
 
 @pytest.fixture(scope="module")
-def compression_pair():
+def compression_pair(tmp_path_factory):
     # small mesh: one numba thread (fork/join of parallel kernels costs more than the
     # work here, and much more on a loaded machine)
     import numba
@@ -128,20 +128,18 @@ def compression_pair():
     nthreads = numba.get_num_threads()
     numba.set_num_threads(1)
     try:
-        return _run_compression_pair()
+        return _run_compression_pair(tmp_path_factory.mktemp("pair"))
     finally:
         numba.set_num_threads(nthreads)
 
 
-def _run_compression_pair():
+def _run_compression_pair(tmp):
     out = {}
     for solver in ("implicit", "explicit"):
-        sc = compression.build(n_across=10, solver=solver, healing=False, seed=0)
-        s = []
-        for _ in range(2600):
-            sc.solver.step(sc.state, sc.dt_s)
-            s.append(-compression.macro_stress(sc))
-        out[solver] = (np.array(s), sc)
+        sim = scene_sim("uniaxial_compression", tmp / solver, compression_overrides(
+            10, **{"solver.name": solver, "healing.law": "none", "run.duration": 2600 * 20.0}))
+        sim.run()
+        out[solver] = (-series(sim, "macro_stress"), sim.model)
     return out
 
 
@@ -152,7 +150,7 @@ def test_compression_stress_strain_agrees_with_implicit(compression_pair):
     curves reach 95 % of the lower peak."""
     a, sa = compression_pair["implicit"]
     b, sb = compression_pair["explicit"]
-    assert sb.solver.last_substeps >= 2
+    assert sb.stepper.last_substeps >= 2
     ia, ib = first_peak(a), first_peak(b)
     assert 0 < ia < len(a) - 50 and 0 < ib < len(b) - 50, "no macroscopic failure"
     assert b[ib] == pytest.approx(a[ia], rel=0.05)
@@ -167,22 +165,25 @@ def test_compression_stress_strain_agrees_with_implicit(compression_pair):
     assert sa.state.damage.max() > 0.5 and sb.state.damage.max() > 0.5
 
 
-def test_stability_refusal_and_warning():
-    sc = compression.build(n_across=10, solver="explicit", substeps=1)
+def test_stability_refusal_and_warning(tmp_path):
+    explicit = compression_overrides(10, **{"solver.name": "explicit", "run.duration": 200.0})
+    sim = scene_sim("uniaxial_compression", tmp_path / "a", {**explicit, "solver.substeps": 1})
     with pytest.raises(ConfigError, match=r"explicit sub-step dt_s = 20 s exceeds the measured "
                                           r"stability limit .* by a factor"):
-        sc.solver.step(sc.state, sc.dt_s)
-    sc = compression.build(n_across=10, solver="explicit", substeps=1, allow_unstable=True)
+        sim.run(n_steps=1)
+    sim = scene_sim("uniaxial_compression", tmp_path / "b",
+                    {**explicit, "solver.substeps": 1, "solver.allow_unstable": True})
     with pytest.warns(StabilityWarning, match="elastic-wave limit"):
-        sc.solver.step(sc.state, sc.dt_s)
+        sim.run(n_steps=1)
     # automatic sub-steps respect the limit with the safety factor
-    sc = compression.build(n_across=10, solver="explicit")
+    sim = scene_sim("uniaxial_compression", tmp_path / "c", explicit)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        sc.solver.step(sc.state, sc.dt_s)
-    lim = explicit_substep_limit(sc.solver.dx_min, sc.solver.rheology.E0)
-    assert sc.dt_s / sc.solver.last_substeps <= 0.7 * lim
-    assert sc.dt_s / (sc.solver.last_substeps - 1) > 0.7 * lim
+        sim.run(n_steps=1)
+    st = sim.model.stepper
+    lim = explicit_substep_limit(st.dx_min, st.rheology.E0)
+    assert sim.dt / st.last_substeps <= 0.7 * lim
+    assert sim.dt / (st.last_substeps - 1) > 0.7 * lim
     assert load_limits()["explicit"]["C"] > 0
 
 
@@ -194,7 +195,7 @@ def test_bad_options(plate_mesh):
         ExplicitSolver(rheo, plate_mesh, bcs=[VelocityBC("north", v=1.0)])
     s = ExplicitSolver(rheo, plate_mesh)
     with pytest.raises(ConfigError, match="dt"):
-        s.step(IceState.uniform(plate_mesh, cohesion_pa=3e4), -1.0)
+        step(s, IceState.uniform(plate_mesh, cohesion_pa=3e4), -1.0)
 
 
 def test_implicit_limit_named_when_measured(monkeypatch):

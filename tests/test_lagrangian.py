@@ -2,6 +2,7 @@
 import numpy as np
 import pytest
 
+from helpers import compression_overrides, scene_sim, step
 from lagice.errors import ConfigError
 from lagice.lagrangian import fixed_node_mask, move_mesh, new_budget
 from lagice.mesh import generate_mesh, rectangle_domain
@@ -41,7 +42,7 @@ def test_volume_and_ice_area_kept_per_element(box_mesh, rng):
     v0, ia0, s0 = st.thickness * a0, st.concentration * a0, st.snow * a0
     st.velocity = _swirl(mesh.nodes, 0.1)
     b = new_budget()
-    rep = move_mesh(st, 3600.0, b)
+    rep = move_mesh(st, st.velocity, 3600.0, b)
     a1 = mesh.areas()
     assert rep.limited_nodes == 0
     np.testing.assert_allclose(st.thickness * a1, v0, rtol=1e-14)
@@ -55,7 +56,7 @@ def test_coast_nodes_fixed_and_segment_nodes_move(channel_mesh, rng):
     st = _state(mesh, rng)
     st.velocity[:] = (0.05, 0.0)
     x0 = mesh.nodes.copy()
-    move_mesh(st, 600.0)
+    move_mesh(st, st.velocity, 600.0)
     fixed = fixed_node_mask(mesh)
     assert np.array_equal(mesh.nodes[fixed], x0[fixed])
     top = np.setdiff1d(mesh.nodes_with_tag("top"), np.flatnonzero(fixed))
@@ -72,7 +73,7 @@ def test_ridging_caps_concentration_and_keeps_volume(box_mesh, rng):
     b = new_budget()
     V0 = st.ice_volume_m3
     IA0 = float(np.sum(st.concentration * mesh.areas()))
-    move_mesh(st, 3 * 86400.0, b)
+    move_mesh(st, st.velocity, 3 * 86400.0, b)
     assert st.concentration.max() <= 1.0
     assert b["ridged_elements"] > 0 and b["ridged_ice_area_m2"] > 0
     assert abs(st.ice_volume_m3 - V0) <= 1e-12 * V0
@@ -87,7 +88,7 @@ def test_inversion_guard_never_inverts(box_mesh, rng):
     a0 = mesh.areas()
     V0 = st.ice_volume_m3
     b = new_budget()
-    rep = move_mesh(st, 5000.0, b, min_area_ratio=0.05)
+    rep = move_mesh(st, st.velocity, 5000.0, b, min_area_ratio=0.05)
     a1 = mesh.areas()
     assert np.all(a1 > 0.05 * a0)
     assert rep.limited_nodes > 0 and b["limited_nodes"] == rep.limited_nodes
@@ -104,7 +105,7 @@ def test_open_boundary_outflow_booked(channel_mesh, rng):
     for _ in range(10):
         st.velocity[:] = (0.02, 0.0)
         st.velocity[fixed & np.isin(np.arange(mesh.n_nodes), mesh.coast_nodes())] = 0.0
-        move_mesh(st, 1800.0, b)
+        move_mesh(st, st.velocity, 1800.0, b)
     V1 = st.ice_volume_m3
     assert b["outflow_volume_m3"] > 0
     assert V1 + b["outflow_volume_m3"] == pytest.approx(V0, rel=1e-12)
@@ -114,31 +115,31 @@ def test_open_boundary_outflow_booked(channel_mesh, rng):
 def test_bad_arguments(box_mesh, rng):
     st = _state(box_mesh.copy(), rng)
     with pytest.raises(ConfigError, match="dt_s"):
-        move_mesh(st, 0.0)
+        move_mesh(st, st.velocity, 0.0)
     with pytest.raises(ConfigError, match="min_area_ratio"):
-        move_mesh(st, 1.0, min_area_ratio=1.5)
+        move_mesh(st, st.velocity, 1.0, min_area_ratio=1.5)
 
 
-def test_solver_move_remesh_step_cycle():
+def test_solver_move_remesh_step_cycle(tmp_path):
     """ImplicitSolver + mesh motion + a forced local remesh: the solver keeps
     stepping on the new mesh, boundary conditions still act on the tagged nodes."""
     from lagice.remesh import RemeshLog, remesh_if_needed
-    from lagice.scenes import compression
 
-    sc = compression.build(n_across=8, seed=3, push_speed_m_s=0.05)
-    st, solver = sc.state, sc.solver
+    sim = scene_sim("uniaxial_compression", tmp_path, compression_overrides(
+        8, **{"run.seed": 3, "boundary.top.v": -0.05, "solver.dt": 600.0, "run.duration": "1d"}))
+    st, solver = sim.model.state, sim.model.stepper
     b = new_budget()
     log = RemeshLog()
     V0 = st.ice_volume_m3
     for k in range(6):
-        solver.step(st, 600.0)
-        rep = move_mesh(st, 600.0, b, solver=solver)
+        step(solver, st, 600.0)
+        rep = move_mesh(st, solver.transport_velocity, 600.0, b, solver=solver)
         flagged = np.union1d(rep.flagged_elements, [k * 7])  # force a remesh event every step
-        ev = remesh_if_needed(st, sc.dx_m, solver=solver, flagged=flagged, log=log)
+        ev = remesh_if_needed(st, 12.5e3, solver=solver, flagged=flagged, log=log)
         assert ev is not None and ev.kind == "local"
         assert solver.mesh is st.mesh
         assert len(st.velocity) == st.mesh.n_nodes and len(st.stress) == st.mesh.n_elements
-    info = solver.step(st, 600.0)
+    info = step(solver, st, 600.0)
     assert np.all(np.isfinite(st.velocity)) and info.iterations >= 1
     top = st.mesh.nodes_with_tag("top")
     np.testing.assert_allclose(st.velocity[top, 1], -0.05)

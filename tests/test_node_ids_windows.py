@@ -7,6 +7,7 @@ from lagice.diagnostics import lagrangian_velocity_gradients
 from lagice.errors import LagiceError
 from lagice.io.snapshots import SnapshotWriter, load_window
 from lagice.mesh import generate_mesh, rectangle_domain
+from lagice.model import Model
 from lagice.remesh import remesh_if_needed
 from lagice.state import IceState
 
@@ -44,15 +45,16 @@ def test_window_across_a_remesh_follows_nodes(tmp_path):
     start-geometry Lagrangian gradient equals G exactly on the kept elements;
     the remeshed elements are left out and counted."""
     st = _state()
+    model = Model(st)
     w = SnapshotWriter(tmp_path / "snaps", crs_epsg=None)
-    w.write(st)
+    w.write(model)
     ev = remesh_if_needed(st, 5e3, flagged=[st.mesh.n_elements // 2])
     st.counters["mesh_epoch"] = 1
     G = np.array([[2e-7, -1e-7], [3e-7, -0.5e-7]])
     dt = 86400.0
     st.mesh.nodes = st.mesh.nodes + dt * (st.mesh.nodes @ G.T + np.array([0.01, -0.02]))
-    st.time_s, st.step = dt, 10
-    w.write(st)
+    model.clock.time_s, model.clock.iteration = dt, 10
+    w.write(model)
     win = load_window(tmp_path / "snaps", 0.0, dt)
     assert win["remesh_events"] == 1 and win["dt_s"] == dt
     assert win["n_elements_lost"] == ev.n_patch_old
@@ -67,13 +69,14 @@ def test_window_across_a_remesh_follows_nodes(tmp_path):
 def test_window_without_ids_across_remesh_is_refused(tmp_path):
     st = _state()
     st.node_id = None
+    model = Model(st)
     w = SnapshotWriter(tmp_path, crs_epsg=None)
-    w.write(st)
+    w.write(model)
     remesh_if_needed(st, 5e3, flagged=[3])
     st.node_id = None
     st.counters["mesh_epoch"] = 1
-    st.time_s, st.step = 100.0, 1
-    w.write(st)
+    model.clock.time_s, model.clock.iteration = 100.0, 1
+    w.write(model)
     with pytest.raises(LagiceError, match="spans a remesh .* no node_id"):
         load_window(tmp_path, 0.0, 100.0)
     with pytest.raises(LagiceError, match="no window"):

@@ -9,7 +9,7 @@ import xarray as xr
 from lagice.io.gridded import conservative_grid_average
 from lagice.mesh import generate_mesh, rectangle_domain
 from lagice.scenes.config import load_scene
-from lagice.scenes.toml_scene import build_simulation
+from lagice.scenes.builder import build_simulation
 
 FAST = {"run.duration": 800.0, "solver.dt": 40.0, "output.every": 400.0, "domain.resolution_m": 25e3,
         "run.progress": False, "output.plot": False, "boundary.top.u": "5e-2*minimum(1.0, t/600.0)",
@@ -38,7 +38,13 @@ def test_snapshots_follow_ugrid_cf(run_dir):
     assert "_FillValue" not in ds["damage"].encoding or ds["damage"].encoding["_FillValue"] is None
     assert "polar_stereographic" in ds["crs"].attrs.get("grid_mapping_name", "")
     assert np.array_equal(ds["damage"].values[0], sim.model.state.damage)
-    assert np.array_equal(ds["stress"].values[0], sim.model.state.stress)
+    for k, comp in enumerate(("xx", "yy", "xy")):
+        assert np.array_equal(ds[f"stress_{comp}"].values[0], sim.model.state.stress[:, k])
+        assert ds[f"stress_{comp}"].attrs["units"] == "Pa"
+    # the snapshot's velocity is the transport velocity (the one that moved the nodes)
+    assert np.array_equal(ds["velocity_x"].values[0], sim.model.transport_velocity[:, 0])
+    assert ds.attrs["Conventions"] == "CF-1.8 UGRID-1.0" and ds.attrs["lagice_version"]
+    assert json.loads(ds.attrs["lagice_config"])["scene"]["name"] == "shear_box"
     xu = pytest.importorskip("xugrid")
     uds = xu.open_dataset(d / "snapshots" / index[-1]["file"])
     assert uds.ugrid.grid.n_face == sim.model.mesh.n_elements
@@ -53,6 +59,11 @@ def test_gridded_output_conserves_totals(run_dir):
     assert g["thickness"].attrs["grid_mapping"] == "crs"
     m = meshio.read(d / "snapshots" / "snapshot_00000020.vtu")
     assert np.allclose(m.cell_data["damage"][0], sim.model.state.damage)
+    assert np.allclose(m.cell_data["stress"][0], sim.model.state.stress)
+    assert set(m.cell_data) >= {"thickness", "concentration", "cohesion", "total_deformation_rate"}
+    assert np.allclose(m.point_data["velocity"][:, :2], sim.model.transport_velocity)
+    pvd = (d / "snapshots" / "snapshots.pvd").read_text()
+    assert pvd.count("<DataSet") == 3 and 'timestep="800.0"' in pvd
 
 
 def test_conservative_average_exact_on_linear_rotation():

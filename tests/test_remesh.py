@@ -121,7 +121,7 @@ def test_deterministic(small_mesh):
         st = _random_state(small_mesh.copy(), rng)
         for k in range(5):
             st.velocity = rng.normal(0.0, 1.0, (st.mesh.n_nodes, 2))
-            rep = move_mesh(st, 1500.0)
+            rep = move_mesh(st, st.velocity, 1500.0)
             remesh_if_needed(st, 5e3, flagged=rep.flagged_elements)
         outs.append((st.mesh.nodes.copy(), st.mesh.triangles.copy(), st.thickness.copy(), st.damage.copy()))
     for a, b in zip(*outs):
@@ -141,7 +141,7 @@ def test_hundreds_of_events_conserve_totals_and_bounds(rng):
         st = _random_state(mesh, rng)
         for k in range(60):
             st.velocity = rng.normal(0.0, 1.0, (st.mesh.n_nodes, 2))
-            rep = move_mesh(st, 300.0 + 300.0 * rng.random())
+            rep = move_mesh(st, st.velocity, 300.0 + 300.0 * rng.random())
             flagged = np.union1d(rep.flagged_elements, rng.integers(0, st.mesh.n_elements, 2))
             before = totals(st.mesh, st)
             ev = remesh_if_needed(st, size, flagged=flagged, rings=int(rng.integers(1, 3)))
@@ -164,7 +164,7 @@ def test_remeshed_patch_has_good_angles(small_mesh, rng):
     st = _random_state(mesh, rng)
     for _ in range(4):
         st.velocity = rng.normal(0.0, 2.0, (st.mesh.n_nodes, 2))
-        move_mesh(st, 2000.0)
+        move_mesh(st, st.velocity, 2000.0)
     tr = check_trigger(st.mesh, 5e3)
     assert tr.any
     ev = remesh_if_needed(st, 5e3)
@@ -172,15 +172,14 @@ def test_remeshed_patch_has_good_angles(small_mesh, rng):
     assert angles_deg(st.mesh.nodes, st.mesh.triangles[k:]).min() >= 10.0 or ev.kind == "global"
 
 
-def test_patch_with_hole_and_island_domain(rng):
+def test_patch_with_hole_and_island_domain(rng, tmp_path):
     """A patch that encloses unpatched elements (a hole), and a global remesh
     of a domain with an island (the annulus of the shear_channel scene)."""
     from lagice.remesh import apply_remesh, remesh_region
     from lagice.remesh.patch import make_manifold, patch_boundary
-    from lagice.scenes import shear_channel
+    from helpers import scene_sim
 
-    sc = shear_channel.build(size_m=12e3)
-    st = sc.state
+    st = scene_sim("shear_channel", tmp_path, {"domain.resolution_m": 12e3}).model.state
     mesh = st.mesh
     interior = np.setdiff1d(np.arange(mesh.n_nodes), np.unique(mesh.boundary_edges))
     r = np.hypot(*mesh.nodes[interior].T)

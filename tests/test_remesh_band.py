@@ -54,7 +54,7 @@ def test_damage_band_blurring_bounded(d_band, damage_remap):
         x = st.mesh.nodes
         st.velocity = np.column_stack([0 * x[:, 0], 0.1 * (x[:, 0] - xc) / (L / 2)
                                        * np.sin(np.pi * x[:, 1] / L) + 0.2 * np.sin(2 * np.pi * x[:, 0] / L)])
-        move_mesh(st, 3600.0)
+        move_mesh(st, st.velocity, 3600.0)
     w1, s1 = band_metrics(st.mesh, st.damage, xc)
     assert w1 == pytest.approx(w0, rel=1e-12) and s1 == pytest.approx(s0, rel=1e-12)  # motion alone: no blur
     c = st.mesh.centroids()

@@ -6,7 +6,7 @@ from shapely.geometry import LineString
 from lagice.errors import ConfigError
 from lagice.mesh import generate_mesh
 from lagice.scenes.config import load_scene
-from lagice.scenes.toml_scene import build_domain
+from lagice.scenes.builder import build_domain
 
 
 def test_strait_scene_is_the_basin_plus_an_open_segment():

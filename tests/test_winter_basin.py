@@ -32,7 +32,7 @@ def test_cli_short_winter_basin_outputs(short_run):
     uds = xu.open_dataset(last)
     ds = xr.open_dataset(last)
     for name, units in (("thickness", "m"), ("concentration", "1"), ("damage", "1"), ("velocity_x", "m s-1"),
-                        ("total_deformation_rate", "s-1"), ("stress", "Pa")):
+                        ("total_deformation_rate", "s-1"), ("stress_xy", "Pa")):
         assert ds[name].attrs["units"] == units, name
     assert uds.ugrid.grid.n_face == ds.sizes["mesh_face"]
     assert "3413" in ds["crs"].attrs["crs_wkt"] or "Polar" in ds["crs"].attrs["crs_wkt"]
@@ -68,5 +68,5 @@ def test_cli_resume_is_bit_identical(short_run, tmp_path):
     assert str(copy) in r.stdout
     a = xr.load_dataset(out / "snapshots" / "snapshot_00000072.nc")
     b = xr.load_dataset(copy / "snapshots" / "snapshot_00000072.nc")
-    for name in ("thickness", "concentration", "damage", "stress", "velocity_x", "mesh_node_x"):
+    for name in ("thickness", "concentration", "damage", "stress_xx", "velocity_x", "mesh_node_x"):
         assert np.array_equal(a[name].values, b[name].values), name

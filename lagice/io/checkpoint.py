@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import RestartError
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 _NAME = re.compile(r"^checkpoint_(\d{10})\.npz$")
 
 

@@ -102,38 +102,69 @@ def conservative_grid_average(nodes, triangles, fields: dict, x_edges, y_edges):
     return out, den / cell
 
 
-def gridded_dataset(state, resolution_m: float, crs_epsg: int | None = 3413, start_date="2000-01-01 00:00:00"):
-    """xarray Dataset of the state's element fields averaged on a regular grid."""
+def gridded_dataset(model, resolution_m: float, crs_epsg: int | None = 3413, start_date="2000-01-01 00:00:00",
+                    title: str = "lagice regular-grid output"):
+    """xarray Dataset of the model's scalar element fields (field registry, those
+    written to snapshots) averaged conservatively on a regular projected grid."""
     import xarray as xr
 
-    from .snapshots import FIELD_ATTRS, _crs_var
+    from ..fields import ELEMENT, FIELDS
+    from .cf import CONVENTIONS, crs_variable, provenance, time_coordinate
 
+    state = model.state
     x0, y0 = state.mesh.nodes.min(axis=0)
     x1, y1 = state.mesh.nodes.max(axis=0)
     nx = max(1, int(np.ceil((x1 - x0) / resolution_m)))
     ny = max(1, int(np.ceil((y1 - y0) / resolution_m)))
     xe = x0 + resolution_m * np.arange(nx + 1)
     ye = y0 + resolution_m * np.arange(ny + 1)
-    names = [n for n in FIELD_ATTRS if getattr(state, n, None) is not None]
+    specs = [f for f in FIELDS.values() if f.location == ELEMENT and f.snapshot and not f.components
+             and getattr(state, f.name, None) is not None]
     means, cov = conservative_grid_average(state.mesh.nodes, state.mesh.triangles,
-                                           {n: getattr(state, n) for n in names}, xe, ye)
+                                           {f.name: getattr(state, f.name) for f in specs}, xe, ye)
     ds = xr.Dataset(coords={
-        "x": ("x", 0.5 * (xe[1:] + xe[:-1]), {"units": "m", "standard_name": "projection_x_coordinate"}),
-        "y": ("y", 0.5 * (ye[1:] + ye[:-1]), {"units": "m", "standard_name": "projection_y_coordinate"}),
-        "time": ("time", [state.time_s], {"units": f"seconds since {start_date}", "standard_name": "time"}),
+        "x": ("x", 0.5 * (xe[1:] + xe[:-1]), {"units": "m", "standard_name": "projection_x_coordinate",
+                                              "axis": "X"}),
+        "y": ("y", 0.5 * (ye[1:] + ye[:-1]), {"units": "m", "standard_name": "projection_y_coordinate",
+                                              "axis": "Y"}),
+        "time": time_coordinate(model.clock.time_s, start_date),
     })
     gm = {}
-    crs = _crs_var(crs_epsg)
+    crs = crs_variable(crs_epsg)
     if crs is not None:
         ds["crs"] = crs
         gm = {"grid_mapping": "crs"}
-    for n in names:
-        std, units, long = FIELD_ATTRS[n]
-        attrs = {"units": units, "long_name": f"{long}, conservative cell average", **gm,
-                 "comment": "NaN where no part of the cell is covered by the ice mesh (see coverage)"}
-        if std:
-            attrs["standard_name"] = std
-        ds[n] = (("time", "y", "x"), means[n][None], attrs)
+    for f in specs:
+        attrs = {"units": f.units, "long_name": f"{f.long_name}, conservative cell average", **gm,
+                 "comment": "missing where no part of the cell is covered by the ice mesh (see coverage)"}
+        if f.standard_name:
+            attrs["standard_name"] = f.standard_name
+        ds[f.name] = (("time", "y", "x"), means[f.name][None], attrs)
     ds["coverage"] = (("time", "y", "x"), cov[None], {"units": "1", "long_name":
                                                       "fraction of the cell covered by the mesh", **gm})
+    ds.attrs.update(provenance(title, model.config, {"Conventions": CONVENTIONS, "step": int(model.clock.iteration)}))
     return ds
+
+
+class GridWriter:
+    """Writes ``grid_SSSSSSSS.nc``: element fields conservatively averaged on a
+    regular grid of ``resolution_m`` [m] (see :func:`gridded_dataset`)."""
+
+    def __init__(self, directory, resolution_m: float, crs_epsg: int | None = 3413,
+                 start_date: str = "2000-01-01 00:00:00"):
+        from pathlib import Path
+
+        from ..errors import check_range
+
+        check_range("output.grid_resolution_m", resolution_m, 0.0, None, low_open=True, unit="m")
+        self.dir = Path(directory)
+        self.resolution_m = float(resolution_m)
+        self.crs_epsg = crs_epsg
+        self.start_date = start_date
+
+    def write(self, model):
+        from .cf import write_netcdf_atomic
+
+        self.dir.mkdir(parents=True, exist_ok=True)
+        ds = gridded_dataset(model, self.resolution_m, self.crs_epsg, self.start_date)
+        return write_netcdf_atomic(ds, self.dir / f"grid_{int(model.clock.iteration):08d}.nc")

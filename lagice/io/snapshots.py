@@ -1,16 +1,14 @@
 """Snapshot output: one UGRID-1.0 / CF netCDF file per snapshot.
 
 Remeshing changes the mesh, so a time series cannot live on one fixed mesh
-dimension. Each snapshot file ``snapshot_SSSSSS.nc`` holds its own mesh
-(UGRID topology ``mesh``) and the element/node fields at one time; the
-attribute ``mesh_epoch`` counts remesh events, so files with equal epochs
-share the same mesh. ``index.json`` lists every snapshot (file, time, step,
-mesh epoch). With a grid resolution, ``grid_SSSSSSSS.nc`` holds the
-element fields conservatively averaged on a regular projected grid
-(:mod:`lagice.io.gridded`); with ``vtu`` a ``.vtu`` file per snapshot is
-written for ParaView. Open one with ``xugrid.open_dataset`` or ``xarray.open_dataset``;
-the files of one epoch concatenate with ``xarray.open_mfdataset(...,
-combine="nested", concat_dim="time")``.
+dimension. Each snapshot file ``snapshot_SSSSSSSS.nc`` holds its own mesh
+(UGRID topology ``mesh``) and the state fields the field registry marks for
+snapshots (:mod:`lagice.fields`), plus the diagnostics every snapshot carries:
+the transport velocity (the velocity that moved the nodes over the last step)
+and the deformation rates of that velocity. The attribute ``mesh_epoch`` counts
+remesh events, so files with equal epochs share the same mesh. ``index.json``
+lists every snapshot (file, time, step, mesh epoch). Open a run's snapshots with
+:func:`lagice.open_run` (docs/output_and_restart.md).
 """
 from __future__ import annotations
 
@@ -22,110 +20,77 @@ import numpy as np
 import xarray as xr
 
 from ..deformation import invariants
+from ..fields import DIAGNOSTICS, FIELDS, cf_attrs
+from .cf import CONVENTIONS_UGRID, crs_variable, provenance, time_coordinate, write_netcdf_atomic
 from .ugrid import mesh_dataset
 
-FIELD_ATTRS = {
-    "thickness": ("sea_ice_thickness", "m", "ice volume per unit area (effective thickness)"),
-    "concentration": ("sea_ice_area_fraction", "1", "ice concentration"),
-    "damage": (None, "1", "damage (0 undamaged, 1 fully damaged)"),
-    "cohesion": (None, "Pa", "cohesion"),
-    "snow": ("surface_snow_thickness", "m", "snow volume per unit area"),
-}
 
-
-def _crs_var(crs_epsg: int | None):
-    if crs_epsg is None:
-        return None
-    try:
-        import pyproj
-
-        crs = pyproj.CRS.from_epsg(crs_epsg)
-        attrs = crs.to_cf()
-        attrs["crs_wkt"] = crs.to_wkt()
-        return xr.DataArray(np.int32(0), attrs=attrs)
-    except Exception:  # noqa: BLE001 - pyproj missing data: keep the EPSG code
-        return xr.DataArray(np.int32(0), attrs={"epsg_code": f"EPSG:{crs_epsg}"})
-
-
-def snapshot_dataset(state, strain_rate=None, crs_epsg: int | None = 3413, extra: dict | None = None,
-                     start_date: str = "2000-01-01 00:00:00"):
-    """The snapshot of ``state`` as an xarray Dataset (UGRID + CF attributes)."""
+def snapshot_dataset(model, crs_epsg: int | None = 3413, start_date: str = "2000-01-01 00:00:00",
+                     title: str = "lagice snapshot", extra: dict | None = None):
+    """The snapshot of ``model`` (state, clock, transport velocity, deformation
+    rates) as an xarray Dataset with UGRID and CF attributes."""
+    state = model.state
     ds = mesh_dataset(state.mesh)
-    grid_mapping = {}
-    crs = _crs_var(crs_epsg)
+    gm = None
+    crs = crs_variable(crs_epsg)
     if crs is not None:
         ds["crs"] = crs
-        grid_mapping = {"grid_mapping": "crs"}
-        ds["mesh_node_x"].attrs.update(grid_mapping)
-        ds["mesh_node_y"].attrs.update(grid_mapping)
-    face = {"mesh": "mesh", "location": "face", **grid_mapping}
-    node = {"mesh": "mesh", "location": "node", **grid_mapping}
-    ds["time"] = ("time", np.array([state.time_s]), {"units": f"seconds since {start_date}",
-                                                     "standard_name": "time", "calendar": "standard"})
-    for name, (std, units, long) in FIELD_ATTRS.items():
-        val = getattr(state, name, None)
-        if val is None:
+        gm = "crs"
+        ds["mesh_node_x"].attrs["grid_mapping"] = gm
+        ds["mesh_node_y"].attrs["grid_mapping"] = gm
+    ds["time"] = time_coordinate(model.clock.time_s, start_date)
+    dims = {"node": "mesh_node", "element": "mesh_face"}
+    for spec in FIELDS.values():
+        val = getattr(state, spec.name, None)
+        if not spec.snapshot or val is None:
             continue
-        attrs = {"units": units, "long_name": long, **face}
-        if std:
-            attrs["standard_name"] = std
-        ds[name] = (("time", "mesh_face"), val[None, :], attrs)
-    ds["stress"] = (("time", "mesh_face", "stress_component"), state.stress[None],
-                    {"units": "Pa", "long_name": "depth-averaged internal stress (xx, yy, xy), tension positive",
-                     **face})
-    ds["stress_component"] = ("stress_component", np.array(["xx", "yy", "xy"]))
-    ds["velocity_x"] = (("time", "mesh_node"), state.velocity[None, :, 0],
-                        {"units": "m s-1", "standard_name": "sea_ice_x_velocity", **node})
-    ds["velocity_y"] = (("time", "mesh_node"), state.velocity[None, :, 1],
-                        {"units": "m s-1", "standard_name": "sea_ice_y_velocity", **node})
-    if getattr(state, "node_id", None) is not None:
-        ds["node_id"] = ("mesh_node", np.asarray(state.node_id, np.int64),
-                         {"long_name": "persistent node identifier (kept through remeshing)", "units": "1",
-                          "mesh": "mesh", "location": "node"})
-    if strain_rate is not None:
-        div, shear, tot = invariants(strain_rate)
-        for name, val, long in (("divergence_rate", div, "divergence of ice velocity"),
-                                ("shear_rate", shear, "maximum shear rate"),
-                                ("total_deformation_rate", tot, "total deformation rate sqrt(div^2+shear^2)")):
-            ds[name] = (("time", "mesh_face"), val[None], {"units": "s-1", "long_name": long, **face})
-    ds.attrs.update({"Conventions": "CF-1.8 UGRID-1.0", "step": int(state.step),
-                     "mesh_epoch": int(state.counters.get("mesh_epoch", 0)), **(extra or {})})
+        dim = dims[spec.location]
+        if spec.name == "node_id":
+            if val.size and val.max() > np.iinfo(np.int32).max:
+                raise OverflowError("node_id exceeds the int32 range of the snapshot format")
+            attrs = {"long_name": spec.long_name, "units": "1", "mesh": "mesh", "location": "node"}
+            ds["node_id"] = (dim, val.astype(np.int32), attrs)
+            continue
+        if spec.components:
+            for k, comp in enumerate(spec.components):
+                attrs = cf_attrs(spec, gm)
+                attrs["long_name"] = f"{spec.long_name}, {comp} component"
+                ds[f"{spec.name}_{comp}"] = (("time", dim), val[None, :, k], attrs)
+        else:
+            ds[spec.name] = (("time", dim), val[None, :], cf_attrs(spec, gm))
+    vel = model.transport_velocity
+    for k, name in enumerate(("velocity_x", "velocity_y")):
+        ds[name] = (("time", "mesh_node"), vel[None, :, k], cf_attrs(DIAGNOSTICS[name], gm))
+    eps = model.strain_rate
+    if eps is not None:
+        div, shear, tot = invariants(eps)
+        for name, val in (("divergence_rate", div), ("shear_rate", shear), ("total_deformation_rate", tot)):
+            ds[name] = (("time", "mesh_face"), val[None], cf_attrs(DIAGNOSTICS[name], gm))
+    ds.attrs.update(provenance(title, model.config, {
+        "Conventions": CONVENTIONS_UGRID, "step": int(model.clock.iteration),
+        "mesh_epoch": int(state.counters.get("mesh_epoch", 0)), **(extra or {})}))
     return ds
 
 
 class SnapshotWriter:
-    """Writes snapshots and keeps ``index.json`` up to date (atomically)."""
+    """Writes snapshots of a model and keeps ``index.json`` up to date (atomically)."""
 
-    def __init__(self, directory, crs_epsg: int | None = 3413, vtu: bool = False,
-                 start_date: str = "2000-01-01 00:00:00", grid_resolution_m: float | None = None):
+    def __init__(self, directory, crs_epsg: int | None = 3413, start_date: str = "2000-01-01 00:00:00",
+                 title: str = "lagice snapshot", extra: dict | None = None):
         self.dir = Path(directory)
-        self.grid_resolution_m = grid_resolution_m
         self.start_date = start_date
         self.crs_epsg = crs_epsg
-        self.vtu = vtu
+        self.title = title
+        self.extra = dict(extra or {})
 
-    def write(self, state, strain_rate=None, extra=None) -> Path:
+    def write(self, model) -> Path:
         self.dir.mkdir(parents=True, exist_ok=True)
-        path = self.dir / f"snapshot_{state.step:08d}.nc"
-        ds = snapshot_dataset(state, strain_rate, self.crs_epsg, extra, self.start_date)
-        tmp = path.with_suffix(".nc.tmp")
-        # no fill values: every value written is a model value
-        ds.to_netcdf(tmp, encoding={v: {"_FillValue": None} for v in ds.variables
-                                    if ds[v].dtype.kind == "f"})
-        os.replace(tmp, path)
-        if self.vtu:
-            from ..mesh import write_mesh
-            cd = {k: getattr(state, k) for k in ("thickness", "concentration", "damage")}
-            write_mesh(path.with_suffix(".vtu"), state.mesh, cell_data=cd,
-                       point_data={"velocity": np.column_stack([state.velocity, np.zeros(len(state.velocity))])})
-        if self.grid_resolution_m:
-            from .gridded import gridded_dataset
-            gds = gridded_dataset(state, self.grid_resolution_m, self.crs_epsg, self.start_date)
-            gpath = self.dir / f"grid_{state.step:08d}.nc"
-            gds.to_netcdf(gpath.with_suffix(".nc.tmp"))
-            os.replace(gpath.with_suffix(".nc.tmp"), gpath)
-        self._index_add({"file": path.name, "time_s": state.time_s, "step": int(state.step),
-                         "mesh_epoch": int(state.counters.get("mesh_epoch", 0))})
+        step = int(model.clock.iteration)
+        path = self.dir / f"snapshot_{step:08d}.nc"
+        ds = snapshot_dataset(model, self.crs_epsg, self.start_date, self.title, self.extra)
+        write_netcdf_atomic(ds, path)
+        self._index_add({"file": path.name, "time_s": model.clock.time_s, "step": step,
+                         "mesh_epoch": int(model.state.counters.get("mesh_epoch", 0))})
         return path
 
     def _index_add(self, entry):

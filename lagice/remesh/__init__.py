@@ -7,11 +7,13 @@ the Lagrangian move (:func:`lagice.lagrangian.move_mesh`)::
 
 It checks the trigger (:mod:`.trigger`), remeshes a patch around the bad
 elements (:mod:`.patch`; larger patches, then a global remesh, when gmsh
-fails or patches grow too large), remaps all element fields of the
-:class:`~lagice.state.IceState` conservatively (:mod:`.remap`), interpolates
-the velocity at new nodes, replaces ``state.mesh`` and calls
+fails or patches grow too large), remaps the element fields of the
+:class:`~lagice.state.IceState` that the field registry marks for remapping
+(:mod:`lagice.fields`) conservatively (:mod:`.remap`), interpolates the
+velocity at new nodes, replaces ``state.mesh`` and calls
 ``solver.reset_topology(new_mesh)``. It returns a :class:`RemeshEvent`
-(diagnostics) or None when nothing needed remeshing.
+(diagnostics) or None when nothing needed remeshing. In a model, the
+:class:`Remesher` component (:mod:`.component`) calls it once per step.
 """
 from __future__ import annotations
 
@@ -21,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ConfigError, MeshError
+from ..fields import remapped_element_fields
 from ..mesh import Mesh, angles_deg, signed_areas
 from .patch import Stitch, grow_patch, make_manifold, mesh_patch, patch_boundary, stitch
 from .remap import interpolate_nodal, intersect_triangles, locate_points, remap_field, remap_weights
@@ -30,11 +33,8 @@ __all__ = [
     "RemeshEvent", "RemeshLog", "TriggerParams", "TriggerResult", "check_trigger", "evaluate_size",
     "remesh_if_needed", "remesh_region", "apply_remesh", "remesh_global", "intersect_triangles", "remap_field",
     "remap_weights", "interpolate_nodal", "locate_points", "grow_patch", "element_fields", "totals",
+    "Remesher",
 ]
-
-#: element fields of IceState that are remapped, and how (all area-weighted convex
-#: combinations; see remap.py): extensive totals are h·a, A·a, hs·a.
-ELEMENT_FIELDS = ("thickness", "concentration", "damage", "stress", "cohesion", "snow")
 
 
 @dataclass
@@ -106,15 +106,11 @@ class RemeshLog:
 
 
 def element_fields(state) -> dict:
-    """The element fields of ``state`` that are remapped (name -> array):
-    :data:`ELEMENT_FIELDS` plus any names listed in ``state.extra_element_fields``
-    (other per-element arrays, remapped as area-weighted means)."""
-    out = {}
-    for name in (*ELEMENT_FIELDS, *getattr(state, "extra_element_fields", ())):
-        v = getattr(state, name, None)
-        if v is not None:
-            out[name] = v
-    return out
+    """The element fields of ``state`` that are remapped (name -> array), from the
+    field registry (:func:`lagice.fields.remapped_element_fields`): all are
+    area-weighted means over the supermesh, so the extensive totals h·a, A·a,
+    hs·a are conserved."""
+    return remapped_element_fields(state)
 
 
 def totals(mesh: Mesh, state) -> dict:
@@ -218,7 +214,7 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
                      rings: int = 2, max_retries: int = 2, max_patch_fraction: float = 0.5,
                      flagged=None, log: RemeshLog | None = None, algorithm: int = 6,
                      remap_method: str = "auto", damage_remap: str = "area",
-                     force_global: bool = False) -> RemeshEvent | None:
+                     force_global: bool = False, time_s: float = 0.0, step: int = 0) -> RemeshEvent | None:
     """Check the trigger and, if needed, remesh and remap ``state`` in place.
 
     Args:
@@ -237,6 +233,7 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
         remap_method: ``"auto"``, ``"clip"`` or ``"celltree"`` (:func:`intersect_triangles`).
         damage_remap: ``"area"`` or ``"compliance"`` (:func:`remesh_region`).
         force_global: remesh everything (regardless of the trigger).
+        time_s, step: model time [s] and iteration, recorded in the event.
 
     Returns:
         :class:`RemeshEvent`, or None when the trigger found nothing.
@@ -253,7 +250,7 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
     if not trig.any and not force_global:
         return None
     m = mesh.n_elements
-    ev = RemeshEvent(time_s=float(state.time_s), step=int(state.step), kind="failed",
+    ev = RemeshEvent(time_s=float(time_s), step=int(step), kind="failed",
                      trigger_counts=dict(trig.counts), n_bad=int(trig.bad.sum()),
                      n_elements_before=m, t_trigger_s=t_trig)
     fields_before = element_fields(state)
@@ -319,3 +316,6 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
 def remesh_global(state, size_field, **kw) -> RemeshEvent:
     """Remesh the whole domain (boundary nodes kept) and remap ``state``."""
     return remesh_if_needed(state, size_field, force_global=True, **kw)
+
+
+from .component import Remesher  # noqa: E402  (uses remesh_if_needed above)

@@ -14,12 +14,18 @@ wind ``kind``             generator (``forcing.synthetic``/``forcing.gridded``)
                           ``cyclone_wind(grid, t_end, cyclones, background_m_s)``
 ``file``                  ``open_wind(path, **kw)`` (ERA5-like netCDF)
 ``expression``            ``u``, ``v``: expressions in t, x, y or module:function
+``function``              ``function = "module:function"`` ``f(t, x, y, **params)
+                          -> (u, v)`` with ``params`` a table (a scene hook)
 ========================  =====================================================
 
 ocean ``kind``: ``rest``, ``uniform`` (u_m_s, v_m_s), ``gyre`` (max_speed_m_s,
-clockwise), ``file``, ``expression``. air_temperature ``kind``: ``synthetic``
-(``synthetic_air_temperature`` keywords), ``constant`` (value_c), ``file``,
-``expression`` (``value``).
+clockwise), ``file``, ``expression``, ``function``. air_temperature ``kind``:
+``synthetic`` (``synthetic_air_temperature`` keywords), ``constant`` (value_c),
+``file``, ``expression`` (``value``).
+
+Mesh motion, remeshing and drifters are components of their own
+(:class:`lagice.lagrangian.MeshMotion`, :class:`lagice.remesh.Remesher`,
+:class:`lagice.drifters.Drifters`); this module builds them from the scene.
 """
 from __future__ import annotations
 
@@ -28,10 +34,10 @@ import inspect
 import numpy as np
 
 from ..errors import ConfigError
-from .config import time_space_callable
+from .config import resolve_hook, time_space_callable
 
-WIND_KINDS = ("uniform", "random", "cyclones", "file", "expression")
-OCEAN_KINDS = ("rest", "uniform", "gyre", "file", "expression")
+WIND_KINDS = ("uniform", "random", "cyclones", "file", "expression", "function")
+OCEAN_KINDS = ("rest", "uniform", "gyre", "file", "expression", "function")
 AIR_KINDS = ("synthetic", "constant", "file", "expression")
 HEAL_LAWS = ("none", "constant", "thermodynamic", "fdd")
 
@@ -57,6 +63,26 @@ def _kwargs(table: dict, key: str, funcs, exclude=()) -> dict:
     return kw
 
 
+def _generators(key: str, kind: str):
+    """The generator functions whose keywords a ``[forcing.KEY]`` table of ``kind`` takes,
+    and the parameters the builder fills itself."""
+    from forcing import gridded, synthetic as syn
+
+    if key == "wind":
+        return {"uniform": ([syn.uniform_wind], ("grid", "t_end_s")),
+                "random": ([syn.random_wind], ("grid", "t_end_s")),
+                "cyclones": ([syn.random_cyclones, syn.cyclone_wind], ("grid", "t_end_s", "bbox", "cyclones")),
+                "file": ([gridded.open_wind, gridded.open_gridded], ("variables", "quantity"))}.get(kind)
+    return {"uniform": ([syn.uniform_current], ("grid",)), "gyre": ([syn.gyre_current], ("grid",)),
+            "file": ([gridded.open_ocean_current, gridded.open_gridded], ("variables", "quantity"))}.get(kind)
+
+
+def _check_kwargs(t: dict, key: str, kind: str) -> None:
+    gen = _generators(key, kind)
+    if gen is not None:
+        _kwargs(t, key, *gen)
+
+
 def validate(cfg: dict) -> None:
     """Checks before any mesh work (kinds, parameter names, dependencies)."""
     law = cfg["healing"]["law"]
@@ -69,10 +95,17 @@ def validate(cfg: dict) -> None:
         raise ConfigError("thermo.enabled = true needs [forcing.air_temperature]")
     if cfg["remesh"]["enabled"] and not cfg["lagrangian"]["enabled"]:
         raise ConfigError("remesh.enabled = true needs lagrangian.enabled = true (a fixed mesh never distorts)")
-    if fc["wind"] is not None:
-        _kind(fc["wind"], "wind", WIND_KINDS)
-    if fc["ocean"] is not None:
-        _kind(fc["ocean"], "ocean", OCEAN_KINDS)
+    for key, kinds in (("wind", WIND_KINDS), ("ocean", OCEAN_KINDS)):
+        t = fc[key]
+        if t is None:
+            continue
+        kind = _kind(t, key, kinds)
+        if kind == "function":
+            _function_field(t, key)
+        elif kind == "expression":
+            _vector_expr(t, key)
+        else:
+            _check_kwargs(t, key, kind)
     if fc["air_temperature"] is not None:
         _kind(fc["air_temperature"], "air_temperature", AIR_KINDS)
     if fc["coriolis"] is not None:
@@ -86,6 +119,19 @@ def validate(cfg: dict) -> None:
             DragParams(**fc["drag"])
         except TypeError as exc:
             raise ConfigError(f"[forcing.drag]: {exc}; known keys: {sorted(DragParams.__dataclass_fields__)}") from None
+    if cfg["thermo"]["enabled"]:
+        from thermo.zero_layer import ThermoParams
+        try:
+            ThermoParams(**cfg["thermo"]["params"])
+        except TypeError as exc:
+            raise ConfigError(f"[thermo.params]: {exc}; known keys: "
+                              f"{sorted(ThermoParams.__dataclass_fields__)}") from None
+    if cfg["remesh"]["enabled"]:
+        from ..remesh import Remesher
+        Remesher(1.0, cfg["remesh"]["min_angle_deg"], **cfg["remesh"]["params"])
+    if cfg["lagrangian"]["enabled"]:
+        from ..lagrangian import MeshMotion
+        MeshMotion(cfg["lagrangian"]["min_area_ratio"], cfg["lagrangian"]["max_halvings"])
 
 
 def _grid(mesh, spacing):
@@ -103,6 +149,16 @@ def _vector_expr(t, key):
         if k not in ("kind", "u", "v"):
             raise ConfigError(f"unknown key forcing.{key}.{k}; known keys: ['u', 'v']")
     return lambda tt, x, y: (fu(tt, x, y), fv(tt, x, y))
+
+
+def _function_field(t, key):
+    """A ``kind = "function"`` field: ``function`` names ``f(t, x, y, **params)``."""
+    for k in t:
+        if k not in ("kind", "function", "params"):
+            raise ConfigError(f"unknown key forcing.{key}.{k}; known keys: ['function', 'params']")
+    if "function" not in t:
+        raise ConfigError(f"forcing.{key}.kind = 'function' needs forcing.{key}.function = 'module:function'")
+    return resolve_hook(t["function"], f"forcing.{key}.function", t.get("params"))
 
 
 def build_wind(t: dict, grid, bbox, t_end, seed):
@@ -125,6 +181,8 @@ def build_wind(t: dict, grid, bbox, t_end, seed):
     if kind == "file":
         kw = _kwargs(t, "wind", [gridded.open_wind, gridded.open_gridded], ("variables", "quantity"))
         return gridded.open_wind(**kw)
+    if kind == "function":
+        return _function_field(t, "wind")
     return _vector_expr(t, "wind")
 
 
@@ -142,6 +200,8 @@ def build_ocean(t: dict, grid):
     if kind == "file":
         return gridded.open_ocean_current(**_kwargs(t, "ocean", [gridded.open_ocean_current, gridded.open_gridded],
                                                      ("variables", "quantity")))
+    if kind == "function":
+        return _function_field(t, "ocean")
     return _vector_expr(t, "ocean")
 
 
@@ -166,11 +226,12 @@ def build_air_temperature(t: dict, grid, t_end, seed):
 
 
 def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
+    """The model's forces and optional components from the scene (None when not asked for)."""
     parts = {"forces": [], "thermo": None, "healing": None, "mover": None, "remesher": None}
     fc = cfg["forcing"]
     seed = cfg["run"]["seed"]
     law = cfg["healing"]["law"]
-    if law == "none":
+    if law == "none" and hasattr(rheology.params, "healing_time_s"):
         rheology.params = rheology.params.replace(healing_time_s=None)
     need_grid = any(fc[k] is not None for k in ("wind", "ocean", "air_temperature"))
     grid = _grid(mesh, fc["grid_spacing_m"]) if need_grid else None
@@ -198,11 +259,7 @@ def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
         from thermo.model_adapters import ThermoComponent
         from thermo.zero_layer import ThermoParams, ZeroLayerThermo
 
-        try:
-            params = ThermoParams(**cfg["thermo"]["params"])
-        except TypeError as exc:
-            raise ConfigError(f"[thermo.params]: {exc}") from None
-        parts["thermo"] = ThermoComponent(air, ZeroLayerThermo(params))
+        parts["thermo"] = ThermoComponent(air, ZeroLayerThermo(ThermoParams(**cfg["thermo"]["params"])))
     if law in ("thermodynamic", "fdd"):
         from thermo.healing import FreezingDegreeDayHealing, ThermodynamicHealing
         from thermo.model_adapters import HealingComponent
@@ -216,69 +273,20 @@ def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
 
         parts["healing"] = HealingComponent(h, air, dt_s=parse_duration(cfg["solver"]["dt"], "solver.dt"))
     if cfg["lagrangian"]["enabled"]:
-        parts["mover"] = build_mover(cfg, mesh)
+        from ..lagrangian import MeshMotion
+
+        lg = cfg["lagrangian"]
+        parts["mover"] = MeshMotion(lg["min_area_ratio"], lg["max_halvings"])
     if cfg["remesh"]["enabled"]:
-        parts["remesher"] = build_remesher(cfg, mesh, parts["mover"])
+        parts["remesher"] = build_remesher(cfg)
     return parts
 
 
-class Mover:
-    """Lagrangian mesh motion (:func:`lagice.lagrangian.move_mesh`) with its
-    budget (outflow, ridging, limited nodes) carried in checkpoints."""
-
-    def __init__(self):
-        from ..lagrangian import new_budget
-
-        self.budget = new_budget()
-        self.last_flagged = None
-
-    def advance(self, state, dt_s):
-        from ..lagrangian import move_mesh
-
-        rep = move_mesh(state, dt_s, self.budget)
-        self.last_flagged = rep.flagged_elements
-        return rep
-
-    def checkpoint_meta(self):
-        return {"budget": self.budget}
-
-    def load_checkpoint(self, arrays, meta):
-        self.budget.update(meta.get("budget", {}))
-
-
-class Remesher:
-    """Remesh check after each move (:func:`lagice.remesh.remesh_if_needed`),
-    target size = the scene's initial resolution, fixed in space."""
-
-    def __init__(self, size_field, mover, min_angle_deg=10.0, **params):
-        from ..remesh import RemeshLog, TriggerParams
-
-        self.size_field = size_field
-        self.mover = mover
-        try:
-            self.trigger = TriggerParams(min_angle_deg=min_angle_deg, **{k: v for k, v in params.items()
-                                                                         if k in TriggerParams.__dataclass_fields__})
-        except TypeError as exc:
-            raise ConfigError(f"[remesh.params]: {exc}") from None
-        self.options = {k: v for k, v in params.items() if k not in TriggerParams.__dataclass_fields__}
-        self.log = RemeshLog()
-
-    def __call__(self, state, solver):
-        from ..remesh import remesh_if_needed
-
-        return remesh_if_needed(state, self.size_field, solver=solver, params=self.trigger,
-                                flagged=self.mover.last_flagged if self.mover else None, log=self.log,
-                                **self.options)
-
-
-def build_mover(cfg, mesh):
-    return Mover()
-
-
-def build_remesher(cfg, mesh, mover=None):
+def build_remesher(cfg):
+    from ..remesh import Remesher
     from .config import spatial_values
 
     res = cfg["domain"]["resolution_m"]
     size = res if not isinstance(res, str) else (
         lambda x, y: spatial_values(res, np.atleast_1d(x), np.atleast_1d(y), "domain.resolution_m"))
-    return Remesher(size, mover, cfg["remesh"]["min_angle_deg"], **cfg["remesh"]["params"])
+    return Remesher(size, cfg["remesh"]["min_angle_deg"], **cfg["remesh"]["params"])

@@ -33,24 +33,29 @@ SCHEMA = {
     "domain": {
         "kind": (str, "rectangle"), "width_m": (NUM, None), "height_m": (NUM, None),
         "x0_m": (NUM, 0.0), "y0_m": (NUM, 0.0), "vertices": (list, None), "islands": (list, []),
-        "file": (str, None), "resolution_m": (EXPR, None), "exterior_tag": (str, "coast"),
-        "segments": (dict, {}),
+        "file": (str, None), "function": (str, None), "params": (dict, {}),
+        "resolution_m": (EXPR, None), "exterior_tag": (str, "coast"),
+        "segments": (dict, {}), "rotate_deg": (NUM, 0.0), "renumber": (bool, False),
     },
     "initial": {
         "thickness_m": (EXPR, 1.0), "concentration": (EXPR, 1.0), "damage": (EXPR, 0.0),
-        "snow_m": (EXPR, None), "cohesion_pa": (EXPR, "random"),
+        "snow_m": (EXPR, None), "cohesion_pa": (EXPR, "random"), "stress_pa": (EXPR, 0.0),
     },
     "rheology": {
+        "law": (str, "maxwell_eb"),
         "poisson": (NUM, 0.3), "friction": (NUM, 0.7), "rho_ice": (NUM, 900.0),
         "shear_wave_speed": (NUM, 500.0), "young_modulus_pa": (NUM, None),
         "relaxation_time_s": (NUM, 1e7), "alpha": (NUM, 4.0), "cohesion_min_pa": (NUM, 25e3),
         "cohesion_max_pa": (NUM, 50e3), "healing_time_s": (NUM, 1e5), "concentration_c": (NUM, 20.0),
         "max_damage": (NUM, 1.0 - 1e-6),
+        "p_star": (NUM, 27.5e3), "c_star": (NUM, 20.0), "ellipse": (NUM, 2.0), "delta_min": (NUM, 2e-9),
+        "replacement_pressure": (bool, False),
     },
     "solver": {
         "name": (str, "implicit"), "dt": (EXPR, None), "substeps": (int, None),
         "linear_solver": (str, None), "tol": (NUM, None), "max_iter": (int, None),
-        "allow_unstable": (bool, False),
+        "allow_unstable": (bool, False), "safety": (NUM, None), "parallel": (bool, None),
+        "velocity": (str, None), "velocity_params": (dict, {}),
     },
     "boundary": {"*": {"u": (EXPR, None), "v": (EXPR, None)}},
     "forcing": {
@@ -60,15 +65,28 @@ SCHEMA = {
     },
     "thermo": {"enabled": (bool, False), "params": (dict, {})},
     "healing": {"law": (str, "constant"), "params": (dict, {})},
-    "lagrangian": {"enabled": (bool, False)},
+    "lagrangian": {"enabled": (bool, False), "min_area_ratio": (NUM, 0.05), "max_halvings": (int, 8)},
     "remesh": {"enabled": (bool, False), "min_angle_deg": (NUM, 10.0), "params": (dict, {})},
     "run": {"duration": (EXPR, None), "seed": (int, 0), "progress": (bool, True),
             "start_date": (str, "2000-01-01 00:00:00")},
-    "output": {"every": (EXPR, "1d"), "vtu": (bool, False), "crs_epsg": (int, 3413), "plot": (bool, True),
-               "grid_resolution_m": (NUM, None)},
+    "output": {"every": (EXPR, "1d"), "vtu": (bool, False), "crs_epsg": (int, 3413), "plot": ((bool, str), True),
+               "grid_resolution_m": (NUM, None), "timeseries": (dict, None)},
     "checkpoint": {"every": (EXPR, None), "keep": (int, 3)},
     "drifters": {"positions_m": (list, None), "count": (int, 0)},
 }
+
+#: rheology keys of each law (``[rheology] law``); keys of the other law are not used
+RHEOLOGY_KEYS = {
+    "maxwell_eb": ("poisson", "friction", "rho_ice", "shear_wave_speed", "young_modulus_pa", "relaxation_time_s",
+                   "alpha", "cohesion_min_pa", "cohesion_max_pa", "healing_time_s", "concentration_c",
+                   "max_damage"),
+    "viscous_plastic": ("p_star", "c_star", "ellipse", "delta_min", "replacement_pressure", "rho_ice"),
+}
+
+#: config keys that do not change the trajectory of a run (left out of the checkpoint
+#: fingerprint, so a run can be extended, re-scheduled or re-described on resume)
+NON_PHYSICS = {"scene": ("name", "description", "extends", "source"), "run": ("duration", "progress"),
+               "output": None, "checkpoint": None}
 
 SCENE_DIR = Path(__file__).resolve().parents[2] / "examples"
 _MODFUNC = re.compile(r"^[A-Za-z_][\w.]*:[A-Za-z_]\w*$")
@@ -211,6 +229,28 @@ def read_raw_scene(path: Path, _chain=()) -> dict:
     return merged
 
 
+def physics_view(cfg: dict) -> dict:
+    """The part of a scene configuration that determines the trajectory: everything
+    but :data:`NON_PHYSICS` (run length, output and checkpoint schedules, names).
+    Forcing generators whose records depend on the run length (``random`` and
+    ``cyclones`` winds, ``synthetic`` air temperature draw their schedule over the
+    whole run) keep ``run.duration`` in the view."""
+    out = {}
+    for table, val in cfg.items():
+        if table.startswith("_"):
+            continue
+        drop = NON_PHYSICS.get(table, ())
+        if drop is None:
+            continue
+        out[table] = {k: v for k, v in val.items() if k not in drop} if isinstance(val, dict) else val
+    fc = cfg.get("forcing", {})
+    by_length = (((fc.get("wind") or {}).get("kind") in ("random", "cyclones"))
+                 or ((fc.get("air_temperature") or {}).get("kind") == "synthetic"))
+    if by_length:
+        out["run"]["duration"] = cfg["run"]["duration"]
+    return out
+
+
 def load_scene(name_or_path, overrides=None) -> dict:
     """Read, override and validate a scene; returns the full config dict."""
     path = scene_path(name_or_path)
@@ -226,6 +266,45 @@ def load_scene(name_or_path, overrides=None) -> dict:
 _NP_NAMES = {name: getattr(np, name) for name in (
     "sin", "cos", "tan", "exp", "log", "log10", "sqrt", "abs", "tanh", "arctan2", "hypot", "where",
     "minimum", "maximum", "clip", "pi", "sign", "floor", "ceil", "ones_like", "zeros_like")}
+
+
+def list_scenes() -> dict:
+    """Bundled scenes: ``{name: (path, description)}`` from ``examples/*.toml``."""
+    out = {}
+    for p in sorted(SCENE_DIR.glob("*.toml")) if SCENE_DIR.exists() else []:
+        try:
+            raw = read_raw_scene(p)
+        except ConfigError:
+            continue
+        sc = raw.get("scene", {}) if isinstance(raw.get("scene"), dict) else {}
+        out[sc.get("name") or p.stem] = (p, sc.get("description", ""))
+    return out
+
+
+def resolve_hook(spec: str, key: str, params: dict | None = None):
+    """The function named by ``"module:function"`` with ``params`` bound as keyword
+    arguments (a ConfigError names ``key`` when it cannot be imported)."""
+    import functools
+
+    if not isinstance(spec, str) or not _MODFUNC.match(spec):
+        raise ConfigError(f"{key} = {spec!r}: expected 'module:function'")
+    f = resolve_callable(spec, key)
+    if params:
+        if not isinstance(params, dict):
+            raise ConfigError(f"{key} params = {params!r}: expected a table of keyword arguments")
+        import inspect
+
+        try:
+            sig = inspect.signature(f)
+        except (TypeError, ValueError):
+            sig = None
+        if sig is not None and not any(p.kind == p.VAR_KEYWORD for p in sig.parameters.values()):
+            for k in params:
+                if k not in sig.parameters:
+                    raise ConfigError(f"{key}: {spec} takes no parameter {k!r}; known: "
+                                      f"{sorted(n for n in sig.parameters if n not in ('t', 'x', 'y'))}")
+        f = functools.partial(f, **params)
+    return f
 
 
 def resolve_callable(spec: str, key: str):

@@ -41,49 +41,17 @@ import time
 import numpy as np
 from numba import njit, prange
 
-from ..errors import ConfigError, SolverError
 from .._numba import PARALLEL_MIN_SIZE, serial_copy
-from ..fem import element_strain_rate, strain_rate, strain_rate_serial
+from ..errors import ConfigError, SolverError
+from ..fem import STRAIN_RATE, NodeSystem, element_strain_rate, solve_node_2x2
 from ..forces import explicit_terms
 from ..rheology import MaxwellEB, _dcrit, damage_step
 from ..state import IceState
-from .base import LumpedMassSolver, StepInfo
+from .base import StepInfo
 
 
 #: keys of ``ExplicitSolver.kernel_timings`` / ``StepInfo.kernel_timings`` [s]
 KERNELS = ("forcing", "setup", "node_velocity", "element_stress_damage")
-
-
-@njit(cache=True, inline="always")
-def solve_node_2x2(a11, a12, a21, a22, rx, ry, fixed_u, fixed_v, pu, pv):
-    """New velocity (u, v) of one node from the 2×2 system [[a11, a12], [a21, a22]]
-    (u, v) = (rx, ry), with u = pu where ``fixed_u`` or v = pv where ``fixed_v``
-    (a prescribed component; callers handle both fixed). 0 for a singular system."""
-    if fixed_u:
-        return pu, ((ry - a21 * pu) / a22 if a22 != 0.0 else 0.0)
-    if fixed_v:
-        return ((rx - a12 * pv) / a11 if a11 != 0.0 else 0.0), pv
-    det = a11 * a22 - a12 * a21
-    if det != 0.0:
-        return (a22 * rx - a12 * ry) / det, (a11 * ry - a21 * rx) / det
-    return 0.0, 0.0
-
-
-def _adjacency_weights(tri, b, c, area, h, ptr, elems, local):
-    """Per adjacency entry p (node i, element e, local vertex k): area·h·∂φk/∂x and
-    area·h·∂φk/∂y [m² per m], so that the internal force on node i is
-    f_i = −Σ_p (wb σxx + wc σxy, wb σxy + wc σyy)."""
-    n = ptr.shape[0] - 1
-    wb = np.empty(elems.shape[0])
-    wc = np.empty(elems.shape[0])
-    for i in prange(n):
-        for p in range(ptr[i], ptr[i + 1]):
-            e = elems[p]
-            k = local[p]
-            w = area[e] * h[e]
-            wb[p] = w * b[e, k]
-            wc[p] = w * c[e, k]
-    return wb, wc
 
 
 def _node_velocity(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
@@ -200,9 +168,6 @@ def _serial(func):
     return serial_copy(func, error_model="numpy")
 
 
-adjacency_weights = njit(cache=True, parallel=True)(_adjacency_weights)
-adjacency_weights_serial = _serial(_adjacency_weights)
-
 #: compiled variants: parallel (numba prange over own entities, no races) and serial
 #: (cheaper below ~PARALLEL_MIN_ELEMENTS, and on a loaded machine where fork/join waits)
 node_velocity_kernel = njit(cache=True, parallel=True, error_model="numpy")(_node_velocity)
@@ -213,35 +178,36 @@ element_stress_damage_kernel_serial = _serial(_element_stress_damage)
 PARALLEL_MIN_ELEMENTS = PARALLEL_MIN_SIZE
 
 
-class ExplicitSolver(LumpedMassSolver):
-    """Explicit (sub-stepped, lumped-mass) Maxwell-EB solver.
+class ExplicitSolver:
+    """Explicit (sub-stepped, lumped-mass) Maxwell-EB time stepper.
 
     Args:
         rheology: :class:`~lagice.rheology.MaxwellEB`.
         mesh: the mesh (node positions are read at each :meth:`update_geometry`).
-        bcs: list of :class:`~lagice.solvers.base.VelocityBC`; coast nodes are no-slip.
+        bcs: list of :class:`~lagice.boundary.VelocityBC`; coast nodes are no-slip.
         forces: external forces (:mod:`lagice.forces`: ``WindStress``,
             ``OceanDrag``, ``Coriolis`` or anything with ``add_explicit_terms``).
         substeps: N elastic sub-steps per outer step, or None: the smallest N with
             Δt/N ≤ ``safety`` × the measured stability limit (:mod:`lagice.stability`).
-        heal_rate: callable ``(state) -> (m,) [s-1]`` or None for the rheology's constant rate.
+        heal_rate: callable ``(state, t_s) -> (m,) [s-1]`` or None for the rheology's
+            constant rate.
         safety: fraction of the measured sub-step limit used when ``substeps`` is None.
         allow_unstable: run (with a :class:`~lagice.stability.StabilityWarning`)
             when Δt_s is beyond the measured limit instead of raising ConfigError.
         parallel: True/False, or None (default): parallel kernels from
-            ``PARALLEL_MIN_ELEMENTS`` elements up (fork/join costs more than it
-            saves on small meshes; measured in ``benchmarks/bench_explicit.py``).
+            ``PARALLEL_MIN_ELEMENTS`` elements up.
 
     After a step, ``state.velocity`` is the last sub-step's velocity (the dynamic
-    state), :attr:`mean_velocity` the mean over the sub-steps (what nodes move
-    with: it filters the elastic waves that the sub-steps resolve) and
-    :attr:`last_strain_rate` the strain rate of that mean velocity.
+    state, carried in checkpoints), :attr:`transport_velocity` the mean over the
+    sub-steps (the velocity whose Δt-integral is the displacement the sub-steps
+    integrated: nodes and drifters move with it) and :attr:`last_strain_rate` its
+    strain rate.
 
     Per-kernel wall times [s] are accumulated in :attr:`kernel_timings` and
     returned per step in ``StepInfo.kernel_timings``; ``StepInfo.timings`` maps
     them onto the implicit solver's keys (assembly = forcing + setup,
-    solve = node_velocity, damage = element_stress_damage) so scenes can sum
-    either. ``StepInfo.iterations`` is the number of sub-steps.
+    solve = node_velocity, damage = element_stress_damage).
+    ``StepInfo.iterations`` is the number of sub-steps.
     """
 
     name = "explicit"
@@ -250,7 +216,8 @@ class ExplicitSolver(LumpedMassSolver):
                  heal_rate=None, safety: float = 0.7, allow_unstable: bool = False,
                  parallel: bool | None = None):
         if not isinstance(rheology, MaxwellEB):
-            raise ConfigError(f"rheology must be MaxwellEB; got {type(rheology).__name__}")
+            raise ConfigError(f"the explicit stepper solves the Maxwell-EB rheology; got "
+                              f"{type(rheology).__name__} (use solver 'evp' for viscous-plastic)")
         if substeps is not None:
             if int(substeps) != substeps or int(substeps) < 1:
                 raise ConfigError(f"substeps = {substeps!r} must be an integer >= 1 (or None: automatic)")
@@ -258,25 +225,50 @@ class ExplicitSolver(LumpedMassSolver):
         if not 0.0 < safety <= 1.0:
             raise ConfigError(f"safety = {safety!r} must be in (0, 1]")
         self.rheology = rheology
-        self.bcs = list(bcs)
         self.forces = list(forces)
         self.substeps = substeps
         self.safety = float(safety)
         self.allow_unstable = bool(allow_unstable)
         self.heal_rate = heal_rate
-        self.parallel = parallel
         self.kernel_timings = {k: 0.0 for k in KERNELS}
         self._checked = set()
-        self.last_strain_rate = None
-        self.mean_velocity = None
+        self._transport = None
+        self._strain_rate = None
         self.last_substeps = None
-        self.reset_topology(mesh)
+        self.nodes = NodeSystem(mesh, bcs, parallel, geometry_hook=self._geometry_extras)
 
-    # -- geometry/topology caches ------------------------------------------------
-    def _geometry_extras(self) -> None:
-        """td and the smallest element size after nodes moved (Lagrangian step)."""
-        self.td = self.rheology.damage_time(np.sqrt(2.0 * self.area))
-        self.dx_min = float(np.sqrt(2.0 * self.area.min()))
+    # -- geometry/topology (the node system owns the caches) ----------------------------
+    @property
+    def mesh(self):
+        return self.nodes.mesh
+
+    @property
+    def area(self):
+        return self.nodes.area
+
+    @property
+    def transport_velocity(self):
+        return self._transport
+
+    @property
+    def last_strain_rate(self):
+        return self._strain_rate
+
+    def reset_topology(self, mesh) -> None:
+        """Rebuild everything that depends on connectivity (after a remesh)."""
+        self._transport = None
+        self._strain_rate = None
+        self.nodes.reset_topology(mesh)
+
+    def update_geometry(self) -> None:
+        """Recompute shape gradients, areas, td after nodes moved (Lagrangian step)."""
+        self.nodes.update_geometry()
+
+    def _geometry_extras(self, ns) -> None:
+        """td and the smallest element size after nodes moved."""
+        area = ns.area
+        self.td = self.rheology.damage_time(np.sqrt(2.0 * area))
+        self.dx_min = float(np.sqrt(2.0 * area.min()))
 
     # -- sub-step choice -------------------------------------------------------------
     def substeps_for(self, dt: float, E_max: float | None = None) -> int:
@@ -304,32 +296,34 @@ class ExplicitSolver(LumpedMassSolver):
         self._checked.add(key)
 
     # -- one step -----------------------------------------------------------------
-    def step(self, state: IceState, dt: float) -> StepInfo:
+    def step(self, state: IceState, t_s: float, dt: float) -> StepInfo:
         if not dt > 0:
             raise ConfigError(f"dt = {dt!r} s must be > 0")
         kt = {k: 0.0 for k in KERNELS}
-        mesh, p = self.mesh, self.rheology.params
+        ns = self.nodes
+        mesh, p = ns.mesh, self.rheology.params
         t0 = time.perf_counter()
         E, lam = self.rheology.moduli(state.damage, state.concentration)
         E_max = float(E.max()) if len(E) else p.E0
         n_sub = self.substeps_for(dt, E_max)
         dt_s = dt / n_sub
         self._check_stability(dt_s, E_max)
-        t_new = state.time_s + dt
+        t_new = t_s + dt
         terms = explicit_terms(self.forces, t_new, mesh.nodes)
-        pres0 = self._prescribed_velocity(state.time_s)
-        pres1 = self._prescribed_velocity(t_new)
+        pres0 = ns.prescribed_velocity(t_s)
+        pres1 = ns.prescribed_velocity(t_new)
         t1 = time.perf_counter()
         kt["forcing"] = t1 - t0
 
         ptr, elems, _ = mesh.node_elements
         tri = mesh.triangles
-        h, mass, wb, wc, m_dt, fext, cda, par = self._node_setup(state, terms, p.rho_ice, dt_s, True)
-        half_mf = 0.5 * mass * terms.coriolis
+        su = ns.setup(state.thickness, terms, p.rho_ice, dt_s, True)
+        par = su.parallel
+        half_mf = 0.5 * su.mass * terms.coriolis
         e_dt = dt_s * E
         gamma = lam / (lam + dt_s)
         rh = self.rheology
-        heal = (self.heal_rate(state) if self.heal_rate is not None
+        heal = (self.heal_rate(state, t_s) if self.heal_rate is not None
                 else self.rheology.constant_heal_rate(mesh.n_elements))
         heal = np.ascontiguousarray(heal, np.float64)
         nu = p.poisson
@@ -350,13 +344,14 @@ class ExplicitSolver(LumpedMassSolver):
         tn = tm = 0.0
         node_k = node_velocity_kernel if par else node_velocity_kernel_serial
         elem_k = element_stress_damage_kernel if par else element_stress_damage_kernel_serial
+        b, c = ns.b, ns.c
         for k in range(n_sub):
             ta = time.perf_counter()
-            node_k(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, terms.current,
-                   terms.cos_turn, terms.sin_turn, half_mf, self.fixed, pres0, pres1, (k + 1) / n_sub)
+            node_k(vel, vel_sum, sigma, ptr, elems, su.wb, su.wc, su.m_dt, su.fext, su.cda, terms.current,
+                   terms.cos_turn, terms.sin_turn, half_mf, ns.fixed, pres0, pres1, (k + 1) / n_sub)
             tb = time.perf_counter()
             n_capped += elem_k(
-                tri, self.b, self.c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, self.td, heal,
+                tri, b, c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, self.td, heal,
                 e_dt, gamma, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0,
                 p.relaxation_time_s, float(p.alpha), flag)
             tc = time.perf_counter()
@@ -370,11 +365,8 @@ class ExplicitSolver(LumpedMassSolver):
         state.velocity = vel
         state.stress = sigma
         state.damage = damage
-        state.time_s = t_new
-        state.step += 1
-        self.mean_velocity = vel_sum / n_sub
-        self.last_strain_rate = (strain_rate if par else strain_rate_serial)(tri, self.b, self.c,
-                                                                            self.mean_velocity)
+        self._transport = vel_sum / n_sub
+        self._strain_rate = STRAIN_RATE[int(par)](tri, b, c, self._transport)
         self.last_substeps = n_sub
         rh.n_capped_total += int(n_capped)
         for k, v in kt.items():

@@ -44,7 +44,10 @@ class ImplicitSolver:
         linear_solver: ``"cg"`` (default, measured fastest), ``"superlu"``, ``"amg"``.
         tol: fixed-point tolerance on the relative constitutive residual.
         max_iter: fixed-point iteration limit (reaching it is reported, not an error).
-        heal_rate: callable ``(state) -> (m,) [s-1]`` or None for the rheology's constant rate.
+        heal_rate: callable ``(state, t_s) -> (m,) [s-1]`` or None for the rheology's constant rate.
+
+    The transport velocity is the end-of-step velocity u^{n+1} (backward Euler:
+    x^{n+1} = x^n + Δt u^{n+1}); :attr:`last_strain_rate` is its strain rate.
     """
 
     name = "implicit"
@@ -52,7 +55,8 @@ class ImplicitSolver:
     def __init__(self, rheology: MaxwellEB, mesh, bcs=(), forces=(), linear_solver: str = "cg",
                  tol: float = 1e-8, max_iter: int = 30, linear_rtol: float = 1e-10, heal_rate=None):
         if not isinstance(rheology, MaxwellEB):
-            raise ConfigError(f"rheology must be MaxwellEB; got {type(rheology).__name__}")
+            raise ConfigError(f"the implicit stepper solves the Maxwell-EB rheology; got "
+                              f"{type(rheology).__name__} (use solver 'evp' for viscous-plastic)")
         if not tol > 0:
             raise ConfigError(f"tol = {tol!r} must be > 0")
         if int(max_iter) < 1:
@@ -64,13 +68,19 @@ class ImplicitSolver:
         self.max_iter = int(max_iter)
         self.heal_rate = heal_rate
         self.linear = LinearSolver(linear_solver, rtol=linear_rtol)
+        self._transport = None
         self.reset_topology(mesh)
+
+    @property
+    def transport_velocity(self):
+        return self._transport
 
     # -- geometry/topology caches ------------------------------------------------
     def reset_topology(self, mesh) -> None:
         """Rebuild everything that depends on connectivity (after a remesh)."""
         self.mesh = mesh
         self.last_strain_rate = None  # belonged to the old mesh
+        self._transport = None
         self.pattern = SparsityPattern(mesh.triangles, mesh.n_nodes)
         self.dirichlet = DirichletSet(mesh, self.bcs)
         self.entry_prescribed = (self.dirichlet.mask[self.pattern.row_of]
@@ -87,13 +97,13 @@ class ImplicitSolver:
         self.td = self.rheology.damage_time(np.sqrt(2.0 * self.area))
 
     # -- one step -----------------------------------------------------------------
-    def step(self, state: IceState, dt: float) -> StepInfo:
+    def step(self, state: IceState, t_s: float, dt: float) -> StepInfo:
         if not dt > 0:
             raise ConfigError(f"dt = {dt!r} s must be > 0")
         info = StepInfo()
         tm = info.timings
         mesh, p = self.mesh, self.rheology.params
-        t_new = state.time_s + dt
+        t_new = t_s + dt
         ptr, elems, local = mesh.node_elements
         h = state.thickness
         n_el = mesh.n_elements
@@ -159,7 +169,7 @@ class ImplicitSolver:
         if not np.all(np.isfinite(vel)):
             raise SolverError(f"non-finite velocity at t = {t_new:.6g} s")
         with Timer(tm, "damage"):
-            heal = (self.heal_rate(state) if self.heal_rate is not None
+            heal = (self.heal_rate(state, t_s) if self.heal_rate is not None
                     else self.rheology.constant_heal_rate(mesh.n_elements))
             n_before = self.rheology.n_capped_total
             dc = self.rheology.damage_update(sigma, state.damage, state.cohesion, dt, self.td, heal)
@@ -167,8 +177,7 @@ class ImplicitSolver:
             info.n_capped = self.rheology.n_capped_total - n_before
         state.velocity = vel
         state.stress = sigma
-        state.time_s = t_new
-        state.step += 1
+        self._transport = vel
         self.last_strain_rate = eps
         return info
 

@@ -18,9 +18,9 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from ._numba import pick, serial_copy
-from .errors import ConfigError
-from .params import MaxwellEBParams
+from .._numba import pick, serial_copy
+from ..errors import ConfigError
+from ..params import MaxwellEBParams
 
 
 def plane_stress_matrix(poisson: float) -> np.ndarray:

@@ -1,0 +1,240 @@
+"""Scheduled activities of a :class:`~lagice.simulation.Simulation`.
+
+Everything that happens during a run besides the model step is an activity with
+a schedule (:mod:`lagice.schedule`): output writers, the checkpointer, progress
+reports, the NaN/Inf checker, user callbacks and stop conditions. After every
+outer step the simulation calls each activity whose schedule is due, in the order
+they were added (the NaN checker first, so nothing non-finite is ever written).
+
+An activity has ``name``, ``schedule`` and
+
+* ``initialize(sim)`` — once before the loop (a fresh or a resumed run);
+* ``__call__(sim)`` — when the schedule is due;
+* ``finalize(sim)`` — once after the loop (``at_end`` activities run then too,
+  when they did not just run).
+"""
+from __future__ import annotations
+
+import math
+import sys
+import time
+from pathlib import Path
+
+from .errors import SolverError
+from .schedule import IterationInterval, WallTimeInterval, parse_schedule
+
+
+class Activity:
+    """Base class (see the module docstring)."""
+
+    name = "activity"
+    at_end = False      # also run once after the last step (if not just run)
+    at_start = False    # also run before the first step of a fresh run
+
+    def __init__(self, schedule):
+        self.schedule = parse_schedule(schedule, f"{self.name} every")
+        self.last_iteration = None
+
+    def initialize(self, sim) -> None:
+        self.schedule.initialize(sim.model)
+        if self.at_start and sim.model.clock.iteration == 0:
+            self.run(sim)
+
+    def run(self, sim) -> None:
+        self(sim)
+        self.last_iteration = sim.model.clock.iteration
+
+    def __call__(self, sim) -> None:
+        raise NotImplementedError
+
+    def finalize(self, sim) -> None:
+        if self.at_end and self.last_iteration != sim.model.clock.iteration:
+            self.run(sim)
+
+
+class SnapshotOutput(Activity):
+    """UGRID/CF snapshot files (:class:`lagice.io.snapshots.SnapshotWriter`), written
+    at the start of a fresh run, when due, and at the end."""
+
+    name = "snapshots"
+    at_start = True
+    at_end = True
+
+    def __init__(self, schedule, writer):
+        super().__init__(schedule)
+        self.writer = writer
+
+    def __call__(self, sim):
+        self.writer.write(sim.model)
+
+
+class GridOutput(SnapshotOutput):
+    """Regular-grid conservative averages (:class:`lagice.io.gridded.GridWriter`)."""
+
+    name = "grid"
+
+
+class VTUOutput(SnapshotOutput):
+    """VTU files and a ``.pvd`` collection (:class:`lagice.io.vtu.VTUWriter`)."""
+
+    name = "vtu"
+
+
+class TimeSeriesOutput(Activity):
+    """Named scalar diagnostics (:class:`lagice.io.timeseries.TimeSeriesWriter`):
+    recorded when due (and at the start), written at every checkpoint and at the end."""
+
+    name = "timeseries"
+    at_start = True
+    at_end = True
+
+    def __init__(self, schedule, writer):
+        super().__init__(schedule)
+        self.writer = writer
+
+    def initialize(self, sim):
+        if sim.model.clock.iteration > 0:
+            self.writer.reload(sim.model.clock.time_s)
+        super().initialize(sim)
+
+    def __call__(self, sim):
+        self.writer.record(sim.model)
+
+    def finalize(self, sim):
+        super().finalize(sim)
+        self.writer.flush()
+
+
+class Checkpointer(Activity):
+    """Checkpoints (:func:`lagice.io.checkpoint.write_checkpoint`), the last ``keep``
+    kept. Flushes the time-series writers first so their files match the checkpoint."""
+
+    name = "checkpointer"
+
+    def __init__(self, schedule, directory, keep: int = 3):
+        from .errors import ConfigError
+
+        if isinstance(keep, bool) or int(keep) != keep or int(keep) < 1:
+            raise ConfigError(f"checkpoint.keep = {keep!r} must be an integer >= 1")
+        super().__init__(schedule)
+        self.directory = Path(directory)
+        self.keep = int(keep)
+
+    def __call__(self, sim):
+        for act in sim.activities.values():
+            if isinstance(act, TimeSeriesOutput):
+                act.writer.flush()
+        sim.write_checkpoint()
+
+
+class Progress(Activity):
+    """A progress line every ``every`` of wall time: simulated day, percentage, rate
+    (simulated days per wall hour, over this session's steps only, so it is right
+    after a resume), ETA, remesh count and the volume budget."""
+
+    name = "progress"
+    at_end = True
+
+    def __init__(self, schedule="wall 10s", stream=None):
+        super().__init__(schedule)
+        self.stream = stream
+        self._t0 = None
+        self._sim0 = None
+
+    def initialize(self, sim):
+        super().initialize(sim)
+        self._t0 = time.perf_counter()
+        self._sim0 = sim.model.clock.time_s
+
+    def __call__(self, sim):
+        m = sim.model
+        wall = time.perf_counter() - self._t0
+        done = m.clock.time_s - self._sim0
+        rate = done / 86400.0 / wall * 3600.0 if wall > 0 else float("nan")
+        frac = m.clock.time_s / sim.stop_time if sim.stop_time else float("nan")
+        left = sim.stop_time - m.clock.time_s if sim.stop_time else float("nan")
+        eta = left / done * wall if done > 0 else float("nan")
+        b = m.volume_budget()
+        eta_s = _fmt_wall(eta) if math.isfinite(eta) else "?"
+        print(f"  day {m.clock.time_s / 86400.0:7.3f}  {100 * frac:5.1f} %  step {m.clock.iteration}/{sim.n_steps}  "
+              f"{rate:8.1f} sim-days/wall-hour  ETA {eta_s}  remeshes {m.state.counters.get('remesh_count', 0)}  "
+              f"volume {b['current_m3']:.4e} m3 (thermo {b['thermodynamic_m3']:+.2e}, outflow "
+              f"{b['outflow_m3']:.2e}, drift {b['relative_residual']:+.1e})",
+              file=self.stream or sys.stdout, flush=True)
+
+
+def _fmt_wall(s: float) -> str:
+    s = max(0.0, s)
+    if s < 90:
+        return f"{s:.0f} s"
+    if s < 5400:
+        return f"{s / 60:.1f} min"
+    return f"{s / 3600:.1f} h"
+
+
+class NaNChecker(Activity):
+    """Stops the run with :class:`~lagice.errors.SolverError` naming the field, the
+    step, the element or node (index and position) of the first NaN/Inf in the state
+    (fields from the registry, :mod:`lagice.fields`). Runs every step by default."""
+
+    name = "nan_checker"
+
+    def __init__(self, schedule=None):
+        super().__init__(schedule if schedule is not None else IterationInterval(1))
+
+    def __call__(self, sim):
+        from .fields import NODE, first_non_finite
+
+        bad = first_non_finite(sim.model.state)
+        if bad is None:
+            return
+        spec, idx, val = bad
+        m = sim.model
+        mesh = m.mesh
+        where = (mesh.nodes[idx] if spec.location == NODE else mesh.nodes[mesh.triangles[idx]].mean(axis=0))
+        raise SolverError(
+            f"non-finite {spec.name} ({val}) at step {m.clock.iteration} (t = {m.clock.time_s:g} s) in "
+            f"{spec.location} {idx} at x = {where[0]:.0f} m, y = {where[1]:.0f} m; the run was stopped "
+            f"(the last checkpoint is untouched). An unstable time step or sub-step is the usual cause.")
+
+
+class Callback(Activity):
+    """A user function ``fn(sim)`` called when due."""
+
+    name = "callback"
+
+    def __init__(self, fn, schedule, name: str | None = None):
+        super().__init__(schedule)
+        self.fn = fn
+        if name:
+            self.name = name
+
+    def __call__(self, sim):
+        self.fn(sim)
+
+
+class StopCondition(Activity):
+    """Stops the run (after the current step) when ``condition(sim)`` is true; the
+    reason is kept in ``sim.stop_reason``. Checked every step by default."""
+
+    name = "stop_condition"
+
+    def __init__(self, condition, reason: str = "stop condition met", schedule=None):
+        super().__init__(schedule if schedule is not None else IterationInterval(1))
+        self.condition = condition
+        self.reason = reason
+
+    def __call__(self, sim):
+        if self.condition(sim):
+            sim.request_stop(self.reason)
+
+
+class WallTimeLimit(StopCondition):
+    """Stops the run (after a checkpoint, if the simulation has a checkpointer) once
+    ``limit`` of wall time has passed — for batch queues."""
+
+    name = "wall_time_limit"
+
+    def __init__(self, limit):
+        sched = WallTimeInterval(limit, "run.wall_time_limit")
+        super().__init__(lambda sim: True, f"wall-time limit of {sched.interval:g} s reached", sched)

@@ -1,0 +1,59 @@
+"""Component ``remeshing``: after the mesh moved, check the trigger and remesh
+distorted patches (:func:`lagice.remesh.remesh_if_needed`), with the target size
+field of the scene's initial resolution, fixed in space."""
+from __future__ import annotations
+
+from ..errors import ConfigError
+from .trigger import TriggerParams
+
+#: options of :func:`lagice.remesh.remesh_if_needed` a scene may set in ``[remesh.params]``
+REMESH_OPTIONS = ("rings", "max_retries", "max_patch_fraction", "algorithm", "remap_method", "damage_remap")
+
+
+class Remesher:
+    """Remesh check after each move; events are appended to :attr:`log` and counted in
+    ``state.counters`` (``remesh_count``, ``mesh_epoch``).
+
+    Args:
+        size_field: target element size [m] (number or vectorised ``f(x, y)``).
+        min_angle_deg: trigger on any angle below this [deg].
+        **params: :class:`~lagice.remesh.trigger.TriggerParams` fields and the
+            options in :data:`REMESH_OPTIONS`; anything else is a ConfigError naming it.
+    """
+
+    name = "remeshing"
+
+    def __init__(self, size_field, min_angle_deg=10.0, **params):
+        from . import RemeshLog
+
+        known = set(TriggerParams.__dataclass_fields__) | set(REMESH_OPTIONS)
+        for k in params:
+            if k not in known:
+                raise ConfigError(f"unknown key remesh.params.{k}; known keys: {sorted(known)}")
+        self.size_field = size_field
+        try:
+            self.trigger = TriggerParams(min_angle_deg=min_angle_deg,
+                                         **{k: v for k, v in params.items() if k in TriggerParams.__dataclass_fields__})
+        except (TypeError, ValueError) as exc:
+            raise ConfigError(f"[remesh.params]: {exc}") from None
+        self.options = {k: v for k, v in params.items() if k in REMESH_OPTIONS}
+        self.log = RemeshLog()
+
+    def advance(self, model, dt_s: float):
+        from . import remesh_if_needed
+
+        st = model.state
+        motion = model.component("mesh_motion")
+        ev = remesh_if_needed(st, self.size_field, solver=model.stepper, params=self.trigger,
+                              flagged=motion.last_flagged if motion is not None else None, log=self.log,
+                              time_s=model.clock.time_s + dt_s, step=model.clock.iteration + 1, **self.options)
+        if ev is not None and ev.kind != "failed":
+            st.counters["remesh_count"] = st.counters.get("remesh_count", 0) + 1
+            st.counters["mesh_epoch"] = st.counters.get("mesh_epoch", 0) + 1
+        return ev
+
+    def checkpoint_state(self):
+        return {}, {"n_events": len(self.log)}
+
+    def restore(self, arrays, meta):
+        pass

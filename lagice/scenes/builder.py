@@ -1,0 +1,394 @@
+"""Build and run a scene (see :mod:`lagice.scenes.config` for the schema).
+
+``build_simulation(config, out_dir)`` is the checkpoint *builder*: a checkpoint
+stores the validated config and ``"lagice.scenes.builder:build_simulation"``, so
+``lagice resume CHECKPOINT`` rebuilds the same model and continues. Every scene
+(bundled or a user's TOML file) and every benchmark goes through this builder and
+:class:`~lagice.simulation.Simulation`: there is no other time loop.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import shapely
+from shapely.geometry import LineString, Polygon, shape
+
+from ..errors import ConfigError, check_range
+from ..mesh import generate_mesh, rectangle_domain, renumber_for_locality, rotate_mesh
+from ..model import Model
+from ..params import MaxwellEBParams
+from ..rheology import MaxwellEB, ViscousPlastic, ViscousPlasticParams, draw_cohesion
+from ..schedule import parse_duration, parse_schedule
+from ..simulation import Simulation
+from ..solvers import SOLVER_RHEOLOGY, SOLVERS, VelocityBC
+from ..state import IceState
+from . import components
+from .config import (RHEOLOGY_KEYS, load_scene, physics_view, resolve_hook, spatial_values,
+                     time_space_callable)
+
+BUILDER = "lagice.scenes.builder:build_simulation"
+ROOT = Path(__file__).resolve().parents[2]
+
+
+# -- domain ------------------------------------------------------------------------
+def build_domain(d: dict):
+    """(polygon, segments {tag: geometry}, exterior_tag, size) from [domain]."""
+    kind = d["kind"]
+    segs = {}
+    if kind == "rectangle":
+        for k in ("width_m", "height_m"):
+            if d[k] is None:
+                raise ConfigError(f"domain.{k} is required for a rectangle domain")
+            check_range(f"domain.{k}", d[k], 0.0, None, low_open=True, unit="m")
+        poly, sides = rectangle_domain(d["width_m"], d["height_m"], d["x0_m"], d["y0_m"])
+    elif kind == "polygon":
+        if not d["vertices"]:
+            raise ConfigError("domain.vertices is required for a polygon domain ([[x, y], ...] in m)")
+        try:
+            poly = Polygon(d["vertices"], d["islands"])
+        except (ValueError, TypeError) as exc:
+            raise ConfigError(f"domain.vertices/islands: not a polygon: {exc}") from exc
+        sides = {}
+    elif kind == "file":
+        if not d["file"]:
+            raise ConfigError("domain.file is required for a file domain (GeoJSON polygon in metres)")
+        p = Path(d["file"])
+        if not p.is_absolute() and not p.exists():
+            p = ROOT / d["file"]
+        if not p.exists():
+            raise ConfigError(f"domain.file = {d['file']!r}: file not found")
+        try:
+            gj = json.loads(p.read_text())
+            geom = shape(gj["features"][0]["geometry"] if "features" in gj else gj.get("geometry", gj))
+        except Exception as exc:  # noqa: BLE001
+            raise ConfigError(f"domain.file = {d['file']!r}: cannot read a GeoJSON polygon: {exc}") from exc
+        if geom.geom_type == "MultiPolygon":
+            geom = max(geom.geoms, key=lambda g: g.area)
+        poly, sides = geom, {}
+    elif kind == "function":
+        if not d["function"]:
+            raise ConfigError("domain.function = 'module:function' is required for a function domain")
+        res = resolve_hook(d["function"], "domain.function", d["params"])()
+        poly, sides = (res if isinstance(res, tuple) else (res, {}))
+        if not isinstance(poly, Polygon):
+            raise ConfigError(f"domain.function = {d['function']!r} returned {type(poly).__name__}; "
+                              f"expected a shapely Polygon (or (polygon, sides))")
+    else:
+        raise ConfigError(f"domain.kind = {kind!r}: expected 'rectangle', 'polygon', 'file' or 'function'")
+    for tag, spec in d["segments"].items():
+        if isinstance(spec, str):
+            if spec not in sides:
+                raise ConfigError(f"domain.segments.{tag} = {spec!r}: expected one of {sorted(sides)} "
+                                  "or a list of [x, y] points")
+            segs[tag] = sides[spec]
+        elif isinstance(spec, list):
+            try:
+                segs[tag] = LineString(spec)
+            except (ValueError, TypeError) as exc:
+                raise ConfigError(f"domain.segments.{tag}: not a line: {exc}") from exc
+        else:
+            raise ConfigError(f"domain.segments.{tag} = {spec!r}: expected a side name or [[x, y], ...]")
+    if d["resolution_m"] is None:
+        raise ConfigError("domain.resolution_m is required (target element size in m, or an expression in x, y)")
+    res = d["resolution_m"]
+    if isinstance(res, str):
+        size = lambda x, y: spatial_values(res, np.atleast_1d(x), np.atleast_1d(y), "domain.resolution_m")  # noqa: E731
+    else:
+        check_range("domain.resolution_m", res, 0.0, None, low_open=True, unit="m")
+        size = res
+    return poly, segs, d["exterior_tag"], size
+
+
+def build_mesh(cfg: dict):
+    """The scene's mesh (gmsh), rotated and renumbered as asked; also returns the polygon."""
+    d = cfg["domain"]
+    poly, segs, ext_tag, size = build_domain(d)
+    mesh = generate_mesh(poly, size, segments=segs, exterior_tag=ext_tag)
+    if d["renumber"]:
+        mesh = renumber_for_locality(mesh)[0]
+    if d["rotate_deg"]:
+        c = poly.centroid
+        mesh = rotate_mesh(mesh, d["rotate_deg"], (c.x, c.y))
+        poly = shapely.affinity.rotate(poly, d["rotate_deg"], origin=c)
+    for tag in cfg["boundary"]:
+        mesh.tag_id(tag)  # unknown boundary tag -> ConfigError naming it
+    return mesh, poly
+
+
+# -- checks before any mesh work ---------------------------------------------------
+def time_step_s(cfg: dict) -> float:
+    """The outer step [s]: ``solver.dt`` as a duration, or ``"td"`` for the damage time
+    scale of the nominal element size, Δt = Δx/cs (Dansereau et al. 2016)."""
+    dt = cfg["solver"]["dt"]
+    if dt is None:
+        raise ConfigError("solver.dt is required (e.g. '10min', seconds, or 'td' for Δx/cs)")
+    if dt == "td":
+        res = cfg["domain"]["resolution_m"]
+        if not isinstance(res, (int, float)):
+            raise ConfigError("solver.dt = 'td' needs a numeric domain.resolution_m (Δt = Δx/cs)")
+        check_range("domain.resolution_m", res, 0.0, None, low_open=True, unit="m")
+        check_range("rheology.shear_wave_speed", cfg["rheology"]["shear_wave_speed"], 0.0, None, low_open=True,
+                    unit="m s-1")
+        return float(res) / float(cfg["rheology"]["shear_wave_speed"])
+    return parse_duration(dt, "solver.dt")
+
+
+def build_rheology(cfg: dict):
+    rp = cfg["rheology"]
+    law = rp["law"]
+    if law == "maxwell_eb":
+        return MaxwellEB(MaxwellEBParams(**{k: rp[k] for k in RHEOLOGY_KEYS[law]}))
+    if law == "viscous_plastic":
+        return ViscousPlastic(ViscousPlasticParams(**{k: rp[k] for k in RHEOLOGY_KEYS[law]}))
+    raise ConfigError(f"rheology.law = {law!r}: expected one of {sorted(RHEOLOGY_KEYS)}")
+
+
+def validate_config(cfg: dict) -> None:
+    """Every check that needs no mesh, so bad input fails before any work."""
+    if cfg["run"]["duration"] is None:
+        raise ConfigError("run.duration is required (e.g. '28d')")
+    duration = parse_duration(cfg["run"]["duration"], "run.duration")
+    dt = time_step_s(cfg)
+    n = duration / dt
+    if abs(n - round(n)) > 1e-9 * max(1.0, n) or round(n) < 1:
+        raise ConfigError(f"run.duration = {cfg['run']['duration']!r} is not a whole number (>= 1) of steps of "
+                          f"solver.dt = {dt:g} s")
+    rheo = build_rheology(cfg)
+    sv = cfg["solver"]
+    want = SOLVER_RHEOLOGY.get(sv["name"], "?")
+    if sv["name"] in SOLVERS and want is not None and rheo.name != want:
+        raise ConfigError(f"solver.name = {sv['name']!r} solves the {want} rheology, but rheology.law = "
+                          f"{cfg['rheology']['law']!r}; set rheology.law = {want!r}")
+    if sv["name"] == "evp" and cfg["healing"]["law"] not in ("none",):
+        raise ConfigError(f"healing.law = {cfg['healing']['law']!r}: the viscous-plastic rheology (solver 'evp') "
+                          f"has no damage to heal; set healing.law = 'none'")
+    if sv["name"] == "prescribed" and cfg["healing"]["law"] != "none":
+        raise ConfigError("solver 'prescribed' updates no damage: set healing.law = 'none'")
+    solver_options(cfg)
+    parse_schedule(cfg["output"]["every"], "output.every")
+    if cfg["checkpoint"]["every"] is not None:
+        parse_schedule(cfg["checkpoint"]["every"], "checkpoint.every")
+    if isinstance(cfg["checkpoint"]["keep"], bool) or cfg["checkpoint"]["keep"] < 1:
+        raise ConfigError(f"checkpoint.keep = {cfg['checkpoint']['keep']!r}: expected an integer >= 1")
+    timeseries_diagnostics(cfg)
+    if isinstance(cfg["output"]["plot"], str):
+        resolve_hook(cfg["output"]["plot"], "output.plot")
+    if cfg["output"]["grid_resolution_m"] is not None:
+        check_range("output.grid_resolution_m", cfg["output"]["grid_resolution_m"], 0.0, None, low_open=True,
+                    unit="m")
+    dr = cfg["drifters"]
+    if dr["count"] < 0:
+        raise ConfigError(f"drifters.count = {dr['count']}: expected an integer >= 0")
+    if dr["positions_m"] is not None:
+        arr = np.asarray(dr["positions_m"], dtype=object)
+        if arr.ndim != 2 or arr.shape[1] != 2:
+            raise ConfigError(f"drifters.positions_m: expected a list of [x, y] pairs in m; got {dr['positions_m']!r}")
+    d = cfg["domain"]
+    known_tags = set(d["segments"]) | {d["exterior_tag"], "coast"}
+    for tag, bc in cfg["boundary"].items():
+        if tag not in known_tags:
+            raise ConfigError(f"[boundary.{tag}]: unknown boundary tag {tag!r}; this domain has tags "
+                              f"{sorted(known_tags)} (name segments in [domain.segments])")
+        for comp in ("u", "v"):
+            if bc[comp] is not None:
+                time_space_callable(bc[comp], f"boundary.{tag}.{comp}")
+    probe = np.array([0.5 * (d.get("width_m") or 1.0)]), np.array([0.5 * (d.get("height_m") or 1.0)])
+    for key, val in cfg["initial"].items():
+        if val is None or (key == "cohesion_pa" and val == "random"):
+            continue
+        if key == "stress_pa" and isinstance(val, str) and ":" in val:
+            resolve_hook(val, "initial.stress_pa")
+            continue
+        spatial_values(val, *probe, f"initial.{key}")
+    components.validate(cfg)
+
+
+def timeseries_diagnostics(cfg: dict) -> dict | None:
+    """``{name: ScalarDiagnostic}`` of ``[output.timeseries]`` (None when not asked for)."""
+    ts = cfg["output"]["timeseries"]
+    if ts is None:
+        return None
+    from ..io.timeseries import BUILTIN, ScalarDiagnostic
+
+    for k in ts:
+        if k not in ("every", "diagnostics"):
+            raise ConfigError(f"unknown key output.timeseries.{k}; known keys: ['diagnostics', 'every']")
+    if "every" not in ts:
+        raise ConfigError("output.timeseries.every is required (e.g. '1h' or '1 steps')")
+    parse_schedule(ts["every"], "output.timeseries.every")
+    names = ts.get("diagnostics", [])
+    if not isinstance(names, list) or not names:
+        raise ConfigError(f"output.timeseries.diagnostics = {names!r}: expected a non-empty list of built-in "
+                          f"names {sorted(BUILTIN)} or 'module:function' hooks")
+    out = {}
+    for n in names:
+        if not isinstance(n, str):
+            raise ConfigError(f"output.timeseries.diagnostics: {n!r} is not a name")
+        if n in BUILTIN:
+            out[n] = BUILTIN[n]
+        else:
+            f = resolve_hook(n, "output.timeseries.diagnostics")
+            out[n.partition(":")[2]] = ScalarDiagnostic(f, getattr(f, "units", "1"), getattr(f, "long_name", ""))
+    return out
+
+
+def solver_options(cfg: dict) -> dict:
+    """The [solver] options the named stepper's constructor accepts; a set option it
+    does not accept is an error naming it."""
+    import inspect
+
+    sv = cfg["solver"]
+    if sv["name"] not in SOLVERS:
+        raise ConfigError(f"solver.name = {sv['name']!r}: expected one of {sorted(SOLVERS)}")
+    accepted = set(inspect.signature(SOLVERS[sv["name"]].__init__).parameters)
+    opts = {}
+    for k in ("linear_solver", "tol", "max_iter", "substeps", "allow_unstable", "safety", "parallel"):
+        if sv[k] is None or (k == "allow_unstable" and sv[k] is False):
+            continue
+        if k not in accepted:
+            raise ConfigError(f"solver.{k} does not apply to solver {sv['name']!r}")
+        opts[k] = sv[k]
+    if sv["velocity"] is not None or sv["velocity_params"]:
+        if "velocity" not in accepted:
+            raise ConfigError(f"solver.velocity applies to solver 'prescribed' only, not {sv['name']!r}")
+        if sv["velocity"] is None:
+            raise ConfigError("solver.velocity_params needs solver.velocity = 'module:function'")
+        opts["velocity"] = resolve_hook(sv["velocity"], "solver.velocity", sv["velocity_params"])
+    elif sv["name"] == "prescribed":
+        raise ConfigError("solver 'prescribed' needs solver.velocity = 'module:function' (f(t, x, y) -> (u, v))")
+    return opts
+
+
+# -- the model -----------------------------------------------------------------------
+def initial_state(cfg: dict, mesh, rheo, rng) -> IceState:
+    c = mesh.centroids()
+    x, y = c[:, 0], c[:, 1]
+    ini = cfg["initial"]
+    coh = ini["cohesion_pa"]
+    if coh == "random":
+        if not isinstance(rheo, MaxwellEB):
+            cohesion = np.zeros(mesh.n_elements)
+        else:
+            cohesion = draw_cohesion(mesh.n_elements, rheo.params, rng)
+    else:
+        cohesion = spatial_values(coh, x, y, "initial.cohesion_pa")
+    state = IceState.uniform(
+        mesh, thickness_m=spatial_values(ini["thickness_m"], x, y, "initial.thickness_m"),
+        concentration=spatial_values(ini["concentration"], x, y, "initial.concentration"),
+        damage=spatial_values(ini["damage"], x, y, "initial.damage"), cohesion_pa=cohesion)
+    if ini["snow_m"] is not None:
+        state.snow = spatial_values(ini["snow_m"], x, y, "initial.snow_m")
+    sp = ini["stress_pa"]
+    if isinstance(sp, str) and ":" in sp:
+        stress = np.asarray(resolve_hook(sp, "initial.stress_pa")(x, y), np.float64)
+        if stress.shape != (mesh.n_elements, 3):
+            raise ConfigError(f"initial.stress_pa = {sp!r} returned shape {stress.shape}; expected "
+                              f"({mesh.n_elements}, 3) (σxx, σyy, σxy per element, Pa)")
+        state.stress = np.ascontiguousarray(stress)
+    else:  # isotropic
+        s = spatial_values(sp, x, y, "initial.stress_pa")
+        state.stress = np.ascontiguousarray(np.column_stack([s, s, np.zeros_like(s)]))
+    state.validate()
+    return state
+
+
+def build_model(cfg: dict) -> Model:
+    validate_config(cfg)
+    mesh, poly = build_mesh(cfg)
+    rng = np.random.default_rng(cfg["run"]["seed"])
+    rheo = build_rheology(cfg)
+    state = initial_state(cfg, mesh, rheo, rng)
+    bcs = []
+    for tag, bc in cfg["boundary"].items():
+        kw = {comp: (time_space_callable(bc[comp], f"boundary.{tag}.{comp}") if isinstance(bc[comp], str)
+                     else bc[comp]) for comp in ("u", "v")}
+        bcs.append(VelocityBC(tag, **kw))
+    duration = parse_duration(cfg["run"]["duration"], "run.duration")
+    parts = components.build(cfg, mesh, state, rheo, duration)
+    opts = solver_options(cfg)
+    return Model(state, rheology=rheo, solver=cfg["solver"]["name"], solver_options=opts, bcs=bcs,
+                 forces=parts["forces"], thermo=parts["thermo"], healing=parts["healing"],
+                 mover=parts["mover"], remesher=parts["remesher"], drifters=build_drifters(cfg, poly),
+                 config=cfg, fingerprint_config=physics_view(cfg), rng=rng)
+
+
+def build_drifters(cfg, poly):
+    """Drifters at the given positions, or ``count`` seeded random points at
+    least 50 km inside the domain (None when none are asked for)."""
+    from ..drifters import Drifters
+
+    dr = cfg["drifters"]
+    if dr["positions_m"]:
+        return Drifters(dr["positions_m"])
+    if dr["count"] <= 0:
+        return None
+    inner = poly.buffer(-50e3)
+    if inner.is_empty:
+        inner = poly
+    rng = np.random.default_rng(cfg["run"]["seed"] + 7919)
+    minx, miny, maxx, maxy = inner.bounds
+    pts = []
+    while len(pts) < dr["count"]:
+        p = rng.uniform((minx, miny), (maxx, maxy))
+        if inner.contains(shapely.Point(p)):
+            pts.append(p)
+    return Drifters(pts)
+
+
+# -- the simulation ------------------------------------------------------------------
+def build_simulation(cfg: dict, out_dir=None, progress: bool | None = None) -> Simulation:
+    """Model + Simulation with the output, time-series and checkpoint activities of
+    the config, writing into ``out_dir`` (default ``runs/SCENE``)."""
+    model = build_model(cfg)
+    prog = cfg["run"]["progress"] if progress is None else progress
+    sim = Simulation(model, dt=time_step_s(cfg), stop=cfg["run"]["duration"], progress=prog, builder=BUILDER)
+    out = Path(out_dir) if out_dir is not None else Path("runs") / cfg["scene"]["name"]
+    sim.out_dir = out
+    oc = cfg["output"]
+    sim.output(oc["every"], out / "snapshots", crs_epsg=oc["crs_epsg"], vtu=oc["vtu"],
+               start_date=cfg["run"]["start_date"], grid_resolution_m=oc["grid_resolution_m"],
+               title=f"lagice {cfg['scene']['name']}: {cfg['scene']['description']}".rstrip(": "))
+    diags = timeseries_diagnostics(cfg)
+    if diags:
+        sim.add_timeseries(out / "timeseries.nc", diags, oc["timeseries"]["every"], cfg["run"]["start_date"])
+    if cfg["checkpoint"]["every"] is not None:
+        sim.checkpoint(cfg["checkpoint"]["every"], out / "checkpoints", keep=cfg["checkpoint"]["keep"])
+    return sim
+
+
+def run_scene(name_or_path, out_dir=None, overrides=None, progress=None) -> dict:
+    cfg = load_scene(name_or_path, overrides)
+    sim = build_simulation(cfg, out_dir, progress)
+    return finish(sim)
+
+
+def finish(sim: Simulation) -> dict:
+    """Run a (new or resumed) simulation to its end, then write the summary and the plot."""
+    summary = sim.run()
+    out = Path(sim.out_dir if sim.out_dir is not None else ".")
+    out.mkdir(parents=True, exist_ok=True)
+    cfg = sim.model.config
+    summary["scene"] = cfg["scene"]["name"]
+    dr = sim.model.drifters
+    res = {"summary": summary, "netcdf": out / "snapshots" / "index.json", "wall_s": summary["wall_s"],
+           "png": None, "out_dir": out}
+    (out / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
+    res["png"] = plot_scene(cfg, out, summary, dr)
+    return res
+
+
+def plot_scene(cfg: dict, out: Path, summary: dict | None = None, drifters=None):
+    """The scene's own figure: ``output.plot`` true (the standard run plot), false
+    (none) or a ``module:function`` hook ``f(run_dir, png_path, summary)``."""
+    spec = cfg["output"]["plot"]
+    if spec is False:
+        return None
+    png = Path(out) / f"{cfg['scene']['name']}.png"
+    if isinstance(spec, str):
+        return resolve_hook(spec, "output.plot")(Path(out), png, summary)
+    from ..plotting import plot_run
+
+    return plot_run(Path(out) / "snapshots", png, summary,
+                    trajectories=drifters.trajectories() if drifters is not None else None)

@@ -1,0 +1,38 @@
+"""Small helpers shared by the tests (imported as ``from helpers import ...``)."""
+import weakref
+
+_CLOCKS = weakref.WeakKeyDictionary()
+
+
+def step(stepper, state, dt):
+    """Advance a bare time stepper one step of ``dt`` [s], keeping the time of
+    ``state`` the way :class:`lagice.model.Model` keeps its clock (stepper unit
+    tests only; everything else goes through Model/Simulation)."""
+    clocks = _CLOCKS.setdefault(stepper, {})
+    t = clocks.get(id(state), 0.0)
+    info = stepper.step(state, t, dt)
+    clocks[id(state)] = t + dt
+    return info
+
+
+QUIET = {"run.progress": False, "output.plot": False}
+
+
+def scene_sim(name, out_dir, overrides=None):
+    """A Simulation of a bundled scene with ``overrides`` (quiet, no plot), writing to ``out_dir``."""
+    from lagice.scenes.builder import build_simulation
+    from lagice.scenes.config import load_scene
+
+    return build_simulation(load_scene(name, {**QUIET, **(overrides or {})}), out_dir)
+
+
+def series(sim, name):
+    """The recorded values of time-series diagnostic ``name`` after the initial record."""
+    import numpy as np
+
+    return np.array(sim.activities["timeseries"].writer.rows[name][1:])
+
+
+def compression_overrides(n_across=10, **kw):
+    """Overrides of the uniaxial_compression scene for N elements across the short edge."""
+    return {"domain.resolution_m": 100e3 / n_across, **kw}
