@@ -31,8 +31,7 @@ sys.path.insert(0, str(ROOT))
 import numba  # noqa: E402
 
 import forcing._numba_util as numba_util  # noqa: E402
-from forcing import (Forcing, RegularGrid, cyclone_wind, gyre_current, open_air_temperature,  # noqa: E402
-                     open_wind, random_cyclones)
+from forcing import Forcing, RegularGrid, cyclone_wind, gyre_current, open_air_temperature, open_wind, random_cyclones  # noqa: E402
 from thermo import synthetic_air_temperature  # noqa: E402
 
 DAY = 86400.0

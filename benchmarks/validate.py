@@ -50,7 +50,7 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import skew
 
-from lagice.diagnostics import summarise, velocity_gradients, spatial_scaling
+from lagice.diagnostics import spatial_scaling, summarise, velocity_gradients
 from lagice.diagnostics.faults import (
     angle_to_axis_deg,
     fault_orientations,
@@ -275,8 +275,8 @@ def analyse_compression(path: Path) -> dict:
 
 # -- figures and report ---------------------------------------------------------------
 def _fig(w, h):
-    from matplotlib.figure import Figure
     from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
     fig = Figure(figsize=(w, h))
     FigureCanvasAgg(fig)
     return fig

@@ -2,13 +2,20 @@
 
 See ``docs/forcing_thermo.md`` for the expected use.
 """
-from .base import (CallableField, ConstantField, Field, Forcing, ForcingValues, ScalarField,
-                   VectorField, as_field)
-from .gridded import (GriddedRecords, open_air_temperature, open_gridded, open_ocean_current,
-                      open_wind)
+from .base import CallableField, ConstantField, Field, Forcing, ForcingValues, ScalarField, VectorField, as_field
+from .gridded import GriddedRecords, open_air_temperature, open_gridded, open_ocean_current, open_wind
 from .records import InMemoryRecords, LonLatGrid, RecordField, RegularGrid
-from .synthetic import (Cyclone, cyclone_wind, gyre_current, ocean_at_rest, random_cyclones,
-                        random_wind, record_times, uniform_current, uniform_wind)
+from .synthetic import (
+                   Cyclone,
+                   cyclone_wind,
+                   gyre_current,
+                   ocean_at_rest,
+                   random_cyclones,
+                   random_wind,
+                   record_times,
+                   uniform_current,
+                   uniform_wind,
+)
 
 __all__ = [
     "Field", "ScalarField", "VectorField", "ConstantField", "CallableField", "as_field",

@@ -1,5 +1,5 @@
 """lagice: Lagrangian Maxwell-Elasto-Brittle sea-ice model."""
-__version__ = "0.1.0"
+__version__ = "0.2.0"  # the one version source (pyproject.toml reads it)
 
 from .errors import ConfigError, ForcingError, LagiceError, MeshError, RestartError, SolverError  # noqa: E402
 

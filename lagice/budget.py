@@ -50,7 +50,7 @@ class VolumeLedger:
         return {"initial_m3": self.initial_m3, "terms": dict(self.terms)}
 
     @classmethod
-    def from_dict(cls, d: dict) -> "VolumeLedger":
+    def from_dict(cls, d: dict) -> VolumeLedger:
         led = cls(d.get("initial_m3"))
         led.terms = {k: float(v) for k, v in d.get("terms", {}).items()}
         return led

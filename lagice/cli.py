@@ -95,7 +95,8 @@ def _info(args) -> int:
         arrays, meta = read_checkpoint(p)
         print(f"checkpoint {p}: step {meta['step']}, t = {meta['clock']['time_s']:.1f} s, "
               f"format {meta.get('format_version')}, lagice {meta.get('lagice_version')}, "
-              f"scene {meta.get('config', {}).get('scene', {}).get('name')}, fingerprint {meta.get('scene_fingerprint')}")
+              f"scene {meta.get('config', {}).get('scene', {}).get('name')}, "
+              f"fingerprint {meta.get('scene_fingerprint')}")
         for k, a in arrays.items():
             print(f"  {k}: {a.dtype} {a.shape}")
         return 0

@@ -102,7 +102,7 @@ class ExplicitTerms:
     has_drag: bool = False
 
     @classmethod
-    def zeros(cls, n: int) -> "ExplicitTerms":
+    def zeros(cls, n: int) -> ExplicitTerms:
         return cls(np.zeros((n, 2)), np.zeros(n), np.zeros((n, 2)), np.zeros(n))
 
 

@@ -142,6 +142,13 @@ class Model:
         t1 = time.perf_counter()
         self.timings["dynamics"] += t1 - t0
         report = {"solver": info}
+        if not np.all(np.isfinite(self.transport_velocity)):
+            # the dynamics blew up: components must not consume a non-finite velocity
+            # (mesh motion, gmsh); the simulation's NaN checker names the field and place
+            report["non_finite"] = True
+            self.clock.tick(dt_s)
+            self.last_report = report
+            return report
         for comp in self.components:
             report[comp.name] = comp.advance(self, dt_s)
             t2 = time.perf_counter()

@@ -75,7 +75,7 @@ class MaxwellEBParams:
         """Slope of the Mohr-Coulomb envelope, seed 004 eq. 3."""
         return (math.sqrt(self.friction**2 + 1.0) + self.friction) ** 2
 
-    def replace(self, **changes) -> "MaxwellEBParams":
+    def replace(self, **changes) -> MaxwellEBParams:
         names = {f.name for f in fields(self)}
         for k in changes:
             if k not in names:

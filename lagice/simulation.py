@@ -23,8 +23,17 @@ import time
 from pathlib import Path
 
 from . import __version__
-from .activities import (Activity, Callback, Checkpointer, GridOutput, NaNChecker, Progress, SnapshotOutput,
-                         TimeSeriesOutput, VTUOutput)
+from .activities import (
+    Activity,
+    Callback,
+    Checkpointer,
+    GridOutput,
+    NaNChecker,
+    Progress,
+    SnapshotOutput,
+    TimeSeriesOutput,
+    VTUOutput,
+)
 from .errors import ConfigError, RestartError
 from .io.checkpoint import FORMAT_VERSION, latest_valid_checkpoint, read_checkpoint, write_checkpoint
 from .schedule import parse_duration
@@ -40,11 +49,12 @@ class Simulation:
         progress: print a progress line every ``progress_every_s`` of wall time.
         builder: ``"module:function"`` that rebuilds this simulation from
             ``model.config`` (stored in checkpoints for :meth:`resume`).
-        nan_check: stop with a clear error at the first NaN/Inf in the state.
+        nan_check: stop with a clear error at the first NaN/Inf in the state, or at an
+            ice speed above ``max_speed_m_s`` [m s-1] (:class:`~lagice.activities.NaNChecker`).
     """
 
     def __init__(self, model, dt, stop, progress: bool = True, builder: str | None = None,
-                 progress_every_s: float = 10.0, nan_check: bool = True):
+                 progress_every_s: float = 10.0, nan_check: bool = True, max_speed_m_s: float = 10.0):
         self.model = model
         self.dt = parse_duration(dt, "dt")
         self.stop_time = parse_duration(stop, "stop")
@@ -56,7 +66,7 @@ class Simulation:
         self.builder = builder
         self.activities: dict[str, Activity] = {}
         if nan_check:
-            self.add(NaNChecker())
+            self.add(NaNChecker(max_speed_m_s=max_speed_m_s))
         if progress:
             self.add(Progress(f"wall {progress_every_s}s"))
         self.wall_total = 0.0
@@ -71,7 +81,7 @@ class Simulation:
         return self.stop_time
 
     # -- activities ----------------------------------------------------------------
-    def add(self, activity: Activity, name: str | None = None) -> "Simulation":
+    def add(self, activity: Activity, name: str | None = None) -> Simulation:
         """Add an activity (replacing one of the same name)."""
         name = name or activity.name
         if name in self.activities:
@@ -154,6 +164,8 @@ class Simulation:
             for act in acts:
                 if act.schedule(model):
                     act.run(self)
+            if model.last_report.get("non_finite"):
+                NaNChecker(1)(self)  # a run without a NaN checker still stops, with the same message
             if self._stop_requested:
                 break
         if self._stop_requested:
@@ -204,7 +216,7 @@ class Simulation:
                                 keep=c.keep)
 
     @classmethod
-    def resume(cls, checkpoint, model=None, builder=None, **builder_kw) -> "Simulation":
+    def resume(cls, checkpoint, model=None, builder=None, **builder_kw) -> Simulation:
         """Resume from a checkpoint file or a checkpoint directory (newest usable one).
 
         The model is rebuilt with the checkpoint's ``builder`` and ``config``

@@ -41,7 +41,7 @@ class IceState:
 
     @classmethod
     def uniform(cls, mesh: Mesh, *, thickness_m=1.0, concentration=1.0, cohesion_pa=None,
-                damage=0.0) -> "IceState":
+                damage=0.0) -> IceState:
         n, m = mesh.n_nodes, mesh.n_elements
 
         def field_of(name, v):

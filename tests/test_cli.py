@@ -13,6 +13,7 @@ def run_cli(*args, cwd=None):
                           cwd=cwd, timeout=600)
 
 
+@pytest.mark.slow
 def test_cli_run_compression(tmp_path):
     out = tmp_path / "run"
     r = run_cli("run", "uniaxial_compression", "--out", str(out), "--set", "domain.resolution_m=12500",
@@ -57,6 +58,7 @@ def test_cli_scenes_lists_every_bundled_scene_with_a_description():
         assert name in r.stdout and desc and desc in r.stdout
 
 
+@pytest.mark.slow
 def test_cli_diagnose_real_output(tmp_path):
     """``lagice diagnose`` on the snapshots of a real (moving-mesh) run writes
     diagnostics.json with the documented keys, and its invariants agree with

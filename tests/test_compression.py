@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from helpers import compression_overrides, scene_sim
 from lagice.errors import ConfigError
 from lagice.scenes.builder import finish
+
+from helpers import compression_overrides, scene_sim
 
 N = 10
 STRAIN_S = 1e5 / 5e-4  # seconds per unit macroscopic strain at U = 1 mm/s, L = 200 km
@@ -93,6 +94,7 @@ def test_healing_rebuilds_stress_after_drop(heal_run, noheal_run):
     assert heal_run["timeseries"]["mean_damage"][-1] < noheal_run["timeseries"]["mean_damage"][-1]
 
 
+@pytest.mark.slow
 def test_seed_reproducible_and_seed_dependent(tmp_path):
     kw = {"healing.law": "none"}
     a = compression_run(tmp_path / "a", 3.0e-4, **{**kw, "run.seed": 7})

@@ -5,9 +5,9 @@ import json
 import numpy as np
 import pytest
 
-from lagice.errors import ConfigError
 from lagice.diagnostics import JSON_KEYS, diagnose_arrays, summarise, write_json
 from lagice.diagnostics.synthetic import jittered_grid_mesh, slip_line_velocity
+from lagice.errors import ConfigError
 
 DT_S = 3 * 86400.0
 REQUIRED = [

@@ -37,7 +37,6 @@ analytic value; we assert 0.02 (and 2 % on the means).
 import numpy as np
 import pytest
 
-from lagice.errors import ConfigError
 from lagice.diagnostics import (
     coarse_grain,
     fit_power_law,
@@ -47,6 +46,7 @@ from lagice.diagnostics import (
     velocity_gradients,
 )
 from lagice.diagnostics.synthetic import jittered_grid_mesh, slip_line_velocity
+from lagice.errors import ConfigError
 
 L_M = 81e3
 S_M = 9e3

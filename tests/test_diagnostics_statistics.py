@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
-from lagice.errors import ConfigError
 from lagice.diagnostics import (
     fit_power_law_tail,
     localisation_area_fraction,
     log_binned_pdf,
     shear_divergence_r2,
 )
+from lagice.errors import ConfigError
 
 
 def pareto_sample(gamma, x_min, n, seed):

@@ -5,7 +5,6 @@ import pytest
 from scipy.linalg import expm
 from scipy.spatial import Delaunay
 
-from lagice.errors import ConfigError, LagiceError
 from lagice.diagnostics import (
     divergence_rate,
     lagrangian_velocity_gradients,
@@ -14,6 +13,7 @@ from lagice.diagnostics import (
     velocity_gradients,
 )
 from lagice.diagnostics.synthetic import jittered_grid_mesh
+from lagice.errors import ConfigError, LagiceError
 
 # A velocity gradient with divergence, shear and rotation (s-1)
 G = np.array([[2.0e-6, 3.0e-6], [-1.0e-6, -0.5e-6]])
@@ -26,7 +26,8 @@ def delaunay_mesh(n=400, size_m=50e3, seed=3):
     pts = np.vstack([rng.uniform(0, size_m, (n, 2)), [[0, 0], [size_m, 0], [0, size_m], [size_m, size_m]]])
     tri = Delaunay(pts).simplices.astype(np.int64)
     p = pts[tri]
-    cross = (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1]) - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1])
+    cross = ((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+             - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
     tri[cross < 0] = tri[cross < 0][:, [0, 2, 1]]
     return pts, tri
 
@@ -47,7 +48,8 @@ def analytic_invariants(g):
 def test_instantaneous_linear_field_is_exact(mesh):
     xy, tri = mesh
     r = velocity_gradients(xy, tri, xy @ G.T + C)
-    np.testing.assert_allclose(r.gradient_s, np.broadcast_to(G, r.gradient_s.shape), rtol=0, atol=1e-12 * np.abs(G).max() * 1e3)
+    np.testing.assert_allclose(r.gradient_s, np.broadcast_to(G, r.gradient_s.shape), rtol=0,
+                               atol=1e-12 * np.abs(G).max() * 1e3)
     div, shear, tot = analytic_invariants(G)
     np.testing.assert_allclose(r.divergence_s, div, rtol=1e-9)
     np.testing.assert_allclose(r.shear_s, shear, rtol=1e-9)
@@ -62,7 +64,8 @@ def test_lagrangian_affine_displacement_is_exact_on_start_geometry(mesh):
     dt = 3 * 86400.0
     xy1 = xy0 + dt * (xy0 @ G.T + C)
     r = lagrangian_velocity_gradients(xy0, xy1, tri, dt, geometry="start")
-    np.testing.assert_allclose(r.gradient_s, np.broadcast_to(G, r.gradient_s.shape), rtol=0, atol=1e-9 * np.abs(G).max())
+    np.testing.assert_allclose(r.gradient_s, np.broadcast_to(G, r.gradient_s.shape), rtol=0,
+                               atol=1e-9 * np.abs(G).max())
 
 
 def test_lagrangian_mid_geometry_is_second_order(mesh):

@@ -5,18 +5,19 @@ iteration, TOML selection."""
 import numpy as np
 import pytest
 
-from helpers import step
 from lagice.errors import ConfigError
 from lagice.forces import Coriolis, OceanDrag, WindStress, free_drift_velocity
 from lagice.mesh import generate_mesh, rectangle_domain
 from lagice.model import Model
 from lagice.params import RHO_AIR, coriolis_from_latitude
 from lagice.rheology import ViscousPlastic, principal_stresses
-from lagice.scenes.config import load_scene
 from lagice.scenes.builder import build_model
+from lagice.scenes.config import load_scene
 from lagice.solvers import SOLVERS, VelocityBC
 from lagice.solvers.evp import DELTA_MIN, EVPSolver, ice_strength, vp_stress_of
 from lagice.state import IceState
+
+from helpers import step
 
 E = 2.0  # ellipse ratio
 SIDES = ("bottom", "right", "top", "left")
@@ -240,6 +241,7 @@ def test_adaptive_converges_where_fixed_alpha_beta_stall():
     assert res[False][0] > 10 * res[True][0]
 
 
+@pytest.mark.slow
 def test_parallel_kernels_match_serial():
     """The prange kernels give the same result as their serial copies (each
     iteration is a pure gather; no reductions except the residual max)."""

@@ -6,15 +6,15 @@ import warnings
 import numpy as np
 import pytest
 
-from helpers import compression_overrides, scene_sim, series, step
 from lagice.errors import ConfigError
 from lagice.mesh import generate_mesh, rectangle_domain
 from lagice.rheology import MaxwellEB
 from lagice.solvers import SOLVERS, ExplicitSolver, VelocityBC
-from lagice.solvers.explicit import (element_stress_damage_kernel,
-                                     element_stress_damage_kernel_serial)
+from lagice.solvers.explicit import element_stress_damage_kernel, element_stress_damage_kernel_serial
 from lagice.stability import StabilityWarning, explicit_substep_limit, load_limits
 from lagice.state import IceState
+
+from helpers import compression_overrides, scene_sim, series, step
 
 G = np.array([[2e-8, 0.7e-8], [-0.3e-8, -1.1e-8]])  # velocity gradient [s-1]
 

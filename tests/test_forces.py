@@ -10,15 +10,15 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from helpers import step
 from lagice.errors import ConfigError, ForcingError
-from lagice.forces import (Coriolis, OceanDrag, WindStress, evaluate_vector, explicit_terms,
-                           free_drift_velocity)
+from lagice.forces import Coriolis, OceanDrag, WindStress, evaluate_vector, explicit_terms, free_drift_velocity
 from lagice.mesh import generate_mesh, rectangle_domain
 from lagice.params import RHO_AIR, RHO_WATER, coriolis_from_latitude
 from lagice.rheology import MaxwellEB
 from lagice.solvers import ExplicitSolver, ImplicitSolver
 from lagice.state import IceState
+
+from helpers import step
 
 RHO_H = 900.0  # ρi h [kg m-2] for h = 1 m
 WIND = (10.0, 5.0)  # m s-1

@@ -2,8 +2,7 @@
 import numpy as np
 import pytest
 
-from forcing import (ConstantField, Forcing, InMemoryRecords, RecordField, RegularGrid, as_field,
-                     open_gridded)
+from forcing import ConstantField, Forcing, InMemoryRecords, RecordField, RegularGrid, as_field, open_gridded
 from lagice.errors import ConfigError, ForcingError
 
 H6 = 6 * 3600.0

@@ -2,8 +2,18 @@
 import numpy as np
 import pytest
 
-from forcing import (Cyclone, RegularGrid, cyclone_wind, gyre_current, ocean_at_rest,
-                     random_cyclones, random_wind, record_times, uniform_current, uniform_wind)
+from forcing import (
+    Cyclone,
+    RegularGrid,
+    cyclone_wind,
+    gyre_current,
+    ocean_at_rest,
+    random_cyclones,
+    random_wind,
+    record_times,
+    uniform_current,
+    uniform_wind,
+)
 from lagice.errors import ConfigError
 
 H = 3600.0
@@ -24,7 +34,8 @@ def test_record_times():
 
 def test_uniform_wind_ramp_and_turn(grid):
     w = uniform_wind(grid, 2 * DAY, speed_m_s=10.0, direction_deg=0.0)
-    x = np.array([1e5, 5e5]); y = np.array([2e5, 7e5])
+    x = np.array([1e5, 5e5])
+    y = np.array([2e5, 7e5])
     assert np.allclose(w.evaluate(0.0, x, y), 0.0)
     np.testing.assert_allclose(w.evaluate(3 * H, x, y)[:, 0], [5.0, 0.0], atol=1e-12)  # half ramp
     np.testing.assert_allclose(w.evaluate(6 * H, x, y)[:, 0], [10.0, 0.0], atol=1e-12)
@@ -46,7 +57,7 @@ def test_cyclone_structure():
     c = Cyclone(x0_m=0.0, y0_m=0.0, radius_m=200e3, max_speed_m_s=20.0, inflow_angle_deg=20.0,
                 t_start_s=0.0, lifetime_s=2 * DAY)
     r = np.linspace(1e3, 1.5e6, 3001)
-    u, v = c.wind(DAY, r, 0.0 * r)  # mid-life: full strength; points on +x axis
+    u, v = c.wind(DAY, r, 0.0 * r)  # mid-life: full strength, points on +x axis
     speed = np.hypot(u, v)
     assert r[np.argmax(speed)] == pytest.approx(200e3, rel=1e-2)
     assert speed.max() == pytest.approx(20.0, rel=1e-4)
@@ -71,13 +82,15 @@ def test_cyclone_wind_several_and_deterministic(grid):
     # superposition: sum of single-system fields
     single = sum(cyclone_wind(grid, 3 * DAY, [c]).source.data for c in cs)
     np.testing.assert_allclose(w.source.data[:, 0] - 1.0, single[:, 0], atol=1e-12)
-    x = np.linspace(1e5, 9e5, 50); y = np.linspace(1e5, 7e5, 50)
+    x = np.linspace(1e5, 9e5, 50)
+    y = np.linspace(1e5, 7e5, 50)
     w.prepare(0.0, 3 * DAY, x, y)
     assert np.all(np.isfinite(w.evaluate(1.7 * DAY, x, y)))
 
 
 def test_ocean_currents(grid):
-    x = np.linspace(1e5, 9e5, 30); y = np.linspace(1e5, 7e5, 30)
+    x = np.linspace(1e5, 9e5, 30)
+    y = np.linspace(1e5, 7e5, 30)
     assert np.all(ocean_at_rest().evaluate(0.0, x, y) == 0.0)
     u = uniform_current(grid, 0.05, -0.02)
     u.prepare(0.0, 100 * DAY, x, y)  # steady: valid at all times

@@ -2,12 +2,13 @@
 import numpy as np
 import pytest
 
-from helpers import step
 from lagice.errors import ConfigError
 from lagice.mesh import generate_mesh, rectangle_domain
 from lagice.rheology import MaxwellEB
 from lagice.solvers import ImplicitSolver, VelocityBC
 from lagice.state import IceState
+
+from helpers import step
 
 G = np.array([[2e-8, 0.7e-8], [-0.3e-8, -1.1e-8]])  # velocity gradient [s-1]
 

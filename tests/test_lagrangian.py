@@ -2,11 +2,12 @@
 import numpy as np
 import pytest
 
-from helpers import compression_overrides, scene_sim, step
 from lagice.errors import ConfigError
 from lagice.lagrangian import fixed_node_mask, move_mesh, new_budget
 from lagice.mesh import generate_mesh, rectangle_domain
 from lagice.state import IceState
+
+from helpers import compression_overrides, scene_sim, step
 
 
 def _state(mesh, rng, conc=(0.5, 0.9)):

@@ -4,8 +4,7 @@ import pytest
 from shapely.geometry import LineString, Point, Polygon
 
 from lagice.errors import ConfigError, LagiceError, MeshError
-from lagice.mesh import (angles_deg, edge_lengths, generate_mesh, quality_report, read_mesh,
-                         rectangle_domain, write_mesh)
+from lagice.mesh import angles_deg, edge_lengths, generate_mesh, quality_report, read_mesh, rectangle_domain, write_mesh
 
 
 def island_domain():

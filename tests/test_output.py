@@ -8,8 +8,8 @@ import xarray as xr
 
 from lagice.io.gridded import conservative_grid_average
 from lagice.mesh import generate_mesh, rectangle_domain
-from lagice.scenes.config import load_scene
 from lagice.scenes.builder import build_simulation
+from lagice.scenes.config import load_scene
 
 FAST = {"run.duration": 800.0, "solver.dt": 40.0, "output.every": 400.0, "domain.resolution_m": 25e3,
         "run.progress": False, "output.plot": False, "boundary.top.u": "5e-2*minimum(1.0, t/600.0)",

@@ -119,7 +119,7 @@ def test_deterministic(small_mesh):
     for _ in range(2):
         rng = np.random.default_rng(7)
         st = _random_state(small_mesh.copy(), rng)
-        for k in range(5):
+        for _k in range(5):
             st.velocity = rng.normal(0.0, 1.0, (st.mesh.n_nodes, 2))
             rep = move_mesh(st, st.velocity, 1500.0)
             remesh_if_needed(st, 5e3, flagged=rep.flagged_elements)
@@ -136,10 +136,10 @@ def test_hundreds_of_events_conserve_totals_and_bounds(rng):
     n_events = 0
     worst = 0.0
     size = lambda x, y: 3e3 + 2e3 * x / 30e3  # noqa: E731 - graded size field, fixed in space
-    for trial in range(4):
+    for _trial in range(4):
         mesh = generate_mesh(poly, size, segments={"open": segs["right"]})
         st = _random_state(mesh, rng)
-        for k in range(60):
+        for _k in range(60):
             st.velocity = rng.normal(0.0, 1.0, (st.mesh.n_nodes, 2))
             rep = move_mesh(st, st.velocity, 300.0 + 300.0 * rng.random())
             flagged = np.union1d(rep.flagged_elements, rng.integers(0, st.mesh.n_elements, 2))
@@ -177,6 +177,7 @@ def test_patch_with_hole_and_island_domain(rng, tmp_path):
     of a domain with an island (the annulus of the shear_channel scene)."""
     from lagice.remesh import apply_remesh, remesh_region
     from lagice.remesh.patch import make_manifold, patch_boundary
+
     from helpers import scene_sim
 
     st = scene_sim("shear_channel", tmp_path, {"domain.resolution_m": 12e3}).model.state

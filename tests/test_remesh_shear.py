@@ -4,10 +4,11 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from helpers import scene_sim
 from lagice.mesh import signed_areas
 from lagice.remesh import totals
 from lagice.scenes.builder import finish
+
+from helpers import scene_sim
 
 
 class MinArea:
@@ -22,7 +23,6 @@ class MinArea:
         assert st.concentration.max() <= 1.0 and st.damage.max() < 1.0
 
 
-@pytest.mark.slow
 def test_ten_day_shear_channel_conserves_and_never_inverts(tmp_path):
     sim = scene_sim("shear_channel", tmp_path, {"solver.velocity_params.speed_m_s": 0.2, "output.every": "10d"})
     st = sim.model.state

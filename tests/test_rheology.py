@@ -6,7 +6,15 @@ import pytest
 
 from lagice.errors import ConfigError
 from lagice.params import MaxwellEBParams
-from lagice.rheology import MaxwellEB, dcrit, draw_cohesion, envelope, principal_stresses, relaxation_time, young_modulus
+from lagice.rheology import (
+    MaxwellEB,
+    dcrit,
+    draw_cohesion,
+    envelope,
+    principal_stresses,
+    relaxation_time,
+    young_modulus,
+)
 
 
 def rotate(s1, s2, theta):

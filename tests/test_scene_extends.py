@@ -5,8 +5,8 @@ from shapely.geometry import LineString
 
 from lagice.errors import ConfigError
 from lagice.mesh import generate_mesh
-from lagice.scenes.config import load_scene
 from lagice.scenes.builder import build_domain
+from lagice.scenes.config import load_scene
 
 
 def test_strait_scene_is_the_basin_plus_an_open_segment():

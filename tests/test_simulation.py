@@ -13,8 +13,8 @@ import xarray as xr
 
 from lagice.errors import ConfigError, RestartError
 from lagice.io.checkpoint import latest_valid_checkpoint, list_checkpoints, read_checkpoint, write_checkpoint
-from lagice.scenes.config import load_scene
 from lagice.scenes.builder import build_simulation
+from lagice.scenes.config import load_scene
 from lagice.simulation import Simulation
 
 FAST = {"run.duration": 1600.0, "solver.dt": 40.0, "output.every": 800.0, "checkpoint.every": 800.0,
@@ -188,7 +188,7 @@ def test_missing_scene_file():
 REMESH = {"run.duration": 6000.0, "solver.dt": 100.0, "output.every": 3000.0, "checkpoint.every": 3000.0,
           "domain.resolution_m": 25e3, "run.progress": False, "output.plot": False,
           "boundary.top.u": "20.0*minimum(1.0, t/600.0)", "lagrangian.enabled": True,
-          "remesh.enabled": True, "drifters.count": 3}
+          "remesh.enabled": True, "drifters.count": 3, "run.max_speed_m_s": 50.0}
 
 
 def test_resume_bit_identical_across_remeshing(tmp_path):

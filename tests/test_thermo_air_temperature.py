@@ -37,7 +37,8 @@ def test_seasonal_cycle_and_synoptic_variability(grid):
 
 
 def test_uniform_or_weak_gradient_through_forcing(grid):
-    x = np.array([1e5, 9e5]); y = np.array([5e5, 5e5])
+    x = np.array([1e5, 9e5])
+    y = np.array([5e5, 5e5])
     flat = Forcing(air_temperature=synthetic_air_temperature(grid, 10 * DAY, seed=0))
     flat.prepare(0.0, 10 * DAY, x, y)
     v = flat.evaluate(3.3 * DAY, x, y).air_temperature

@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from thermo import (ConstantHealing, FreezingDegreeDayHealing, ThermodynamicHealing, make_healing)
 from lagice.errors import ConfigError
+from thermo import ConstantHealing, FreezingDegreeDayHealing, ThermodynamicHealing, make_healing
 
 DAY = 86400.0
 

@@ -8,8 +8,14 @@ from lagice.budget import VolumeLedger
 from lagice.errors import ConfigError
 from lagice.mesh import generate_mesh, rectangle_domain
 from lagice.state import IceState
-from thermo import (ConstantHealing, FreezingDegreeDayHealing, HealingComponent, ThermoComponent,
-                    ThermodynamicHealing, synthetic_air_temperature)
+from thermo import (
+    ConstantHealing,
+    FreezingDegreeDayHealing,
+    HealingComponent,
+    ThermoComponent,
+    ThermodynamicHealing,
+    synthetic_air_temperature,
+)
 
 DAY = 86400.0
 

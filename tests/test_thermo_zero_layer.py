@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from thermo import ThermoParams, VolumeBudget, ZeroLayerThermo, build
 from lagice.errors import ConfigError, LagiceError
+from thermo import ThermoParams, VolumeBudget, ZeroLayerThermo, build
 
 DAY = 86400.0
 
@@ -29,16 +29,20 @@ def test_stefan_growth_constant_cold(h0, dt):
 def test_melt_snow_insulation_and_open_water():
     z = ZeroLayerThermo()
     # warm: melts; thin ice melts completely and is booked as congelation < 0
-    h = np.array([1.0, 0.02]); A = np.array([1.0, 1.0])
+    h = np.array([1.0, 0.02])
+    A = np.array([1.0, 1.0])
     tend = z.step(h, A, 3.0, DAY)
     assert h[0] < 1.0 and tend.congelation[0] < 0
     assert h[1] == 0.0 and A[1] == 0.0 and tend.total[1] == -0.02
     # snow insulates: slower growth
-    h = np.array([0.5, 0.5]); A = np.ones(2); hs = np.array([0.0, 0.3])
+    h = np.array([0.5, 0.5])
+    A = np.ones(2)
+    hs = np.array([0.0, 0.3])
     z.step(h, A, -20.0, DAY, hs=hs)
     assert h[1] < h[0]
     # open water: new ice at h0 thickness raises A
-    h = np.array([0.0]); A = np.array([0.0])
+    h = np.array([0.0])
+    A = np.array([0.0])
     tend = z.step(h, A, -20.0, 3600.0)
     p = z.params
     rho_l = p.rho_ice_kg_m3 * p.latent_heat_j_kg
@@ -46,7 +50,8 @@ def test_melt_snow_insulation_and_open_water():
     assert tend.new_ice[0] == pytest.approx(dv)
     assert A[0] == pytest.approx(dv / p.new_ice_thickness_m)
     # warm air over open water: nothing
-    h = np.array([0.0]); A = np.array([0.0])
+    h = np.array([0.0])
+    A = np.array([0.0])
     assert z.step(h, A, 5.0, DAY).total[0] == 0.0
 
 
@@ -54,11 +59,14 @@ def test_thin_ice_floor_booked():
     p = ThermoParams(min_ice_thickness_m=0.05, min_concentration=1e-3)
     z = ZeroLayerThermo(p)
     # thin ice compacts: volume kept, area shrinks to h/h_min
-    h = np.array([0.02]); A = np.array([1.0])
+    h = np.array([0.02])
+    A = np.array([1.0])
     tend = z.step(h, A, -1.8, 1.0)  # Ta = Tf: no growth
     assert h[0] == 0.02 and A[0] == pytest.approx(0.4) and tend.total[0] == 0.0
     # a trace of ice below min_concentration·h_min is removed and booked
-    h = np.array([1e-5]); A = np.array([0.5]); hs = np.array([1e-6])
+    h = np.array([1e-5])
+    A = np.array([0.5])
+    hs = np.array([1e-6])
     tend = z.step(h, A, -1.8, 1.0, hs=hs)
     assert h[0] == 0.0 and A[0] == 0.0 and hs[0] == 0.0
     assert tend.floor_removed[0] == -1e-5 and tend.total[0] == -1e-5 and tend.snow_removed[0] == -1e-6

@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from helpers import scene_sim
 from lagice.errors import ConfigError
 from lagice.scenes.builder import finish
 from lagice.scenes.hooks.wind_square import turning_wind, wind_components
+
+from helpers import scene_sim
 
 KW = {"domain.resolution_m": 50e3, "forcing.wind.params.ramp_h": 1.0, "forcing.wind.params.turn_h": 3.0,
       "run.seed": 3}

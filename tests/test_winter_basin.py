@@ -7,6 +7,8 @@ import numpy as np
 import pytest
 import xarray as xr
 
+pytestmark = pytest.mark.slow
+
 SHORT = ["domain.resolution_m=40e3", "run.duration=\"12h\"", "output.every=\"6h\"", "checkpoint.every=\"6h\"",
          "forcing.grid_spacing_m=50e3"]
 

@@ -5,8 +5,7 @@ for a component that is switched off, and the model skips it (no work).
 See ``docs/forcing_thermo.md``.
 """
 from .air_temperature import synthetic_air_temperature
-from .healing import (ConstantHealing, FreezingDegreeDayHealing, Healing, ThermodynamicHealing,
-                      make_healing)
+from .healing import ConstantHealing, FreezingDegreeDayHealing, Healing, ThermodynamicHealing, make_healing
 from .model_adapters import HealingComponent, ThermoComponent
 from .zero_layer import ThermoParams, ThermoTendencies, VolumeBudget, ZeroLayerThermo
 

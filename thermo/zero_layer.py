@@ -43,7 +43,6 @@ import numpy as np
 from numba import prange
 
 from forcing._numba_util import pick, serial_and_parallel
-
 from lagice.errors import ConfigError, LagiceError, check_range
 from lagice.params import RHO_ICE
 
@@ -92,7 +91,7 @@ class ThermoParams:
                     low_open=self.min_ice_thickness_m == 0.0, unit="m")
         check_range("min_concentration", self.min_concentration, 0.0, 1.0, high_open=True)
 
-    def replace(self, **changes) -> "ThermoParams":
+    def replace(self, **changes) -> ThermoParams:
         names = {f.name for f in fields(self)}
         for k in changes:
             if k not in names:

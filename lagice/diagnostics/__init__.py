@@ -14,14 +14,12 @@ applies equally to model output and to RGPS-like Lagrangian data:
 See ``docs/diagnostics.md``.
 """
 
-from lagice.diagnostics.strain import (
-    ElementStrainRates,
-    divergence_rate,
-    lagrangian_velocity_gradients,
-    shear_rate,
-    total_deformation_rate,
-    triangle_geometry,
-    velocity_gradients,
+from lagice.diagnostics.report import (
+    JSON_KEYS,
+    diagnose_arrays,
+    summarise,
+    write_figures,
+    write_json,
 )
 from lagice.diagnostics.scaling import (
     CoarseGraining,
@@ -42,12 +40,14 @@ from lagice.diagnostics.statistics import (
     log_binned_pdf,
     shear_divergence_r2,
 )
-from lagice.diagnostics.report import (
-    JSON_KEYS,
-    diagnose_arrays,
-    summarise,
-    write_figures,
-    write_json,
+from lagice.diagnostics.strain import (
+    ElementStrainRates,
+    divergence_rate,
+    lagrangian_velocity_gradients,
+    shear_rate,
+    total_deformation_rate,
+    triangle_geometry,
+    velocity_gradients,
 )
 
 __all__ = [

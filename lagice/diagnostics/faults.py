@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lagice.errors import ConfigError
 from lagice.diagnostics._checks import as_points, as_triangles, positive, values_1d
+from lagice.errors import ConfigError
 
 
 @dataclass(frozen=True)

@@ -10,8 +10,8 @@ import numpy as np
 
 
 def _figure(width_in=6.0, height_in=4.5, ncols=1):
-    from matplotlib.figure import Figure
     from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
     fig = Figure(figsize=(width_in * ncols, height_in))
     FigureCanvasAgg(fig)

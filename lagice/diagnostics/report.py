@@ -11,9 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lagice.errors import ConfigError
 from lagice.diagnostics._checks import as_points, as_triangles, choice, positive
-from lagice.diagnostics.strain import GEOMETRIES, _lagrangian
 from lagice.diagnostics.scaling import spatial_scaling, temporal_scaling
 from lagice.diagnostics.statistics import (
     fit_power_law_tail,
@@ -21,6 +19,8 @@ from lagice.diagnostics.statistics import (
     log_binned_pdf,
     shear_divergence_r2,
 )
+from lagice.diagnostics.strain import GEOMETRIES, _lagrangian
+from lagice.errors import ConfigError
 
 SCHEMA_VERSION = 1
 

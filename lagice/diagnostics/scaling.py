@@ -30,7 +30,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lagice.errors import ConfigError, check_range
 from lagice.diagnostics._checks import as_triangles, choice, positive
 from lagice.diagnostics.strain import (
     GEOMETRIES,
@@ -38,6 +37,7 @@ from lagice.diagnostics.strain import (
     _lagrangian,
     total_deformation_rate,
 )
+from lagice.errors import ConfigError, check_range
 
 
 @dataclass(frozen=True)

@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lagice.errors import ConfigError, check_range
 from lagice.diagnostics._checks import values_1d
+from lagice.errors import ConfigError, check_range
 
 
 @dataclass(frozen=True)

@@ -31,8 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lagice.errors import ConfigError
 from lagice.diagnostics._checks import as_points, as_triangles, choice, positive
+from lagice.errors import ConfigError
 
 GEOMETRIES = ("start", "mid", "end")
 

@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from lagice.errors import check_range
 from lagice.diagnostics._checks import positive
+from lagice.errors import check_range
 
 
 def jittered_grid_mesh(nx, ny, length_x_m, length_y_m, jitter=0.2, seed=0):

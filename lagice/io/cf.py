@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import os
 import subprocess
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -57,7 +57,7 @@ def provenance(title: str, config: dict | None = None, extra: dict | None = None
     commit), the scene configuration as JSON, plus ``extra``."""
     from .. import __version__
 
-    now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    now = datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
     attrs = {"title": title, "institution": "lagice", "source": f"lagice {__version__}",
              "history": f"{now}: written by lagice {__version__}", "lagice_version": __version__}
     commit = git_commit()

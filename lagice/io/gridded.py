@@ -91,7 +91,8 @@ def conservative_grid_average(nodes, triangles, fields: dict, x_edges, y_edges):
     xe = np.asarray(x_edges, np.float64)
     ye = np.asarray(y_edges, np.float64)
     names = list(fields)
-    vals = np.column_stack([np.asarray(fields[n], np.float64) for n in names]) if names else np.zeros((len(triangles), 0))
+    vals = (np.column_stack([np.asarray(fields[n], np.float64) for n in names]) if names
+            else np.zeros((len(triangles), 0)))
     num = np.zeros((len(names), len(ye) - 1, len(xe) - 1))
     den = np.zeros((len(ye) - 1, len(xe) - 1))
     _grid_sums(np.ascontiguousarray(nodes, np.float64), np.ascontiguousarray(triangles, np.int64),

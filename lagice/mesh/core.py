@@ -155,7 +155,7 @@ class Mesh:
     def coast_nodes(self) -> np.ndarray:
         return self.nodes_with_tag(COAST) if self.has_tag(COAST) else np.zeros(0, np.int64)
 
-    def copy(self) -> "Mesh":
+    def copy(self) -> Mesh:
         return Mesh(self.nodes.copy(), self.triangles.copy(), self.boundary_edges.copy(),
                     self.boundary_tags.copy(), self.tag_names)
 

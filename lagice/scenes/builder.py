@@ -25,8 +25,7 @@ from ..simulation import Simulation
 from ..solvers import SOLVER_RHEOLOGY, SOLVERS, VelocityBC
 from ..state import IceState
 from . import components
-from .config import (RHEOLOGY_KEYS, load_scene, physics_view, resolve_hook, spatial_values,
-                     time_space_callable)
+from .config import RHEOLOGY_KEYS, load_scene, physics_view, resolve_hook, spatial_values, time_space_callable
 
 BUILDER = "lagice.scenes.builder:build_simulation"
 ROOT = Path(__file__).resolve().parents[2]
@@ -155,6 +154,7 @@ def validate_config(cfg: dict) -> None:
     if abs(n - round(n)) > 1e-9 * max(1.0, n) or round(n) < 1:
         raise ConfigError(f"run.duration = {cfg['run']['duration']!r} is not a whole number (>= 1) of steps of "
                           f"solver.dt = {dt:g} s")
+    check_range("run.max_speed_m_s", cfg["run"]["max_speed_m_s"], 0.0, None, low_open=True, unit="m s-1")
     rheo = build_rheology(cfg)
     sv = cfg["solver"]
     want = SOLVER_RHEOLOGY.get(sv["name"], "?")
@@ -343,7 +343,8 @@ def build_simulation(cfg: dict, out_dir=None, progress: bool | None = None) -> S
     the config, writing into ``out_dir`` (default ``runs/SCENE``)."""
     model = build_model(cfg)
     prog = cfg["run"]["progress"] if progress is None else progress
-    sim = Simulation(model, dt=time_step_s(cfg), stop=cfg["run"]["duration"], progress=prog, builder=BUILDER)
+    sim = Simulation(model, dt=time_step_s(cfg), stop=cfg["run"]["duration"], progress=prog, builder=BUILDER,
+                     max_speed_m_s=cfg["run"]["max_speed_m_s"])
     out = Path(out_dir) if out_dir is not None else Path("runs") / cfg["scene"]["name"]
     sim.out_dir = out
     oc = cfg["output"]

@@ -66,7 +66,8 @@ def _kwargs(table: dict, key: str, funcs, exclude=()) -> dict:
 def _generators(key: str, kind: str):
     """The generator functions whose keywords a ``[forcing.KEY]`` table of ``kind`` takes,
     and the parameters the builder fills itself."""
-    from forcing import gridded, synthetic as syn
+    from forcing import gridded
+    from forcing import synthetic as syn
 
     if key == "wind":
         return {"uniform": ([syn.uniform_wind], ("grid", "t_end_s")),
@@ -162,7 +163,8 @@ def _function_field(t, key):
 
 
 def build_wind(t: dict, grid, bbox, t_end, seed):
-    from forcing import gridded, synthetic as syn
+    from forcing import gridded
+    from forcing import synthetic as syn
 
     kind = _kind(t, "wind", WIND_KINDS)
     if kind == "uniform":
@@ -187,7 +189,8 @@ def build_wind(t: dict, grid, bbox, t_end, seed):
 
 
 def build_ocean(t: dict, grid):
-    from forcing import gridded, synthetic as syn
+    from forcing import gridded
+    from forcing import synthetic as syn
 
     kind = _kind(t, "ocean", OCEAN_KINDS)
     if kind == "rest":

@@ -68,7 +68,7 @@ SCHEMA = {
     "lagrangian": {"enabled": (bool, False), "min_area_ratio": (NUM, 0.05), "max_halvings": (int, 8)},
     "remesh": {"enabled": (bool, False), "min_angle_deg": (NUM, 10.0), "params": (dict, {})},
     "run": {"duration": (EXPR, None), "seed": (int, 0), "progress": (bool, True),
-            "start_date": (str, "2000-01-01 00:00:00")},
+            "start_date": (str, "2000-01-01 00:00:00"), "max_speed_m_s": (NUM, 10.0)},
     "output": {"every": (EXPR, "1d"), "vtu": (bool, False), "crs_epsg": (int, 3413), "plot": ((bool, str), True),
                "grid_resolution_m": (NUM, None), "timeseries": (dict, None)},
     "checkpoint": {"every": (EXPR, None), "keep": (int, 3)},
@@ -85,7 +85,7 @@ RHEOLOGY_KEYS = {
 
 #: config keys that do not change the trajectory of a run (left out of the checkpoint
 #: fingerprint, so a run can be extended, re-scheduled or re-described on resume)
-NON_PHYSICS = {"scene": ("name", "description", "extends", "source"), "run": ("duration", "progress"),
+NON_PHYSICS = {"scene": ("name", "description", "extends", "source"), "run": ("duration", "progress", "max_speed_m_s"),
                "output": None, "checkpoint": None}
 
 SCENE_DIR = Path(__file__).resolve().parents[2] / "examples"

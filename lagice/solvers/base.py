@@ -34,7 +34,7 @@ class TimeStepper(Protocol):
 
     name: str
 
-    def step(self, state, t_s: float, dt_s: float) -> "StepInfo":
+    def step(self, state, t_s: float, dt_s: float) -> StepInfo:
         """Advance velocity, stress and damage of ``state`` over [t_s, t_s + dt_s]."""
 
     def reset_topology(self, mesh) -> None:

@@ -42,13 +42,12 @@ import numpy as np
 from numba import njit, prange
 
 from .._numba import PARALLEL_MIN_SIZE, serial_copy
-from ..errors import ConfigError, SolverError
+from ..errors import ConfigError
 from ..fem import STRAIN_RATE, NodeSystem, element_strain_rate, solve_node_2x2
 from ..forces import explicit_terms
 from ..rheology import MaxwellEB, _dcrit, damage_step
 from ..state import IceState
 from .base import StepInfo
-
 
 #: keys of ``ExplicitSolver.kernel_timings`` / ``StepInfo.kernel_timings`` [s]
 KERNELS = ("forcing", "setup", "node_velocity", "element_stress_damage")
@@ -359,9 +358,6 @@ class ExplicitSolver:
             tm += tc - tb
         kt["node_velocity"] = tn
         kt["element_stress_damage"] = tm
-        if not np.all(np.isfinite(vel)):
-            raise SolverError(f"non-finite velocity at t = {t_new:.6g} s (explicit solver, Δt = {dt:g} s, "
-                              f"{n_sub} sub-steps of {dt_s:.3g} s): sub-step beyond the stability limit?")
         state.velocity = vel
         state.stress = sigma
         state.damage = damage

@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ConfigError, SolverError
 from .._numba import pick
+from ..errors import ConfigError, SolverError
 from ..fem import LUMPED_MASS, NODAL_FORCE, SHAPE_GRADIENTS, STRAIN_RATE, SparsityPattern, assemble_elasticity
 from ..rheology import MaxwellEB
 from ..state import IceState
@@ -128,7 +128,7 @@ class ImplicitSolver:
         sigma_prev = None
         residual = 0.0
         it = 0
-        for it in range(1, self.max_iter + 1):
+        for it in range(1, self.max_iter + 1):  # noqa: B007 (it is reported after the loop)
             with Timer(tm, "assembly"):
                 data = data0.copy()
                 data[self.pattern.diag_pos] += diag_mass
