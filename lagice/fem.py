@@ -132,14 +132,14 @@ class SparsityPattern:
         self.row_of = r.astype(np.int64)
         self.diag_pos = np.flatnonzero(r == self.indices)
         assert len(self.diag_pos) == ndof
-        self._offdiag = None
+        self._offdiag = None  # positions of the (2i, 2i+1) entries, built on first use
 
     def matrix(self, data: np.ndarray) -> sp.csr_matrix:
         return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.ndof, self.ndof))
 
     def node_offdiag_pos(self):
         """Positions of the (2i, 2i+1) and (2i+1, 2i) entries in the CSR data."""
-        if getattr(self, "_offdiag", None) is None:
+        if self._offdiag is None:
             ndof = self.ndof
             rows = self.row_of
             cols = self.indices.astype(np.int64)

@@ -79,6 +79,7 @@ class Mesh:
     tag_names: tuple
     _adj: tuple | None = field(default=None, repr=False)
     _fixed: np.ndarray | None = field(default=None, repr=False)
+    _edge_on_boundary: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self):
         self.nodes = np.ascontiguousarray(self.nodes, dtype=np.float64)
@@ -151,6 +152,24 @@ class Mesh:
                     fixed[self.nodes_with_tag(name)] = True
             self._fixed = fixed
         return self._fixed
+
+    @property
+    def edge_on_boundary(self) -> np.ndarray:
+        """(m, 3) bool, cached: edge k (opposite vertex k) of each element lies on the
+        domain boundary (the topology does not change while nodes move)."""
+        if self._edge_on_boundary is None:
+            n = np.int64(self.n_nodes)
+            be = self.boundary_edges
+            keys = np.sort(np.minimum(be[:, 0], be[:, 1]) * n + np.maximum(be[:, 0], be[:, 1]))
+            tri = self.triangles
+            out = np.zeros(tri.shape, dtype=bool)
+            for k in range(3):
+                a, b = tri[:, (k + 1) % 3], tri[:, (k + 2) % 3]
+                q = np.minimum(a, b) * n + np.maximum(a, b)
+                pos = np.minimum(np.searchsorted(keys, q), max(len(keys) - 1, 0))
+                out[:, k] = (keys[pos] == q) if len(keys) else False
+            self._edge_on_boundary = out
+        return self._edge_on_boundary
 
     def coast_nodes(self) -> np.ndarray:
         return self.nodes_with_tag(COAST) if self.has_tag(COAST) else np.zeros(0, np.int64)

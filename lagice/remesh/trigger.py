@@ -82,18 +82,9 @@ class TriggerResult:
 
 
 def boundary_edge_counts(mesh: Mesh) -> np.ndarray:
-    """(m, 3) bool: edge k (opposite vertex k) of each element lies on the domain boundary."""
-    n = np.int64(mesh.n_nodes)
-    be = mesh.boundary_edges
-    keys = np.sort(np.minimum(be[:, 0], be[:, 1]) * n + np.maximum(be[:, 0], be[:, 1]))
-    tri = mesh.triangles
-    out = np.zeros(tri.shape, dtype=bool)
-    for k in range(3):
-        a, b = tri[:, (k + 1) % 3], tri[:, (k + 2) % 3]
-        q = np.minimum(a, b) * n + np.maximum(a, b)
-        pos = np.minimum(np.searchsorted(keys, q), max(len(keys) - 1, 0))
-        out[:, k] = (keys[pos] == q) if len(keys) else False
-    return out
+    """(m, 3) bool: edge k (opposite vertex k) of each element lies on the domain
+    boundary (:attr:`lagice.mesh.Mesh.edge_on_boundary`, cached on the mesh)."""
+    return mesh.edge_on_boundary
 
 
 @njit(cache=True)
@@ -160,10 +151,7 @@ def check_trigger(mesh: Mesh, size_field, params: TriggerParams | None = None,
         target = evaluate_size(size_field, cen[:, 0], cen[:, 1])
     else:
         target = evaluate_size(size_field, np.zeros(len(tri)), np.zeros(len(tri)))
-    on_bnd = getattr(mesh, "_lagice_on_bnd", None)
-    if on_bnd is None or on_bnd.shape != tri.shape:
-        on_bnd = boundary_edge_counts(mesh)
-        mesh._lagice_on_bnd = on_bnd  # boundary edges never change while nodes move
+    on_bnd = mesh.edge_on_boundary
     flags, cmax = _trigger_kernel(nodes, tri, on_bnd, target, np.cos(np.radians(p.min_angle_deg)),
                                   np.cos(np.radians(p.min_angle_deg + p.seed_margin_deg)),
                                   p.near_inversion * EQUILATERAL, p.length_factor)
