@@ -56,6 +56,7 @@ SCHEMA = {
         "linear_solver": (str, None), "tol": (NUM, None), "max_iter": (int, None),
         "allow_unstable": (bool, False), "safety": (NUM, None), "parallel": (bool, None),
         "velocity": (str, None), "velocity_params": (dict, {}),
+        "device": (str, "cpu"),  # "cpu" (default) or "cuda" (lagice.solvers.cuda_explicit)
     },
     "boundary": {"*": {"u": (EXPR, None), "v": (EXPR, None)}},
     "forcing": {

@@ -1,0 +1,682 @@
+"""GPU explicit Maxwell-EB stepper (issue 15): :class:`CudaExplicitSolver`.
+
+The same outer step as :class:`lagice.solvers.explicit.ExplicitSolver`, with
+every per-element and per-node loop on an NVIDIA GPU through ``numba.cuda``
+(kernels in :mod:`lagice.solvers.cuda_kernels`), state kept on the device
+between outer steps. Design, sync rules and measured agreement with the CPU
+kernels: ``docs/gpu.md``.
+
+What runs where, per outer step
+-------------------------------
+host (Python, O(boundary) or O(1) work):
+  prescribed velocities at the boundary dofs (``VelocityBC`` callables),
+  forcing fields that have no records (callables: evaluated at the nodes and
+  copied over; constants: filled on the device once), the record bracket
+  (which two records, weight ``a``) and reading a record when the bracket
+  moves on, a ``heal_rate`` callable, the sub-step count and stability check.
+device:
+  record fields interpolated at the nodes (bilinear in space, linear in time,
+  as :class:`forcing.records.RecordField`), E, λ, exp(−c*(1−A)), strengths,
+  lumped mass, adjacency weights, wind force and drag coefficients, then the
+  sub-step loop (node velocity + element stress/damage/healing), the sub-step
+  mean velocity (transport velocity) and its strain rate.
+
+Two host↔device synchronisations per outer step read a handful of counters:
+after the setup (E_max for the sub-step count; forcing points outside the
+grid / non-finite) and after the sub-steps (capped elements, damaged
+elements, non-finite velocities).
+
+Launches per sub-step: none with the cooperative kernel (``launch="auto"``
+where the device supports it: one launch runs all sub-steps with grid-wide
+barriers); two with ``launch="launches"`` (node kernel, element kernel).
+"""
+from __future__ import annotations
+
+import math
+import time
+import warnings
+
+import numpy as np
+
+from ..errors import ConfigError, ForcingError, SolverError
+from ..forces import Coriolis, OceanDrag, WindStress, evaluate_vector
+from ..rheology import MaxwellEB
+from .base import LumpedMassSolver, StepInfo
+from .explicit import ExplicitSolver
+
+#: values of ``[solver] device``
+DEVICES = ("cpu", "cuda")
+#: keys of ``CudaExplicitSolver.kernel_timings`` [s] (see the class doc)
+KERNELS = ("forcing", "setup", "substeps", "transfer")
+SYNC_MODES = ("step", "explicit")
+LAUNCH_MODES = ("auto", "cooperative", "launches")
+#: state fields the device advances (host copies go stale in sync="explicit")
+DEVICE_OWNED = ("velocity", "stress", "damage")
+#: state fields only the host changes (thermodynamics, remapping); the device keeps read-only copies
+HOST_OWNED = ("thickness", "concentration", "cohesion")
+STATE_FIELDS = DEVICE_OWNED + HOST_OWNED
+_DEV_KEY = {"velocity": "vel", "stress": "sigma", "damage": "damage", "thickness": "h",
+            "concentration": "conc", "cohesion": "coh"}
+
+
+# ----------------------------------------------------------------------------
+# availability
+# ----------------------------------------------------------------------------
+def simulator_enabled() -> bool:
+    """True when numba runs CUDA kernels in its simulator (``NUMBA_ENABLE_CUDASIM=1``
+    at numba's import)."""
+    from numba import config
+
+    return bool(config.ENABLE_CUDASIM)
+
+
+def cuda_status() -> tuple[bool, str]:
+    """``(usable, description)``: the GPU's name, the simulator, or why no GPU is usable."""
+    if simulator_enabled():
+        return True, "numba CUDA simulator (NUMBA_ENABLE_CUDASIM=1)"
+    try:
+        from numba import cuda
+
+        if cuda.is_available():
+            name = cuda.get_current_device().name
+            return True, name.decode() if isinstance(name, bytes) else str(name)
+        reason = cuda.cuda_error() or "no CUDA device found"
+    except Exception as exc:  # noqa: BLE001 - any driver or toolkit failure means "not usable"
+        reason = f"{type(exc).__name__}: {exc}"
+    return False, " ".join(str(reason).split())
+
+
+def require_cuda(key: str = "solver.device") -> str:
+    """Raise :class:`ConfigError` naming ``key`` unless numba can use a CUDA GPU
+    (or its simulator); returns the device description. Cheap: no mesh, no kernel."""
+    ok, info = cuda_status()
+    if not ok:
+        raise ConfigError(
+            f'{key} = "cuda": no CUDA GPU is usable on this machine (numba.cuda.is_available() is False: '
+            f'{info}). Use {key} = "cpu" (the default), run on a machine with an NVIDIA GPU and the CUDA '
+            f"libraries numba needs (docs/gpu.md), or set NUMBA_ENABLE_CUDASIM=1 to run the GPU kernels in "
+            f"numba's CUDA simulator (for tests: very slow)")
+    return info
+
+
+def check_solver_device(sv: dict) -> None:
+    """Check ``[solver] device`` of a scene before any mesh work (issue 15):
+    a known value, a usable GPU for ``"cuda"``, and the explicit solver."""
+    dev = sv.get("device", "cpu")
+    if dev not in DEVICES:
+        raise ConfigError(f"solver.device = {dev!r}: expected one of {list(DEVICES)}")
+    if dev == "cuda":
+        require_cuda("solver.device")
+        if sv.get("name") != "explicit":
+            raise ConfigError(f'solver.device = "cuda" runs the explicit solver only; solver.name = '
+                              f'{sv.get("name")!r} (set solver.name = "explicit", or solver.device = "cpu")')
+
+
+def build_cuda_solver(rheology, mesh, bcs, forces, healing, options: dict):
+    """The scene builder's CUDA solver (``[solver] device = "cuda"``), with the
+    healing component wired as :class:`lagice.model.Model` does for CPU solvers.
+    ``sync="step"``: today's Model reads the host state after every step."""
+    heal = None
+    if healing is not None:
+        heal = lambda st: healing(st, st.time_s)
+    return CudaExplicitSolver(rheology, mesh, bcs=bcs, forces=forces, heal_rate=heal, sync="step", **options)
+
+
+# ----------------------------------------------------------------------------
+# forcing fields on the device
+# ----------------------------------------------------------------------------
+class _NodeField:
+    """A wind or ocean-current field at the nodes, for the device.
+
+    ``path``: ``"device"`` (a vector :class:`forcing.records.RecordField` on a
+    :class:`~forcing.records.RegularGrid` with ``rebuild_tolerance_m = 0``: the
+    bracketing records live on the device, interpolation runs there),
+    ``"constant"`` (a constant pair: filled on the device once per mesh),
+    ``"zero"`` (absent), or ``"host"`` (anything else: callables, lon/lat grids,
+    record fields with a rebuild tolerance: evaluated on the host at the nodes
+    and copied over, 16 B per node per outer step).
+    """
+
+    def __init__(self, field, name: str, slots: tuple):
+        from forcing.base import VECTOR
+        from forcing.records import RecordField, RegularGrid
+
+        self.field = field
+        self.name = name
+        self.c_out, self.c_bad = slots
+        if field is None:
+            self.path = "zero"
+        elif isinstance(field, tuple):
+            self.path = "constant"
+        elif (isinstance(field, RecordField) and isinstance(field.grid, RegularGrid) and field.kind == VECTOR
+              and field.rebuild_tolerance_m == 0.0):
+            self.path = "device"
+        else:
+            self.path = "host"
+        self._filled = None  # device array last filled with a constant
+        self._recs = {}  # record index -> (host shape size, device array)
+        self._blend = None  # ((i, j, a), device array)
+        self._axes = None
+
+    def device_bytes(self) -> int:
+        out = sum(r.nbytes for _, r in self._recs.values())
+        out += self._blend[1].nbytes if self._blend is not None else 0
+        out += sum(a.nbytes for a in self._axes[:2]) if self._axes is not None else 0
+        return out
+
+    def _record(self, i):
+        from numba import cuda
+
+        if i not in self._recs:
+            f = self.field
+            rec = np.ascontiguousarray(f.grid.extend(f.source.read(i)), dtype=np.float64)
+            self._recs[i] = (rec.size, cuda.to_device(rec))
+        return self._recs[i]
+
+    def evaluate(self, solver, t: float, out) -> None:
+        """Fill the device array ``out`` (n, 2) [m s-1] for time ``t`` [s] (launches
+        are asynchronous; outside-grid and non-finite counts go to the counters)."""
+        from numba import cuda
+
+        from . import cuda_kernels as K
+
+        if self.path in ("zero", "constant"):
+            if self._filled is not out:
+                u, v = (0.0, 0.0) if self.path == "zero" else self.field
+                solver._launch(K.fill_pair_kernel, out.shape[0], out, float(u), float(v))
+                self._filled = out
+            return
+        if self.path == "host":
+            vals = evaluate_vector(self.field, t, solver.mesh.nodes, self.name)
+            out.copy_to_device(np.ascontiguousarray(vals))
+            return
+        f = self.field
+        if self._axes is None:
+            self._axes = (cuda.to_device(np.ascontiguousarray(f._ax, np.float64)),
+                          cuda.to_device(np.ascontiguousarray(f._ay, np.float64)),
+                          int(f._uniform[0]), int(f._uniform[1]))
+        ax, ay, ux, uy = self._axes
+        i, j, a = f._bracket(t)  # same bracket, extrapolation policy and errors as the CPU
+        size0, r0 = self._record(i)
+        _, r1 = self._record(j)
+        for k in list(self._recs):
+            if k != i and k != j:
+                del self._recs[k]
+                self._blend = None
+        n = out.shape[0]
+        nc = r0.shape[0]
+        if i == j or a == 0.0:
+            src0, src1, two = r0, r0, 0
+        elif size0 <= nc * n:
+            # grid smaller than the points: blend in time on the grid once per (i, j, a)
+            if self._blend is None or self._blend[0] != (i, j, a):
+                buf = self._blend[1] if self._blend is not None else cuda.device_array(r0.shape, np.float64)
+                solver._launch(K.blend_records_kernel, size0, r0, r1, float(a), buf)
+                self._blend = ((i, j, a), buf)
+            src0, src1, two = self._blend[1], self._blend[1], 0
+        else:
+            src0, src1, two = r0, r1, 1
+        clamp = int(f.space_extrapolation == "clamp")
+        solver._launch(K.record_field_kernel, n, solver._d["nodes"], ax, ay, ux, uy, clamp, src0, src1,
+                       float(a), two, out, solver._d["counters"], self.c_out, self.c_bad)
+
+    def check(self, counters, t: float, nodes) -> None:
+        """After the mid-step sync: raise the CPU's :class:`ForcingError` (replayed on
+        the host for its message) if the device met points outside the grid or
+        non-finite values."""
+        if self.path != "device":
+            return
+        n_out, n_bad = int(counters[self.c_out]), int(counters[self.c_bad])
+        if n_out or n_bad:
+            evaluate_vector(self.field, t, nodes, self.name)  # raises with the CPU's message
+            raise ForcingError(f"{self.name}: the device interpolation met {n_out} points outside the "
+                               f"forcing grid and {n_bad} non-finite values at t = {t} s, but the host "
+                               f"evaluation did not (a bug: please report)")
+
+    def reset(self):
+        self._filled = None
+
+
+# ----------------------------------------------------------------------------
+# the solver
+# ----------------------------------------------------------------------------
+class CudaExplicitSolver(LumpedMassSolver):
+    """Explicit Maxwell-EB stepper on a CUDA GPU (``[solver] device = "cuda"``).
+
+    Args (as :class:`~lagice.solvers.explicit.ExplicitSolver`):
+        rheology, mesh, bcs, forces (``WindStress``, ``OceanDrag``, ``Coriolis``;
+        at most one of each of the first two), substeps, heal_rate, safety,
+        allow_unstable.
+    Device options (keyword only):
+        sync: ``"step"`` (default): the host state (velocity, stress, damage) is
+            brought up to date after every step and uploaded again before the
+            next, so any host code may read and write it (what today's
+            :class:`~lagice.model.Model` needs); ``"explicit"``: the state stays
+            on the device between steps and the caller syncs with
+            :meth:`to_host` / :meth:`from_host` (``docs/gpu.md``: what to call when).
+        launch: ``"auto"`` (cooperative single-launch sub-step loop where
+            possible, else ``"launches"``), ``"cooperative"``, ``"launches"``
+            (two kernels per sub-step).
+        threads_per_block: CUDA block size (default 128).
+        max_blocks: cap on blocks per launch (None: one thread per entity; every
+            kernel is a grid-stride loop, so any cap is correct).
+
+    Attributes as ExplicitSolver: ``mean_velocity`` (transport velocity, mean
+    over the sub-steps) and ``last_strain_rate`` (its strain rate) are
+    downloaded on first access after a step; ``area``, ``b``, ``c``, ``td`` on
+    first access after a geometry update; ``dx_min``, ``last_substeps``.
+    ``kernel_timings`` [s]: ``forcing`` (host forcing work and record uploads),
+    ``setup`` (device setup through the mid-step sync), ``substeps`` (sub-step
+    loop, mean velocity and strain rate, to the end-of-step sync),
+    ``transfer`` (state copies of :meth:`from_host` / :meth:`to_host` made by
+    ``step`` in ``sync="step"``). ``StepInfo.timings`` maps them as
+    assembly = forcing + setup + transfer, solve = substeps, damage = 0
+    (fused into the sub-step kernels).
+    """
+
+    name = "explicit_cuda"
+    device = "cuda"
+
+    def __init__(self, rheology: MaxwellEB, mesh, bcs=(), forces=(), substeps: int | None = None,
+                 heal_rate=None, safety: float = 0.7, allow_unstable: bool = False, *,
+                 sync: str = "step", launch: str = "auto", threads_per_block: int = 128,
+                 max_blocks: int | None = None):
+        self.device_name = require_cuda("solver.device")
+        if not isinstance(rheology, MaxwellEB):
+            raise ConfigError(f"rheology must be MaxwellEB; got {type(rheology).__name__}")
+        if substeps is not None:
+            if int(substeps) != substeps or int(substeps) < 1:
+                raise ConfigError(f"substeps = {substeps!r} must be an integer >= 1 (or None: automatic)")
+            substeps = int(substeps)
+        if not 0.0 < safety <= 1.0:
+            raise ConfigError(f"safety = {safety!r} must be in (0, 1]")
+        if sync not in SYNC_MODES:
+            raise ConfigError(f"sync = {sync!r}: expected one of {list(SYNC_MODES)}")
+        if launch not in LAUNCH_MODES:
+            raise ConfigError(f"launch = {launch!r}: expected one of {list(LAUNCH_MODES)}")
+        if int(threads_per_block) != threads_per_block or not 1 <= threads_per_block <= 1024:
+            raise ConfigError(f"threads_per_block = {threads_per_block!r} must be an integer in [1, 1024]")
+        if max_blocks is not None and (int(max_blocks) != max_blocks or max_blocks < 1):
+            raise ConfigError(f"max_blocks = {max_blocks!r} must be an integer >= 1 or None")
+        from . import cuda_kernels as K
+
+        self.rheology = rheology
+        self.bcs = list(bcs)
+        self.forces = list(forces)
+        self.substeps = substeps
+        self.safety = float(safety)
+        self.allow_unstable = bool(allow_unstable)
+        self.heal_rate = heal_rate
+        self.parallel = None
+        self.sync = sync
+        self.launch = launch
+        self.launch_used = None  # "cooperative" or "launches", set at the first step
+        self.launch_note = ""
+        self.tpb = int(threads_per_block)
+        self.max_blocks = None if max_blocks is None else int(max_blocks)
+        self.kernel_timings = {k: 0.0 for k in KERNELS}
+        self._checked = set()
+        self.last_substeps = None
+        self._d = {}
+        self._coop_max = None
+        self._wind = self._ocean = None
+        self._c_air = 0.0
+        self._drag_coef, self._cos_t, self._sin_t = 0.0, 1.0, 0.0
+        self._f_cor = 0.0
+        for f in self.forces:
+            if isinstance(f, WindStress):
+                if self._wind is not None:
+                    raise ConfigError("the CUDA stepper takes one WindStress force; combine the winds into one field")
+                self._wind = _NodeField(f.wind, "wind", (K.C_WIND_OUT, K.C_WIND_BAD))
+                self._c_air = f.rho_air * f.drag
+            elif isinstance(f, OceanDrag):
+                if self._ocean is not None:
+                    raise ConfigError("more than one OceanDrag force given; combine them into one")
+                self._ocean = _NodeField(f.current, "ocean current", (K.C_OCEAN_OUT, K.C_OCEAN_BAD))
+                self._drag_coef = f.rho_water * f.drag
+                self._cos_t, self._sin_t = f.cos_turn, f.sin_turn
+            elif isinstance(f, Coriolis):
+                self._f_cor += f.f
+            else:
+                raise ConfigError(f"force {f!r}: the CUDA stepper evaluates WindStress, OceanDrag and Coriolis "
+                                  "forces only (use solver.device = 'cpu' for other forces)")
+        if self._ocean is None:
+            self._ocean = _NodeField(None, "ocean current", (K.C_OCEAN_OUT, K.C_OCEAN_BAD))
+        self._pres_static = all(not callable(bc.u) and not callable(bc.v) for bc in self.bcs)
+        self.reset_topology(mesh)
+
+    # -- sub-step choice: the CPU solver's own rules (same N, same refusals) -------
+    substeps_for = ExplicitSolver.substeps_for
+    _check_stability = ExplicitSolver._check_stability
+
+    # -- forcing paths (documentation, tests) ---------------------------------------
+    @property
+    def forcing_paths(self) -> dict:
+        """``{"wind": path, "ocean": path}``, path in device/constant/zero/host (see ``_NodeField``)."""
+        return {"wind": self._wind.path if self._wind is not None else "zero", "ocean": self._ocean.path}
+
+    # -- launch helpers ----------------------------------------------------------------
+    def _blocks(self, size: int) -> int:
+        nb = max(1, -(-int(size) // self.tpb))
+        return nb if self.max_blocks is None else min(nb, self.max_blocks)
+
+    def _launch(self, kernel, size: int, *args) -> None:
+        kernel[self._blocks(size), self.tpb](*args)
+
+    # -- topology and geometry ----------------------------------------------------------
+    def reset_topology(self, mesh) -> None:
+        """New mesh (remesh, checkpoint load): drop every device array; the next
+        :meth:`step` uploads the whole state from the host."""
+        self._d = {}
+        self._resident = None
+        self._host_stale = set()
+        self._geom_cache = {}
+        for f in (self._wind, self._ocean):
+            if f is not None:
+                f.reset()
+        self._heal_const = None
+        self._pres_done = False
+        super().reset_topology(mesh)  # DirichletSet, fixed flags, then update_geometry()
+
+    def _ensure_topology(self) -> None:
+        if self._d:
+            return
+        from numba import cuda
+
+        from . import cuda_kernels as K
+
+        mesh = self.mesh
+        n, m = mesh.n_nodes, mesh.n_elements
+        ptr, elems, local = mesh.node_elements
+        idx = np.int32 if max(3 * m, n) < 2**31 - 1 else np.int64
+        d = self._d
+        d["tri"] = cuda.to_device(np.ascontiguousarray(mesh.triangles, idx))
+        d["ptr"] = cuda.to_device(np.ascontiguousarray(ptr, idx))
+        d["elems"] = cuda.to_device(np.ascontiguousarray(elems, idx))
+        d["local"] = cuda.to_device(np.ascontiguousarray(local, np.int8))
+        d["fixed"] = cuda.to_device(np.ascontiguousarray(self.fixed, np.int8))
+        dofs = np.ascontiguousarray(self.dirichlet.dofs, idx)
+        d["dofs"] = cuda.to_device(dofs) if len(dofs) else None
+        f8 = np.float64
+        for key, shape in (("nodes", (n, 2)), ("b", (m, 3)), ("c", (m, 3)), ("area", m), ("td", m),
+                           ("vel", (n, 2)), ("vel_w", (n, 2)), ("sigma", (m, 3)), ("sigma_w", (m, 3)),
+                           ("damage", m), ("damage_w", m), ("h", m), ("conc", m), ("coh", m),
+                           ("conc_factor", m), ("sig_c", m), ("sig_t", m), ("e_dt", m), ("gamma", m),
+                           ("heal", m), ("m_dt", n), ("fext", (n, 2)), ("cda", n), ("half_mf", n),
+                           ("wb", len(elems)), ("wc", len(elems)), ("wind", (n, 2)), ("current", (n, 2)),
+                           ("vel_sum", (n, 2)), ("mean_vel", (n, 2)), ("strain", (m, 3))):
+            d[key] = cuda.device_array(shape, f8)
+        d["flag"] = cuda.device_array(m, np.int8)
+        d["pres0"] = cuda.to_device(np.zeros((n, 2)))
+        d["pres1"] = cuda.to_device(np.zeros((n, 2)))
+        d["counters"] = cuda.device_array(K.N_COUNTERS, np.int64)
+        d["scalars"] = cuda.device_array(K.N_SCALARS, f8)
+        self._index_dtype = idx
+
+    def _reset_counters(self) -> None:
+        from . import cuda_kernels as K
+
+        self._d["counters"].copy_to_device(np.zeros(K.N_COUNTERS, np.int64))
+        sc = np.empty(K.N_SCALARS)
+        sc[K.S_E_MAX] = -math.inf
+        sc[K.S_AREA_MIN] = math.inf
+        self._d["scalars"].copy_to_device(sc)
+
+    def update_geometry(self) -> None:
+        """Nodes moved on the host (Lagrangian step): upload them and recompute
+        shape gradients, areas, td and ``dx_min`` on the device."""
+        from . import cuda_kernels as K
+
+        self._ensure_topology()
+        d = self._d
+        d["nodes"].copy_to_device(np.ascontiguousarray(self.mesh.nodes, np.float64))
+        self._reset_counters()
+        self._launch(K.geometry_kernel, self.mesh.n_elements, d["nodes"], d["tri"], d["b"], d["c"], d["area"],
+                     d["td"], float(self.rheology.params.shear_wave_speed), d["scalars"], d["counters"])
+        cnt = d["counters"].copy_to_host()
+        sc = d["scalars"].copy_to_host()
+        self._geom_cache = {}
+        if cnt[K.C_INVERTED]:
+            raise SolverError(f"{int(cnt[K.C_INVERTED])} inverted elements in the mesh")
+        self.dx_min = float(np.sqrt(2.0 * sc[K.S_AREA_MIN]))
+
+    #: the name the sync API uses in docs/gpu.md
+    invalidate_geometry = update_geometry
+
+    def _geom(self, key):
+        if key not in self._geom_cache:
+            self._geom_cache[key] = self._d[key].copy_to_host()
+        return self._geom_cache[key]
+
+    area = property(lambda self: self._geom("area"), doc="element areas [m²] (host copy, cached)")
+    b = property(lambda self: self._geom("b"), doc="∂φ/∂x [m-1] (host copy, cached)")
+    c = property(lambda self: self._geom("c"), doc="∂φ/∂y [m-1] (host copy, cached)")
+    td = property(lambda self: self._geom("td"), doc="damage time td [s] (host copy, cached)")
+
+    # -- results downloaded on demand ------------------------------------------------------
+    @property
+    def mean_velocity(self):
+        """(n, 2) mean velocity over the last step's sub-steps [m s-1] (transport velocity)."""
+        if self._mean is None and self._have_results:
+            self._mean = self._d["mean_vel"].copy_to_host()
+        return self._mean
+
+    @mean_velocity.setter
+    def mean_velocity(self, value):
+        if value is not None:
+            raise AttributeError("mean_velocity is computed on the device; it can only be cleared (None)")
+        self._mean = None
+        self._strain = None
+        self._have_results = False
+
+    @property
+    def last_strain_rate(self):
+        """(m, 3) strain rate of :attr:`mean_velocity` [s-1]."""
+        if self._strain is None and self._have_results:
+            self._strain = self._d["strain"].copy_to_host()
+        return self._strain
+
+    # -- sync API ---------------------------------------------------------------------------
+    @property
+    def host_stale(self) -> tuple:
+        """State fields whose host copy is older than the device's (``sync="explicit"``)."""
+        return tuple(f for f in DEVICE_OWNED if f in self._host_stale)
+
+    def to_host(self, state, fields=DEVICE_OWNED) -> None:
+        """Copy device-advanced fields into ``state`` (new host arrays, as the CPU
+        solver assigns them). Call before host code reads velocity, stress or
+        damage in ``sync="explicit"`` (output, checkpoint, remesh, diagnostics).
+        A no-op for a state the device does not hold (its host copy is the newest)."""
+        if self._resident is not state:
+            return
+        for f in fields:
+            if f not in STATE_FIELDS:
+                raise ConfigError(f"to_host: unknown field {f!r}; expected some of {list(STATE_FIELDS)}")
+            if f in DEVICE_OWNED:
+                setattr(state, f, self._d[_DEV_KEY[f]].copy_to_host())
+                self._host_stale.discard(f)
+
+    def from_host(self, state, fields=None) -> None:
+        """Upload ``fields`` (default: all of :data:`STATE_FIELDS`) of ``state`` to the
+        device. Call after host code changed them (thermodynamics: thickness,
+        concentration; edits of velocity, stress, damage). A state the device has
+        not seen is always uploaded whole."""
+        self._ensure_topology()
+        if self._resident is not state:
+            fields = STATE_FIELDS
+            self._host_stale = set()
+        fields = STATE_FIELDS if fields is None else tuple(fields)
+        n, m = self.mesh.n_nodes, self.mesh.n_elements
+        for f in fields:
+            if f not in STATE_FIELDS:
+                raise ConfigError(f"from_host: unknown field {f!r}; expected some of {list(STATE_FIELDS)}")
+            if f in self._host_stale:
+                raise SolverError(f"from_host({f!r}): the host copy is older than the device's; call "
+                                  f"to_host(state, [{f!r}]) before changing it on the host")
+            shape = {"velocity": (n, 2), "stress": (m, 3)}.get(f, (m,))
+            arr = np.ascontiguousarray(getattr(state, f), np.float64)
+            if arr.shape != shape:
+                raise SolverError(f"state.{f} has shape {arr.shape}; expected {shape} for this mesh "
+                                  "(call reset_topology after replacing the mesh)")
+            self._d[_DEV_KEY[f]].copy_to_device(arr)
+        self._resident = state
+
+    def device_bytes(self) -> int:
+        """Bytes held in device arrays (mesh, state, work arrays, forcing records)."""
+        out = sum(a.nbytes for a in self._d.values() if a is not None)
+        for f in (self._wind, self._ocean):
+            if f is not None:
+                out += f.device_bytes()
+        return out
+
+    # -- the step -----------------------------------------------------------------------------
+    def _choose_launch(self, args) -> str:
+        """Cooperative single-launch loop where requested and possible."""
+        from . import cuda_kernels as K
+
+        if self.launch_used is not None:
+            return self.launch_used
+        if self.launch == "launches":
+            self.launch_used = "launches"
+            return self.launch_used
+        try:
+            kern = K.substeps_cooperative
+            if simulator_enabled():
+                mx = kern.overloads[None].max_cooperative_grid_blocks(self.tpb)
+            else:
+                from numba import typeof
+
+                mx = kern.compile(tuple(typeof(a) for a in args)).max_cooperative_grid_blocks(self.tpb)
+            if mx < 1:
+                raise SolverError(f"no block of {self.tpb} threads of the cooperative kernel fits on the device")
+            self._coop_max = int(mx)
+            self.launch_used = "cooperative"
+        except Exception as exc:  # compile, link or driver failures all mean "not available"
+            if self.launch == "cooperative":
+                raise SolverError(f"launch = 'cooperative' is not available on {self.device_name}: {exc}") from exc
+            self.launch_note = f"cooperative sub-step kernel unavailable ({type(exc).__name__}: {exc})"
+            warnings.warn(f"{self.launch_note}; using two launches per sub-step", RuntimeWarning, stacklevel=3)
+            self.launch_used = "launches"
+        return self.launch_used
+
+    def step(self, state, dt: float) -> StepInfo:
+        from . import cuda_kernels as K
+
+        if not dt > 0:
+            raise ConfigError(f"dt = {dt!r} s must be > 0")
+        if state.mesh is not self.mesh:
+            raise SolverError("state.mesh is not this solver's mesh: call reset_topology(state.mesh) after "
+                              "replacing the mesh (remesh, checkpoint load)")
+        kt = {k: 0.0 for k in KERNELS}
+        t0 = time.perf_counter()
+        if self.sync == "step" or self._resident is not state:
+            self.from_host(state)
+        d = self._d
+        rh, p = self.rheology, self.rheology.params
+        t1 = time.perf_counter()
+        kt["transfer"] = t1 - t0
+
+        # -- host side of the forcing; device forcing kernels (asynchronous) ----------------
+        self._reset_counters()
+        mesh = self.mesh
+        n, m = mesh.n_nodes, mesh.n_elements
+        t_new = state.time_s + dt
+        self._launch(K.prepare_elements_kernel, m, d["damage"], d["sigma"], d["conc"], d["coh"], float(p.E0),
+                     float(p.relaxation_time_s), float(p.concentration_c), float(p.alpha), rh._denom, rh.q,
+                     d["damage_w"], d["sigma_w"], d["e_dt"], d["gamma"], d["conc_factor"], d["sig_c"],
+                     d["sig_t"], d["flag"], d["scalars"])
+        if self._wind is not None:
+            self._wind.evaluate(self, t_new, d["wind"])
+        self._ocean.evaluate(self, t_new, d["current"])
+        if self.heal_rate is not None:
+            if "damage" in self._host_stale:  # the callable reads the host state
+                self.to_host(state, ("damage",))
+            heal = np.ascontiguousarray(self.heal_rate(state), np.float64)
+            if heal.shape != (m,):
+                raise SolverError(f"heal_rate returned shape {heal.shape}; expected ({m},) [s-1]")
+            d["heal"].copy_to_device(heal)
+            self._heal_const = None
+        else:
+            rate = float(rh.constant_heal_rate(1)[0])
+            if self._heal_const != rate:
+                self._launch(K.fill_kernel, m, d["heal"], rate)
+                self._heal_const = rate
+        if d["dofs"] is not None and not (self._pres_static and self._pres_done):
+            from numba import cuda
+
+            v0 = cuda.to_device(np.ascontiguousarray(self.dirichlet.values(state.time_s), np.float64))
+            v1 = cuda.to_device(np.ascontiguousarray(self.dirichlet.values(t_new), np.float64))
+            self._launch(K.scatter_prescribed_kernel, v0.shape[0], d["dofs"], v0, v1, d["pres0"], d["pres1"])
+            self._pres_done = True
+        t2 = time.perf_counter()
+        kt["forcing"] = t2 - t1
+
+        # -- mid-step sync: E_max, forcing checks, sub-step count ------------------------------
+        cnt = d["counters"].copy_to_host()
+        E_max = float(d["scalars"].copy_to_host()[K.S_E_MAX]) if m else float(p.E0)
+        n_sub = self.substeps_for(dt, E_max)
+        dt_s = dt / n_sub
+        self._check_stability(dt_s, E_max)
+        if self._wind is not None:
+            self._wind.check(cnt, t_new, mesh.nodes)
+        self._ocean.check(cnt, t_new, mesh.nodes)
+        self._launch(K.finish_moduli_kernel, m, d["e_dt"], d["gamma"], dt_s)
+        self._launch(K.prepare_nodes_kernel, n, d["ptr"], d["elems"], d["local"], d["area"], d["h"], d["b"],
+                     d["c"], float(p.rho_ice), dt_s, d["wind"], int(self._wind is not None), self._c_air,
+                     self._drag_coef, self._f_cor, d["vel"], d["vel_w"], d["vel_sum"], d["m_dt"], d["fext"],
+                     d["cda"], d["half_mf"], d["wb"], d["wc"])
+        t3 = time.perf_counter()
+        kt["setup"] = t3 - t2
+
+        # -- the sub-step loop -------------------------------------------------------------------
+        nu = p.poisson
+        kxx, kxy, kss = 1.0 / (1.0 - nu * nu), nu / (1.0 - nu * nu), (1.0 - nu) / (1.0 - nu * nu)
+        node_args = (d["vel_w"], d["vel_sum"], d["sigma_w"], d["ptr"], d["elems"], d["wb"], d["wc"], d["m_dt"],
+                     d["fext"], d["cda"], d["current"], self._cos_t, self._sin_t, d["half_mf"], d["fixed"],
+                     d["pres0"], d["pres1"])
+        mat = (d["conc_factor"], d["coh"], d["sig_c"], d["sig_t"], d["td"], d["heal"], d["e_dt"], d["gamma"])
+        consts = (kxx, kxy, kss, rh.q, rh._denom, float(p.max_damage), float(p.E0),
+                  float(p.relaxation_time_s), float(p.alpha))
+        coop_args = (n_sub, dt_s, *node_args, d["tri"], d["b"], d["c"], d["damage_w"], *mat, *consts,
+                     d["flag"], d["mean_vel"], d["strain"], d["counters"])
+        if self._choose_launch(coop_args) == "cooperative":
+            blocks = min(self._coop_max, self._blocks(max(n, m)))
+            K.substeps_cooperative[blocks, self.tpb](*coop_args)
+        else:
+            elem_args = (d["tri"], d["b"], d["c"], d["vel_w"], d["sigma_w"], d["damage_w"], *mat, *consts,
+                         d["flag"], d["counters"])
+            for k in range(n_sub):
+                self._launch(K.node_substep_kernel, n, (k + 1) / n_sub, *node_args)
+                self._launch(K.element_substep_kernel, m, dt_s, *elem_args)
+            self._launch(K.finish_nodes_kernel, n, n_sub, d["vel_w"], d["vel_sum"], d["mean_vel"], d["counters"])
+            self._launch(K.finish_elements_kernel, m, d["tri"], d["b"], d["c"], d["mean_vel"], d["strain"],
+                         d["flag"], d["counters"])
+        cnt = d["counters"].copy_to_host()
+        t4 = time.perf_counter()
+        kt["substeps"] = t4 - t3
+        if cnt[K.C_NONFINITE]:
+            raise SolverError(f"non-finite velocity at t = {t_new:.6g} s (explicit solver on CUDA, Δt = {dt:g} s, "
+                              f"{n_sub} sub-steps of {dt_s:.3g} s): sub-step beyond the stability limit?")
+
+        # -- commit: the working arrays become the state -----------------------------------------
+        for a, w in (("vel", "vel_w"), ("sigma", "sigma_w"), ("damage", "damage_w")):
+            d[a], d[w] = d[w], d[a]
+        state.time_s = t_new
+        state.step += 1
+        self._mean = self._strain = None
+        self._have_results = True
+        self.last_substeps = n_sub
+        n_capped = int(cnt[K.C_CAPPED])
+        rh.n_capped_total += n_capped
+        if self.sync == "step":
+            self.to_host(state)
+            kt["transfer"] += time.perf_counter() - t4
+        else:
+            self._host_stale = set(DEVICE_OWNED)
+        for k, v in kt.items():
+            self.kernel_timings[k] += v
+        info = StepInfo(iterations=n_sub, residual=0.0, n_damaged=int(cnt[K.C_DAMAGED]), n_capped=n_capped)
+        info.timings = {"assembly": kt["forcing"] + kt["setup"] + kt["transfer"], "solve": kt["substeps"],
+                        "damage": 0.0}
+        info.kernel_timings = kt
+        return info

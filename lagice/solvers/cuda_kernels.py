@@ -1,0 +1,479 @@
+"""numba.cuda kernels of the GPU explicit Maxwell-EB stepper (issue 15; see
+:mod:`lagice.solvers.cuda_explicit` and ``docs/gpu.md``).
+
+Same arithmetic as the CPU kernels, operation for operation:
+
+* the scalar building blocks are the CPU solver's own numba functions
+  (:func:`lagice.solvers.explicit.solve_node_2x2`, :func:`lagice.rheology._dcrit`,
+  :func:`lagice.rheology.damage_step`): numba compiles a CPU ``@njit`` function
+  called from a CUDA kernel for the CUDA target, so there is one source;
+* the array helpers are compiled from the CPU helpers' Python source
+  (``element_strain_rate.py_func``, ``forcing.records._bilinear.py_func``);
+* the bodies of the node and element sub-step updates, lumped mass, adjacency
+  weights, moduli, shape gradients and bilinear weights repeat the CPU
+  expressions in the same order (``tests/test_cuda_explicit.py`` checks the
+  results against the CPU solver in numba's CUDA simulator).
+
+Every kernel is a grid-stride loop over its own entities (nodes, elements,
+grid points), so any launch size is correct; nothing scatters except the
+counters (atomics, once per thread). Importing this module compiles nothing
+and needs no GPU (numba compiles a kernel at its first launch).
+
+Counters (int64) and scalars (float64) are small device arrays read once or
+twice per outer step; their slots are the ``C_*`` and ``S_*`` constants.
+"""
+from __future__ import annotations
+
+import math
+
+from numba import cuda
+
+from forcing.records import _bilinear
+
+from ..fem import element_strain_rate
+from ..rheology import _dcrit, damage_step
+from .explicit import solve_node_2x2
+
+# counter slots (int64)
+C_CAPPED, C_DAMAGED, C_NONFINITE, C_INVERTED = 0, 1, 2, 3
+C_WIND_OUT, C_WIND_BAD, C_OCEAN_OUT, C_OCEAN_BAD = 4, 5, 6, 7
+N_COUNTERS = 8
+# scalar slots (float64)
+S_E_MAX, S_AREA_MIN = 0, 1
+N_SCALARS = 2
+
+strain_rate_dev = cuda.jit(device=True)(element_strain_rate.py_func)
+bilinear_dev = cuda.jit(device=True)(_bilinear.py_func)
+
+
+# ----------------------------------------------------------------------------
+# per-entity device functions (the sub-step arithmetic)
+# ----------------------------------------------------------------------------
+@cuda.jit(device=True)
+def node_update(i, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
+                half_mf, fixed, pres0, pres1, w_time):
+    """One node of :func:`lagice.solvers.explicit._node_velocity` (same expressions)."""
+    fx0 = fixed[i, 0]
+    fx1 = fixed[i, 1]
+    if fx0 and fx1:
+        vel[i, 0] = pres0[i, 0] + w_time * (pres1[i, 0] - pres0[i, 0])
+        vel[i, 1] = pres0[i, 1] + w_time * (pres1[i, 1] - pres0[i, 1])
+        vel_sum[i, 0] += vel[i, 0]
+        vel_sum[i, 1] += vel[i, 1]
+        return
+    fx = 0.0
+    fy = 0.0
+    for p in range(ptr[i], ptr[i + 1]):
+        e = elems[p]
+        sxx = sigma[e, 0]
+        syy = sigma[e, 1]
+        sxy = sigma[e, 2]
+        fx -= wb[p] * sxx + wc[p] * sxy
+        fy -= wb[p] * sxy + wc[p] * syy
+    u = vel[i, 0]
+    v = vel[i, 1]
+    md = m_dt[i]
+    uwx = current[i, 0]
+    uwy = current[i, 1]
+    ru = uwx - u
+    rv = uwy - v
+    cd = cda[i] * math.sqrt(ru * ru + rv * rv)
+    hf = half_mf[i]
+    a11 = md + cd * cos_t
+    a12 = -cd * sin_t - hf
+    a21 = cd * sin_t + hf
+    a22 = md + cd * cos_t
+    rx = md * u + fx + fext[i, 0] + cd * (cos_t * uwx - sin_t * uwy) + hf * v
+    ry = md * v + fy + fext[i, 1] + cd * (sin_t * uwx + cos_t * uwy) - hf * u
+    pu = pres0[i, 0] + w_time * (pres1[i, 0] - pres0[i, 0]) if fx0 else 0.0
+    pv = pres0[i, 1] + w_time * (pres1[i, 1] - pres0[i, 1]) if fx1 else 0.0
+    un, vn = solve_node_2x2(a11, a12, a21, a22, rx, ry, fx0, fx1, pu, pv)
+    vel[i, 0] = un
+    vel[i, 1] = vn
+    vel_sum[i, 0] += un
+    vel_sum[i, 1] += vn
+
+
+@cuda.jit(device=True)
+def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c, sigma_t, td,
+                   heal_rate, e_dt, gamma, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0,
+                   alpha, damaged_flag):
+    """One element of :func:`lagice.solvers.explicit._element_stress_damage`
+    (same expressions); returns 1 when the damage cap acted."""
+    exx, eyy, exy = strain_rate_dev(tri, b, c, vel, e)
+    ed = e_dt[e]
+    g = gamma[e]
+    sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * g
+    syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * g
+    sxy = (sigma[e, 2] + ed * (kss * exy)) * g
+    mm = 0.5 * (sxx + syy)
+    rr = math.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
+    s1 = mm + rr
+    if s1 < sigma_t[e] and q * s1 - (mm - rr) < sigma_c[e]:
+        dc = 1.0
+    else:
+        dc = _dcrit(sxx, syy, sxy, cohesion[e], q, denom)
+    d0 = damage[e]
+    d, f, capped = damage_step(d0, dc, dt_s, td[e], heal_rate[e], max_damage)
+    if dc < 1.0:
+        sxx *= f
+        syy *= f
+        sxy *= f
+        damaged_flag[e] = 1
+    sigma[e, 0] = sxx
+    sigma[e, 1] = syy
+    sigma[e, 2] = sxy
+    if d != d0:
+        damage[e] = d
+        x = (1.0 - d) * conc_factor[e]
+        if alpha == 4.0:
+            lam = lambda0 * (x * x * x)
+        elif alpha == 5.0:
+            lam = lambda0 * (x * x) * (x * x)
+        else:
+            lam = lambda0 * x ** (alpha - 1.0)
+        e_dt[e] = dt_s * (E0 * x)
+        gamma[e] = lam / (lam + dt_s)
+    return capped
+
+
+@cuda.jit(device=True)
+def finish_node(i, vel, vel_sum, n_sub, mean_vel):
+    """Mean velocity over the sub-steps (``vel_sum / n_sub``); returns 1 when the
+    last sub-step's velocity is not finite."""
+    mean_vel[i, 0] = vel_sum[i, 0] / n_sub
+    mean_vel[i, 1] = vel_sum[i, 1] / n_sub
+    u = vel[i, 0]
+    v = vel[i, 1]
+    if math.isnan(u) or math.isinf(u) or math.isnan(v) or math.isinf(v):
+        return 1
+    return 0
+
+
+@cuda.jit(device=True)
+def finish_element(e, tri, b, c, mean_vel, strain, damaged_flag):
+    """Strain rate of the mean velocity; returns the element's damaged flag."""
+    exx, eyy, exy = strain_rate_dev(tri, b, c, mean_vel, e)
+    strain[e, 0] = exx
+    strain[e, 1] = eyy
+    strain[e, 2] = exy
+    return damaged_flag[e]
+
+
+# ----------------------------------------------------------------------------
+# sub-step loop: one cooperative launch per outer step ...
+# ----------------------------------------------------------------------------
+@cuda.jit
+def substeps_cooperative(n_sub, dt_s, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current,
+                         cos_t, sin_t, half_mf, fixed, pres0, pres1, tri, b, c, damage, conc_factor,
+                         cohesion, sigma_c, sigma_t, td, heal_rate, e_dt, gamma, kxx, kxy, kss, q, denom,
+                         max_damage, E0, lambda0, alpha, damaged_flag, mean_vel, strain, counters):
+    """All ``n_sub`` sub-steps, then the mean velocity and its strain rate, in one
+    launch: the node and element phases are separated by a grid-wide barrier
+    (cooperative groups), so the grid must be co-resident (launch with at most
+    ``max_cooperative_grid_blocks`` blocks)."""
+    grid = cuda.cg.this_grid()
+    start = cuda.grid(1)
+    stride = cuda.gridsize(1)
+    n = ptr.shape[0] - 1
+    m = tri.shape[0]
+    capped = 0
+    for k in range(n_sub):
+        w_time = (k + 1) / n_sub
+        for i in range(start, n, stride):
+            node_update(i, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
+                        half_mf, fixed, pres0, pres1, w_time)
+        grid.sync()
+        for e in range(start, m, stride):
+            capped += element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c,
+                                     sigma_t, td, heal_rate, e_dt, gamma, dt_s, kxx, kxy, kss, q, denom,
+                                     max_damage, E0, lambda0, alpha, damaged_flag)
+        grid.sync()
+    bad = 0
+    for i in range(start, n, stride):
+        bad += finish_node(i, vel, vel_sum, n_sub, mean_vel)
+    grid.sync()
+    ndam = 0
+    for e in range(start, m, stride):
+        ndam += finish_element(e, tri, b, c, mean_vel, strain, damaged_flag)
+    if capped:
+        cuda.atomic.add(counters, C_CAPPED, capped)
+    if bad:
+        cuda.atomic.add(counters, C_NONFINITE, bad)
+    if ndam:
+        cuda.atomic.add(counters, C_DAMAGED, ndam)
+
+
+# ----------------------------------------------------------------------------
+# ... or two launches per sub-step (fallback) plus two to finish
+# ----------------------------------------------------------------------------
+@cuda.jit
+def node_substep_kernel(w_time, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current,
+                        cos_t, sin_t, half_mf, fixed, pres0, pres1):
+    n = ptr.shape[0] - 1
+    for i in range(cuda.grid(1), n, cuda.gridsize(1)):
+        node_update(i, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
+                    half_mf, fixed, pres0, pres1, w_time)
+
+
+@cuda.jit
+def element_substep_kernel(dt_s, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c, sigma_t,
+                           td, heal_rate, e_dt, gamma, kxx, kxy, kss, q, denom, max_damage, E0, lambda0,
+                           alpha, damaged_flag, counters):
+    capped = 0
+    for e in range(cuda.grid(1), tri.shape[0], cuda.gridsize(1)):
+        capped += element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c, sigma_t,
+                                 td, heal_rate, e_dt, gamma, dt_s, kxx, kxy, kss, q, denom, max_damage,
+                                 E0, lambda0, alpha, damaged_flag)
+    if capped:
+        cuda.atomic.add(counters, C_CAPPED, capped)
+
+
+@cuda.jit
+def finish_nodes_kernel(n_sub, vel, vel_sum, mean_vel, counters):
+    bad = 0
+    for i in range(cuda.grid(1), vel.shape[0], cuda.gridsize(1)):
+        bad += finish_node(i, vel, vel_sum, n_sub, mean_vel)
+    if bad:
+        cuda.atomic.add(counters, C_NONFINITE, bad)
+
+
+@cuda.jit
+def finish_elements_kernel(tri, b, c, mean_vel, strain, damaged_flag, counters):
+    ndam = 0
+    for e in range(cuda.grid(1), tri.shape[0], cuda.gridsize(1)):
+        ndam += finish_element(e, tri, b, c, mean_vel, strain, damaged_flag)
+    if ndam:
+        cuda.atomic.add(counters, C_DAMAGED, ndam)
+
+
+# ----------------------------------------------------------------------------
+# per-geometry and per-outer-step setup
+# ----------------------------------------------------------------------------
+@cuda.jit
+def geometry_kernel(nodes, tri, b, c, area, td, shear_wave_speed, scalars, counters):
+    """P1 gradients and areas (:func:`lagice.fem.shape_gradients`), damage time
+    td = sqrt(2 area)/cs (``MaxwellEB.damage_time``); smallest area and the count
+    of non-positive areas into ``scalars``/``counters``."""
+    amin = math.inf
+    bad = 0
+    for e in range(cuda.grid(1), tri.shape[0], cuda.gridsize(1)):
+        i = tri[e, 0]
+        j = tri[e, 1]
+        k = tri[e, 2]
+        x0 = nodes[i, 0]
+        y0 = nodes[i, 1]
+        x1 = nodes[j, 0]
+        y1 = nodes[j, 1]
+        x2 = nodes[k, 0]
+        y2 = nodes[k, 1]
+        a2 = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)
+        ar = 0.5 * a2
+        area[e] = ar
+        inv = 1.0 / a2
+        b[e, 0] = (y1 - y2) * inv
+        b[e, 1] = (y2 - y0) * inv
+        b[e, 2] = (y0 - y1) * inv
+        c[e, 0] = (x2 - x1) * inv
+        c[e, 1] = (x0 - x2) * inv
+        c[e, 2] = (x1 - x0) * inv
+        td[e] = math.sqrt(2.0 * ar) / shear_wave_speed
+        if ar <= 0.0:
+            bad += 1
+        amin = min(amin, ar)
+    cuda.atomic.min(scalars, S_AREA_MIN, amin)
+    if bad:
+        cuda.atomic.add(counters, C_INVERTED, bad)
+
+
+@cuda.jit
+def prepare_elements_kernel(damage, sigma, concentration, cohesion, E0, lambda0, c_star, alpha, denom, q,
+                            damage_w, sigma_w, e_buf, lam_buf, conc_factor, sigma_c, sigma_t, damaged_flag,
+                            scalars):
+    """Start of an outer step, per element: working copies of σ and d (the
+    committed state stays untouched until the step succeeds), E and λ
+    (``MaxwellEB.moduli``) into ``e_buf``/``lam_buf``, g = exp(−c*(1−A)),
+    σc = 2C/denom, σT = σc/q, flags cleared; E_max into ``scalars``."""
+    emax = -math.inf
+    for e in range(cuda.grid(1), damage.shape[0], cuda.gridsize(1)):
+        d = damage[e]
+        damage_w[e] = d
+        sigma_w[e, 0] = sigma[e, 0]
+        sigma_w[e, 1] = sigma[e, 1]
+        sigma_w[e, 2] = sigma[e, 2]
+        cf = math.exp(-c_star * (1.0 - concentration[e]))
+        E = E0 * (1.0 - d) * cf
+        e_buf[e] = E
+        lam_buf[e] = lambda0 * ((1.0 - d) * cf) ** (alpha - 1.0)
+        conc_factor[e] = cf
+        sc = 2.0 * cohesion[e] / denom
+        sigma_c[e] = sc
+        sigma_t[e] = sc / q
+        damaged_flag[e] = 0
+        emax = max(emax, E)
+    cuda.atomic.max(scalars, S_E_MAX, emax)
+
+
+@cuda.jit
+def finish_moduli_kernel(e_buf, lam_buf, dt_s):
+    """In place: e_buf ← Δt_s E, lam_buf ← λ/(λ+Δt_s) (once Δt_s is known)."""
+    for e in range(cuda.grid(1), e_buf.shape[0], cuda.gridsize(1)):
+        e_buf[e] = dt_s * e_buf[e]
+        lam = lam_buf[e]
+        lam_buf[e] = lam / (lam + dt_s)
+
+
+@cuda.jit
+def prepare_nodes_kernel(ptr, elems, local, area, h, b, c, rho, dt_s, wind, has_wind, c_air, drag_coef,
+                         coriolis_f, vel, vel_w, vel_sum, m_dt, fext, cda, half_mf, wb, wc):
+    """Per node: lumped mass and area (``fem.lumped_mass``), adjacency weights
+    (``explicit._adjacency_weights``, thickness-weighted), m/Δt_s, wind force
+    a·τa with τa = (ρa Ca |Ua|) Ua (``WindStress.stress``), drag coefficient
+    a·ρw·Cw, ½ m f; working copy of the velocity, zeroed velocity sum."""
+    n = ptr.shape[0] - 1
+    for i in range(cuda.grid(1), n, cuda.gridsize(1)):
+        sm = 0.0
+        sa = 0.0
+        for p in range(ptr[i], ptr[i + 1]):
+            e = elems[p]
+            k = local[p]
+            sm += (rho * h[e]) * area[e]
+            sa += 1.0 * area[e]
+            w = area[e] * h[e]
+            wb[p] = w * b[e, k]
+            wc[p] = w * c[e, k]
+        mass = sm / 3.0
+        na = sa / 3.0
+        m_dt[i] = mass / dt_s
+        tx = 0.0
+        ty = 0.0
+        if has_wind:
+            u = wind[i, 0]
+            v = wind[i, 1]
+            s = math.hypot(u, v)
+            tx = 0.0 + (c_air * s) * u
+            ty = 0.0 + (c_air * s) * v
+        fext[i, 0] = tx * na
+        fext[i, 1] = ty * na
+        cda[i] = drag_coef * na
+        half_mf[i] = 0.5 * mass * coriolis_f
+        vel_w[i, 0] = vel[i, 0]
+        vel_w[i, 1] = vel[i, 1]
+        vel_sum[i, 0] = 0.0
+        vel_sum[i, 1] = 0.0
+
+
+@cuda.jit
+def scatter_prescribed_kernel(dofs, vals0, vals1, pres0, pres1):
+    """pres.reshape(-1)[dofs] = vals (``LumpedMassSolver._prescribed_velocity``)."""
+    for j in range(cuda.grid(1), dofs.shape[0], cuda.gridsize(1)):
+        d = dofs[j]
+        pres0[d // 2, d % 2] = vals0[j]
+        pres1[d // 2, d % 2] = vals1[j]
+
+
+@cuda.jit
+def fill_kernel(out, value):
+    """out[...] = value for a 1-D array."""
+    for j in range(cuda.grid(1), out.shape[0], cuda.gridsize(1)):
+        out[j] = value
+
+
+@cuda.jit
+def fill_pair_kernel(out, u, v):
+    """out[:, 0] = u, out[:, 1] = v for an (n, 2) array."""
+    for j in range(cuda.grid(1), out.shape[0], cuda.gridsize(1)):
+        out[j, 0] = u
+        out[j, 1] = v
+
+
+# ----------------------------------------------------------------------------
+# forcing records (forcing.records on the device)
+# ----------------------------------------------------------------------------
+@cuda.jit(device=True)
+def cell_dev(ax, p, uniform, inv_d):
+    """:func:`forcing.records._cell`: arithmetic on a uniform axis, binary search
+    (``searchsorted(side='right') - 1``) otherwise."""
+    n = ax.shape[0]
+    if uniform:
+        i = max(min(int((p - ax[0]) * inv_d), n - 2), 0)
+        if p < ax[i] and i > 0:
+            i -= 1
+        elif p >= ax[i + 1] and i < n - 2:
+            i += 1
+        return i
+    lo = 0
+    hi = n
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if ax[mid] <= p:
+            lo = mid + 1
+        else:
+            hi = mid
+    return max(min(lo - 1, n - 2), 0)
+
+
+@cuda.jit
+def blend_records_kernel(r0, r1, a, out):
+    """out = (1 − a) r0 + a r1 on the record grid (records ``(nc, ny, nx)``)."""
+    nc = r0.shape[0]
+    ny = r0.shape[1]
+    nx = r0.shape[2]
+    for k in range(cuda.grid(1), nc * ny * nx, cuda.gridsize(1)):
+        cc = k // (ny * nx)
+        rem = k - cc * (ny * nx)
+        j = rem // nx
+        i = rem - j * nx
+        out[cc, j, i] = (1.0 - a) * r0[cc, j, i] + a * r1[cc, j, i]
+
+
+@cuda.jit
+def record_field_kernel(nodes, ax, ay, ux, uy, clamp, r0, r1, a, two_records, out, counters, c_out, c_bad):
+    """A vector record field at the nodes (:class:`forcing.records.RecordField`
+    on a :class:`~forcing.records.RegularGrid`): bilinear weights as
+    ``_bilinear_weights``, then one record (``two_records`` = 0: a single record
+    or a grid already blended in time) or ``(1−a)·bilinear(r0) + a·bilinear(r1)``
+    (``_interp_records``). Points outside the grid (when not clamping) and
+    non-finite values are counted into ``counters[c_out]``/``counters[c_bad]``."""
+    nx = ax.shape[0]
+    ny = ay.shape[0]
+    inv_dx = (nx - 1) / (ax[nx - 1] - ax[0])
+    inv_dy = (ny - 1) / (ay[ny - 1] - ay[0])
+    n_out = 0
+    n_bad = 0
+    for k in range(cuda.grid(1), nodes.shape[0], cuda.gridsize(1)):
+        px = nodes[k, 0]
+        py = nodes[k, 1]
+        bad = 0
+        if not (px >= ax[0] and px <= ax[nx - 1]):
+            bad = 1
+            if px > ax[nx - 1]:
+                px = ax[nx - 1]
+            else:
+                px = ax[0]
+        if not (py >= ay[0] and py <= ay[ny - 1]):
+            bad = 1
+            if py > ay[ny - 1]:
+                py = ay[ny - 1]
+            else:
+                py = ay[0]
+        n_out += bad
+        i = cell_dev(ax, px, ux, inv_dx)
+        j = cell_dev(ay, py, uy, inv_dy)
+        fx = (px - ax[i]) / (ax[i + 1] - ax[i])
+        fy = (py - ay[j]) / (ay[j + 1] - ay[j])
+        nonfinite = 0
+        for cc in range(r0.shape[0]):
+            if two_records:
+                v = ((1.0 - a) * bilinear_dev(r0, cc, i, j, fx, fy)
+                     + a * bilinear_dev(r1, cc, i, j, fx, fy))
+            else:
+                v = bilinear_dev(r0, cc, i, j, fx, fy)
+            if math.isnan(v) or math.isinf(v):
+                nonfinite = 1
+            out[k, cc] = v
+        n_bad += nonfinite
+    if n_out and not clamp:
+        cuda.atomic.add(counters, c_out, n_out)
+    if n_bad:
+        cuda.atomic.add(counters, c_bad, n_bad)
