@@ -86,6 +86,34 @@ def test_device_option_schema_and_checks(monkeypatch):
 
 
 # ----------------------------------------------------------------------------
+# compilation for a real device (NVVM, no GPU needed): what the simulator cannot see
+# ----------------------------------------------------------------------------
+@pytest.mark.slow
+def test_every_kernel_compiles_for_sm90():
+    """Every kernel compiles to PTX for an H100 (sm_90) with the signatures the
+    solver launches; with ptxas it assembles, and the grid-sync kernel links
+    with libcudadevrt (as the driver links it at load). Skipped without NVVM."""
+    from numba.cuda.dispatcher import CUDADispatcher
+
+    from lagice.solvers import cuda_kernels as K
+
+    r = subprocess.run([sys.executable, str(ROOT / "tests" / "cuda_ptx_check.py")], check=False,
+                       capture_output=True, text=True, env=_env(False), timeout=300, cwd=ROOT)
+    assert r.returncode == 0, r.stderr[-3000:]
+    rep = json.loads(r.stdout)
+    if not rep["nvvm"]:
+        pytest.skip(f"no NVVM to compile with: {rep['reason']}")
+    kernels = {name for name, obj in vars(K).items()
+               if isinstance(obj, CUDADispatcher) and not obj.targetoptions.get("device")}
+    assert set(rep["kernels"]) == kernels  # the check covers every kernel
+    for name, k in rep["kernels"].items():
+        assert k["ok"], (name, k.get("error"))
+        assert k.get("ptxas_ok", True), (name, k.get("ptxas_error"))
+    coop = rep["kernels"]["substeps_cooperative"]
+    assert coop["grid_sync"] and coop.get("linked_with_cudadevrt", True), coop.get("nvlink_error")
+
+
+# ----------------------------------------------------------------------------
 # simulator: the device kernels against the CPU kernels
 # ----------------------------------------------------------------------------
 @pytest.fixture(scope="module")

@@ -3,16 +3,20 @@
 
 Same arithmetic as the CPU kernels, operation for operation:
 
-* the scalar building blocks are the CPU solver's own numba functions
-  (:func:`lagice.solvers.explicit.solve_node_2x2`, :func:`lagice.rheology._dcrit`,
-  :func:`lagice.rheology.damage_step`): numba compiles a CPU ``@njit`` function
-  called from a CUDA kernel for the CUDA target, so there is one source;
+* :func:`lagice.solvers.explicit.solve_node_2x2` and
+  :func:`lagice.rheology._principal` are the CPU solver's own numba functions:
+  numba compiles a CPU ``@njit`` function called from a CUDA kernel for the
+  CUDA target, so there is one source;
 * the array helpers are compiled from the CPU helpers' Python source
   (``element_strain_rate.py_func``, ``forcing.records._bilinear.py_func``);
-* the bodies of the node and element sub-step updates, lumped mass, adjacency
-  weights, moduli, shape gradients and bilinear weights repeat the CPU
-  expressions in the same order (``tests/test_cuda_explicit.py`` checks the
-  results against the CPU solver in numba's CUDA simulator).
+* ``rheology._dcrit`` and ``rheology.damage_step`` are repeated here
+  (:func:`dcrit_dev`, :func:`damage_step_dev`) because they call the builtin
+  ``min``, which numba 0.68's CUDA target cannot compile; so are the bodies of
+  the node and element sub-step updates, lumped mass, adjacency weights,
+  moduli, shape gradients and bilinear weights: the CPU expressions in the
+  same order (``tests/test_cuda_explicit.py`` checks the results against the
+  CPU solver in numba's CUDA simulator; ``tests/test_cuda_explicit.py`` also
+  compiles every kernel to PTX where NVVM is installed).
 
 Every kernel is a grid-stride loop over its own entities (nodes, elements,
 grid points), so any launch size is correct; nothing scatters except the
@@ -31,7 +35,7 @@ from numba import cuda
 from forcing.records import _bilinear
 
 from ..fem import element_strain_rate
-from ..rheology import _dcrit, damage_step
+from ..rheology import _principal
 from .explicit import solve_node_2x2
 
 # counter slots (int64)
@@ -44,6 +48,59 @@ N_SCALARS = 2
 
 strain_rate_dev = cuda.jit(device=True)(element_strain_rate.py_func)
 bilinear_dev = cuda.jit(device=True)(_bilinear.py_func)
+
+
+# ----------------------------------------------------------------------------
+# min/max and the two rheology helpers that use them. numba 0.68's built-in
+# CUDA target cannot compile the builtin min()/max() (their generic overload
+# takes *args: "Signature mismatch: 2 argument types given, but function takes
+# 1 arguments" when compiled to PTX), so rheology._dcrit and
+# rheology.damage_step are repeated here with min2 (numba's and Python's
+# min(a, b): b if b < a else a). Everything else is the CPU code.
+# ----------------------------------------------------------------------------
+@cuda.jit(device=True)
+def min2(a, b):
+    """``min(a, b)`` as numba and Python compute it: ``b if b < a else a``."""
+    return b if b < a else a  # noqa: FURB136 - builtin min does not compile for CUDA (numba 0.68)
+
+
+@cuda.jit(device=True)
+def max2(a, b):
+    """``max(a, b)`` as numba and Python compute it: ``b if b > a else a``."""
+    return b if b > a else a  # noqa: FURB136 - builtin max does not compile for CUDA (numba 0.68)
+
+
+@cuda.jit(device=True)
+def dcrit_dev(sxx, syy, sxy, cohesion, q, denom):
+    """:func:`lagice.rheology._dcrit` (same expressions, ``min`` → :func:`min2`)."""
+    s1, s2 = _principal(sxx, syy, sxy)
+    sigma_c = 2.0 * cohesion / denom
+    sigma_t = sigma_c / q
+    dc = 1.0
+    if s1 > 0.0:
+        dc = min2(dc, sigma_t / s1)
+    mc = q * s1 - s2
+    if mc > 0.0:
+        dc = min2(dc, sigma_c / mc)
+    return dc
+
+
+@cuda.jit(device=True)
+def damage_step_dev(d, dc, dt, td, heal_rate, max_damage):
+    """:func:`lagice.rheology.damage_step` (same expressions, ``min`` → :func:`min2`)."""
+    f = 1.0
+    if dc < 1.0:
+        r = min2(1.0, dt / td) * (1.0 - dc)
+        d = 1.0 - (1.0 - d) * (1.0 - r)
+        f = 1.0 - r
+    d -= dt * heal_rate
+    if d < 0.0:  # noqa: PLR1730 - no builtin max on CUDA (numba 0.68)
+        d = 0.0
+    capped = 0
+    if d > max_damage:
+        d = max_damage
+        capped = 1
+    return d, f, capped
 
 
 # ----------------------------------------------------------------------------
@@ -112,9 +169,9 @@ def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigm
     if s1 < sigma_t[e] and q * s1 - (mm - rr) < sigma_c[e]:
         dc = 1.0
     else:
-        dc = _dcrit(sxx, syy, sxy, cohesion[e], q, denom)
+        dc = dcrit_dev(sxx, syy, sxy, cohesion[e], q, denom)
     d0 = damage[e]
-    d, f, capped = damage_step(d0, dc, dt_s, td[e], heal_rate[e], max_damage)
+    d, f, capped = damage_step_dev(d0, dc, dt_s, td[e], heal_rate[e], max_damage)
     if dc < 1.0:
         sxx *= f
         syy *= f
@@ -280,7 +337,7 @@ def geometry_kernel(nodes, tri, b, c, area, td, shear_wave_speed, scalars, count
         td[e] = math.sqrt(2.0 * ar) / shear_wave_speed
         if ar <= 0.0:
             bad += 1
-        amin = min(amin, ar)
+        amin = min2(amin, ar)
     cuda.atomic.min(scalars, S_AREA_MIN, amin)
     if bad:
         cuda.atomic.add(counters, C_INVERTED, bad)
@@ -310,7 +367,7 @@ def prepare_elements_kernel(damage, sigma, concentration, cohesion, E0, lambda0,
         sigma_c[e] = sc
         sigma_t[e] = sc / q
         damaged_flag[e] = 0
-        emax = max(emax, E)
+        emax = max2(emax, E)
     cuda.atomic.max(scalars, S_E_MAX, emax)
 
 
@@ -396,7 +453,7 @@ def cell_dev(ax, p, uniform, inv_d):
     (``searchsorted(side='right') - 1``) otherwise."""
     n = ax.shape[0]
     if uniform:
-        i = max(min(int((p - ax[0]) * inv_d), n - 2), 0)
+        i = max2(min2(int((p - ax[0]) * inv_d), n - 2), 0)
         if p < ax[i] and i > 0:
             i -= 1
         elif p >= ax[i + 1] and i < n - 2:
@@ -410,7 +467,7 @@ def cell_dev(ax, p, uniform, inv_d):
             lo = mid + 1
         else:
             hi = mid
-    return max(min(lo - 1, n - 2), 0)
+    return max2(min2(lo - 1, n - 2), 0)
 
 
 @cuda.jit
