@@ -12,6 +12,10 @@ An activity has ``name``, ``schedule`` and
 * ``__call__(sim)`` — when the schedule is due;
 * ``finalize(sim)`` — once after the loop (``at_end`` activities run then too,
   when they did not just run).
+
+Before an activity with ``needs_host_state`` (the default) runs, the model brings
+the state fields a device stepper keeps on its device up to date on the host
+(:meth:`lagice.model.Model.needs_host_state`; free on the CPU).
 """
 from __future__ import annotations
 
@@ -32,6 +36,7 @@ class Activity:
     name = "activity"
     at_end = False      # also run once after the last step (if not just run)
     at_start = False    # also run before the first step of a fresh run
+    needs_host_state = True  # reads velocity, stress or damage of the host state
 
     def __init__(self, schedule):
         self.schedule = parse_schedule(schedule, f"{self.name} every")
@@ -43,6 +48,8 @@ class Activity:
             self.run(sim)
 
     def run(self, sim) -> None:
+        if self.needs_host_state:
+            sim.model.needs_host_state()
         self(sim)
         self.last_iteration = sim.model.clock.iteration
 
@@ -136,6 +143,7 @@ class Progress(Activity):
 
     name = "progress"
     at_end = True
+    needs_host_state = False  # clock, counters and the volume budget only
 
     def __init__(self, schedule="wall 10s", stream=None):
         super().__init__(schedule)
@@ -180,9 +188,12 @@ class NaNChecker(Activity):
     (fields from the registry, :mod:`lagice.fields`), or of an ice speed above
     ``max_speed_m_s`` (default 10 m/s: sea ice in free drift under a 30 m/s wind moves
     at about 1 m/s; an unstable time step makes the speed grow without bound, and the
-    quadratic ocean drag can keep it finite). Runs every step by default."""
+    quadratic ocean drag can keep it finite). Runs every step by default. Fields a
+    device stepper checked on its device are not downloaded
+    (:meth:`lagice.model.Model.device_checked_fields`)."""
 
     name = "nan_checker"
+    needs_host_state = False  # downloads only what the device could not clear
 
     def __init__(self, schedule=None, max_speed_m_s: float = 10.0):
         from .errors import check_range
@@ -194,11 +205,14 @@ class NaNChecker(Activity):
         from .fields import FIELDS, NODE, first_non_finite
 
         m = sim.model
-        bad = first_non_finite(m.state)
+        checked = m.device_checked_fields(self.max_speed_m_s)
+        bad = first_non_finite(m.state, skip=checked)
         if bad is not None:
             spec, idx, val = bad
             what = f"non-finite {spec.name} ({val})"
         else:
+            if "velocity" in checked:
+                return
             v = m.state.velocity  # the dynamic velocity: an unstable sub-step oscillation
             speed = np.hypot(v[:, 0], v[:, 1])  # averages out of the transport velocity
             idx = int(np.argmax(speed)) if speed.size else 0

@@ -164,10 +164,12 @@ def checkpoint_arrays(state) -> dict:
     return out
 
 
-def first_non_finite(state):
+def first_non_finite(state, skip=()):
     """``(field, index, value)`` of the first NaN/Inf in the floating-point state
-    fields, or None when all are finite."""
+    fields (but those named in ``skip``), or None when all are finite."""
     for f in FIELDS.values():
+        if f.name in skip:
+            continue
         a = getattr(state, f.name, None)
         if a is None or a.dtype.kind != "f":
             continue

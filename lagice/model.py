@@ -125,6 +125,34 @@ class Model:
         v = self.stepper.transport_velocity
         return self.state.velocity if v is None else v
 
+    def needs_host_state(self, fields=None) -> IceState:
+        """The state, with the fields a device stepper keeps on its device between
+        steps (velocity, stress, damage: ``CudaExplicitSolver(sync="explicit")``,
+        docs/gpu.md) brought up to date on the host. Call before reading or editing
+        them between steps (scheduled activities, checkpoints and remeshing do);
+        free for CPU steppers, whose host state is always current."""
+        to_host = getattr(self.stepper, "to_host", None)
+        if to_host is not None:
+            if fields is None:
+                to_host(self.state)
+            else:
+                to_host(self.state, tuple(fields))
+        return self.state
+
+    def device_checked_fields(self, max_speed_m_s: float) -> tuple:
+        """State fields a device stepper found finite, with ice speeds below
+        ``max_speed_m_s`` [m s-1], at the end of the last step (so the NaN checker
+        need not download them); () for CPU steppers. When the device found a
+        problem, the fields are downloaded (:meth:`needs_host_state`) and () returned."""
+        check = getattr(self.stepper, "device_check", None)
+        if check is None:
+            return ()
+        fields, ok = check(max_speed_m_s)
+        if ok:
+            return tuple(fields)
+        self.needs_host_state()
+        return ()
+
     @property
     def strain_rate(self) -> np.ndarray | None:
         """(m, 3) [s-1] strain rate of the transport velocity over the last step."""
@@ -177,7 +205,7 @@ class Model:
     def state_arrays(self) -> dict:
         """Every array a checkpoint needs: the mesh, the registry's checkpointed
         state fields and the components' arrays (``component.<name>.<array>``)."""
-        st = self.state
+        st = self.needs_host_state()
         m = st.mesh
         arrays = {"mesh_nodes": m.nodes, "mesh_triangles": m.triangles,
                   "mesh_boundary_edges": m.boundary_edges, "mesh_boundary_tags": m.boundary_tags}

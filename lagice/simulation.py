@@ -177,6 +177,7 @@ class Simulation:
                 act.finalize(self)
             elif isinstance(act, TimeSeriesOutput):
                 act.writer.flush()
+        model.needs_host_state()  # the caller reads model.state next
         self.wall_total = self.wall_s
         self._t_run = None
         return self.summary()

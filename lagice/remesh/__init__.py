@@ -214,7 +214,8 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
                      rings: int = 2, max_retries: int = 2, max_patch_fraction: float = 0.5,
                      flagged=None, log: RemeshLog | None = None, algorithm: int = 6,
                      remap_method: str = "auto", damage_remap: str = "area",
-                     force_global: bool = False, time_s: float = 0.0, step: int = 0) -> RemeshEvent | None:
+                     force_global: bool = False, time_s: float = 0.0, step: int = 0,
+                     before_remap=None) -> RemeshEvent | None:
     """Check the trigger and, if needed, remesh and remap ``state`` in place.
 
     Args:
@@ -234,6 +235,9 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
         damage_remap: ``"area"`` or ``"compliance"`` (:func:`remesh_region`).
         force_global: remesh everything (regardless of the trigger).
         time_s, step: model time [s] and iteration, recorded in the event.
+        before_remap: called (no arguments) when the trigger fired, before any field
+            is read (:meth:`lagice.model.Model.needs_host_state`: a device stepper's
+            fields come to the host only when a remesh happens).
 
     Returns:
         :class:`RemeshEvent`, or None when the trigger found nothing.
@@ -249,6 +253,8 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
     t_trig = time.perf_counter() - t_start
     if not trig.any and not force_global:
         return None
+    if before_remap is not None:
+        before_remap()
     m = mesh.n_elements
     ev = RemeshEvent(time_s=float(time_s), step=int(step), kind="failed",
                      trigger_counts=dict(trig.counts), n_bad=int(trig.bad.sum()),

@@ -46,7 +46,8 @@ class Remesher:
         motion = model.component("mesh_motion")
         ev = remesh_if_needed(st, self.size_field, solver=model.stepper, params=self.trigger,
                               flagged=motion.last_flagged if motion is not None else None, log=self.log,
-                              time_s=model.clock.time_s + dt_s, step=model.clock.iteration + 1, **self.options)
+                              time_s=model.clock.time_s + dt_s, step=model.clock.iteration + 1,
+                              before_remap=model.needs_host_state, **self.options)
         if ev is not None and ev.kind != "failed":
             st.counters["remesh_count"] = st.counters.get("remesh_count", 0) + 1
             st.counters["mesh_epoch"] = st.counters.get("mesh_epoch", 0) + 1

@@ -14,6 +14,12 @@ u^{n+1} for the backward-Euler implicit and mEVP steppers, the prescribed veloci
 for the kinematic stepper. Nodes, drifters and the displacement behind every
 Lagrangian deformation rate move with it, and ``last_strain_rate`` is its strain
 rate.
+
+A stepper that keeps fields on a device between steps (the GPU explicit stepper,
+docs/gpu.md) also has ``to_host(state, fields)``, which brings them up to date in
+``state`` (the model calls it through :meth:`lagice.model.Model.needs_host_state`
+before anything reads them), and ``device_check(max_speed_m_s)`` for the NaN
+checker. Both are optional: CPU steppers have neither.
 """
 from __future__ import annotations
 
