@@ -1,30 +1,34 @@
-"""GPU explicit stepper throughput (issue 15): element-sub-steps per second,
-host overhead per outer step, state transfer cost, memory per element, and
-agreement with the CPU solver on the same problem.
+"""GPU explicit stepper throughput (issue 15): element-sub-steps per second, host
+overhead and transfers per outer step, the other components' time, memory per
+element on the GPU and on the CPU, and the agreement with the CPU stepper.
 
-The problem is the ``wind_square`` set-up on a structured mesh (a jittered
-right-triangle grid of a 500 km closed basin, nodes and elements numbered
-row by row, so that 2M elements need no gmsh run): compact 1 m ice, random
-cohesion, a 20 m s-1 uniform wind and a 0.1 m s-1 gyre current as record
-fields (interpolated on the device), ocean drag, Coriolis at 75° N; the clock
-starts at 12 h (full wind: damage is active). Each outer step holds
-``--substeps`` sub-steps (default 100) at 0.999 × safety × the measured
-stability limit, as ``bench_explicit.py``.
+Every run is a scene built by the scene builder and run by ``Simulation``: the
+``wind_square`` basin (500 km, closed, compact 1 m ice, random cohesion, mesh
+motion) at the resolution that gives about ``--elements`` elements, with a
+20 m s-1 uniform wind (``--wind uniform``, ramped over 1 min) or moving cyclones
+(``--wind cyclones``: the box-with-cyclone set-up) and a 0.1 m s-1 gyre current,
+both record fields interpolated on the device; ``solver.device = "cuda"``. The
+outer step holds ``--substeps`` sub-steps (default 100) at 0.999 × safety × the
+measured stability limit of the mesh, as ``bench_explicit.py``. Two warm-up steps
+(compilation, record upload, the initial snapshot) are left out of the figures.
 
     python benchmarks/bench_gpu.py                                # 200k and 2M elements
-    python benchmarks/bench_gpu.py --elements 50000 200000 2000000 --mode both --cpu
+    python benchmarks/bench_gpu.py --elements 130000 --mode both --cpu
+    python benchmarks/bench_gpu.py --cpu                          # without a GPU: CPU rows only
     NUMBA_ENABLE_CUDASIM=1 python benchmarks/bench_gpu.py --smoke # the script runs (figures meaningless)
 
-Printed per size and launch mode: element-sub-steps/s over whole outer steps
-and over the sub-step loop alone, host+setup overhead per outer step, the
-cost of one full state sync (``to_host`` + ``from_host``: what
-``sync="step"`` pays per step), device memory per element (our arrays, and
-the driver's used-memory increase), a byte model of the sub-step loop with the
-achieved bandwidth. ``--cpu`` adds the CPU ExplicitSolver on the same mesh
-(serial and parallel kernels) and the largest relative difference of
-velocity, stress and damage between the two devices after ``--check-steps``
-outer steps from the same state. Without a usable GPU the script says so,
-writes ``{"gpu": false, ...}`` and exits 0.
+Printed per size and launch mode: element-sub-steps/s over the stepper's whole
+outer step and over the sub-step loop alone, host+setup overhead and state
+transfers per outer step [ms], the rest of the model step (mesh motion) [ms],
+device memory per element (the stepper's arrays, and the driver's used-memory
+increase), and a byte model of the sub-step loop with the bandwidth it implies.
+``--cpu`` adds the CPU stepper on the same scene (serial and parallel kernels):
+element-sub-steps/s, its memory per element (persistent arrays and the peak of
+one step's temporaries, by tracemalloc), and the largest relative difference of
+velocity, stress and damage between the devices after ``--check-steps`` outer
+steps from the same initial state. Without a usable GPU the script prints
+``NO GPU: ...``, writes ``{"gpu": false, ...}`` (plus the CPU rows with ``--cpu``)
+and exits 0.
 """
 from __future__ import annotations
 
@@ -33,12 +37,14 @@ import json
 import math
 import sys
 import time
+import tracemalloc
 from pathlib import Path
 
 import numpy as np
 
 L_M = 500e3
-HOUR = 3600.0
+OUT = Path("benchmarks/out")
+
 
 #: bytes of one element-sub-step in the sub-step loop, counting each array the
 #: kernels touch once (gathers through the adjacency assumed cached), for an
@@ -53,157 +59,142 @@ def bytes_per_element_substep(r: float, idx: int = 4) -> float:
     return elem + node + adj
 
 
-def structured_mesh(n_elements: int, seed: int = 0):
-    """Jittered right-triangle mesh of the L_M square with about ``n_elements``
-    elements, every boundary edge tagged coast (no-slip)."""
-    from lagice.mesh import Mesh
-    from lagice.mesh.core import boundary_edges_of
-
-    k = max(2, round(math.sqrt(n_elements / 2.0)))
-    dx = L_M / k
-    x = np.linspace(0.0, L_M, k + 1)
-    X, Y = np.meshgrid(x, x)
-    nodes = np.c_[X.ravel(), Y.ravel()]
-    rng = np.random.default_rng(seed)
-    inner = (nodes[:, 0] > 0) & (nodes[:, 0] < L_M) & (nodes[:, 1] > 0) & (nodes[:, 1] < L_M)
-    nodes[inner] += rng.uniform(-0.15 * dx, 0.15 * dx, (int(inner.sum()), 2))
-    j, i = np.meshgrid(np.arange(k), np.arange(k), indexing="ij")
-    n0 = (j * (k + 1) + i).ravel()
-    n1, n2, n3 = n0 + 1, n0 + k + 1, n0 + k + 2
-    tri = np.empty((2 * k * k, 3), np.int64)
-    tri[0::2] = np.c_[n0, n1, n3]
-    tri[1::2] = np.c_[n0, n3, n2]
-    edges = boundary_edges_of(tri)
-    return Mesh(nodes, tri, edges, np.zeros(len(edges), np.int32), ("coast",)), dx
+def resolution_for(n_elements: int) -> float:
+    """gmsh: elements ≈ 2·1.15·(L/Δx)² (as bench_explicit.py)."""
+    return L_M * math.sqrt(2 * 1.15 / n_elements)
 
 
-def problem(n_elements: int, seed: int = 0):
-    from forcing.records import RegularGrid
-    from forcing.synthetic import gyre_current, uniform_wind
-    from lagice.forces import Coriolis, OceanDrag, WindStress
-    from lagice.params import DragParams, MaxwellEBParams
-    from lagice.rheology import MaxwellEB, draw_cohesion
-    from lagice.state import IceState
+def scene_config(n_elements: int, device: str, substeps: int, wind: str, parallel=None):
+    from lagice.scenes.config import load_scene
 
-    mesh, dx = structured_mesh(n_elements, seed)
-    grid = RegularGrid.from_bbox(0.0, L_M, 0.0, L_M, 25e3, margin_m=100e3)
-    wind = uniform_wind(grid, 4 * 86400.0, speed_m_s=20.0, direction_deg=0.0, ramp_s=HOUR)
-    current = gyre_current(grid, 0.1)
-    drag = DragParams()
-    forces = [WindStress(wind, rho_air=drag.rho_air, drag=drag.air_drag),
-              OceanDrag(current, rho_water=drag.rho_water, drag=drag.water_drag,
-                        turning_angle_deg=drag.turning_angle_deg),
-              Coriolis(latitude_deg=75.0)]
-    params = MaxwellEBParams()
-    rheo = MaxwellEB(params)
-    state = IceState.uniform(mesh, thickness_m=1.0, concentration=1.0,
-                             cohesion_pa=draw_cohesion(mesh.n_elements, params, np.random.default_rng(seed)))
-    state.time_s = 12 * HOUR
-    return mesh, state, rheo, forces, dx
+    winds = {"uniform": {"kind": "uniform", "speed_m_s": 20.0, "direction_deg": 0.0, "ramp_s": 60.0},
+             "cyclones": {"kind": "cyclones", "n": 4, "background_m_s": [2.0, 0.0]}}
+    ov = {"domain.resolution_m": resolution_for(n_elements), "solver.device": device, "solver.substeps": substeps,
+          "forcing.wind": winds[wind], "forcing.ocean": {"kind": "gyre", "max_speed_m_s": 0.1},
+          "output.every": "1000d", "output.timeseries": None, "output.plot": False, "run.progress": False,
+          "run.duration": "2d"}
+    if parallel is not None:
+        ov["solver.parallel"] = parallel
+    return load_scene("wind_square", ov)
 
 
-def copy_state(st):
-    from lagice.state import IceState
-
-    return IceState(mesh=st.mesh, velocity=st.velocity.copy(), thickness=st.thickness.copy(),
-                    concentration=st.concentration.copy(), damage=st.damage.copy(), stress=st.stress.copy(),
-                    cohesion=st.cohesion.copy(), time_s=st.time_s, step=st.step)
-
-
-def outer_step(solver, substeps):
+def build(n_elements, device, substeps, wind, out_dir, parallel=None, launch=None, tpb=None):
+    """(simulation, seconds to build): the scene, then a Simulation whose outer step holds
+    exactly ``substeps`` sub-steps at 0.999 × safety × the stability limit of this mesh."""
+    from lagice.scenes.builder import build_simulation
+    from lagice.simulation import Simulation
     from lagice.stability import explicit_substep_limit
 
-    lim = explicit_substep_limit(solver.dx_min, solver.rheology.E0)
-    return substeps * solver.safety * lim * 0.999
+    t0 = time.perf_counter()
+    scene = build_simulation(scene_config(n_elements, device, substeps, wind, parallel), out_dir)
+    model = scene.model
+    st = model.stepper
+    if launch is not None:  # device options the scene file does not carry: set before the first step
+        st.launch = launch
+    if tpb is not None:
+        st.tpb = int(tpb)
+    dt = substeps * st.safety * explicit_substep_limit(st.dx_min, st.rheology.E0, st.rheology.params) * 0.999
+    sim = Simulation(model, dt=dt, stop=10_000 * dt, progress=False)
+    sim.output("1000d", Path(out_dir) / "snapshots", crs_epsg=None)  # one snapshot, at the start
+    return sim, time.perf_counter() - t0
 
 
-def bench_gpu(n, mode, steps, substeps, cpu, check_steps, tpb):
+def timed(sim, steps):
+    """Run 2 warm-up steps, then ``steps`` timed ones; returns the figures of the timed ones."""
+    model = sim.model
+    st = model.stepper
+    sim.run(n_steps=2)
+    st.kernel_timings = dict.fromkeys(st.kernel_timings, 0.0)
+    model.timings = dict.fromkeys(model.timings, 0.0)
+    n_sub = [0]
+    sim.add_callback(lambda s: n_sub.__setitem__(0, n_sub[0] + s.model.last_report["solver"].iterations),
+                     every="1 steps", name="substep_count")
+    t0 = time.perf_counter()
+    sim.run(n_steps=steps)
+    wall = time.perf_counter() - t0
+    del sim.activities["substep_count"]
+    m = model.mesh.n_elements
+    es = m * n_sub[0]
+    dyn = model.timings["dynamics"]
+    return {"n_elements": m, "n_nodes": model.mesh.n_nodes, "outer_steps": steps,
+            "substeps_per_step": n_sub[0] / steps, "outer_step_s": sim.dt,
+            "element_substeps_per_s_stepper": es / dyn, "element_substeps_per_s_wall": es / wall,
+            "kernel_timings_ms_per_step": {k: 1e3 * v / steps for k, v in st.kernel_timings.items()},
+            "component_ms_per_step": {k: 1e3 * v / steps for k, v in model.timings.items()},
+            "wall_ms_per_step": 1e3 * wall / steps, "mean_damage": float(np.mean(model.state.damage)), "es": es}
+
+
+def bench_gpu(n, mode, a):
     from numba import cuda
 
-    from lagice.solvers.cuda_explicit import CudaExplicitSolver, simulator_enabled
+    from lagice.solvers.cuda_explicit import simulator_enabled
 
-    mesh, st, rheo, forces, dx = problem(n)
-    st0 = copy_state(st)
-    sim = simulator_enabled()
-    free0 = None if sim else cuda.current_context().get_memory_info()[0]
-    s = CudaExplicitSolver(rheo, mesh, forces=forces, substeps=substeps, sync="explicit", launch=mode,
-                           threads_per_block=tpb)
-    dt = outer_step(s, substeps)
-    t_c = time.perf_counter()
-    for _ in range(2):  # compilation, record upload
-        s.step(st, dt)
-    compile_s = time.perf_counter() - t_c
-    used = None if sim else free0 - cuda.current_context().get_memory_info()[0]
-    s.kernel_timings = {k: 0.0 for k in s.kernel_timings}
-    t0 = time.perf_counter()
-    n_sub = 0
-    for _ in range(steps):
-        n_sub += s.step(st, dt).iterations
-    wall = time.perf_counter() - t0
-    kt = s.kernel_timings
-    t1 = time.perf_counter()
-    s.to_host(st)
-    t2 = time.perf_counter()
-    s.from_host(st)
-    t3 = time.perf_counter()
-    m = mesh.n_elements
-    es = m * n_sub
-    r = mesh.n_nodes / m
-    bpe = bytes_per_element_substep(r, 4 if s._index_dtype == np.int32 else 8)
-    row = {"n_elements": m, "n_nodes": mesh.n_nodes, "dx_m": dx, "launch": s.launch_used,
-           "launch_note": s.launch_note, "threads_per_block": tpb, "outer_steps": steps,
-           "substeps_per_step": n_sub / steps, "outer_step_s": dt,
-           "element_substeps_per_s": es / wall, "substep_loop_per_s": es / kt["substeps"],
-           "overhead_ms_per_outer_step": 1e3 * (kt["forcing"] + kt["setup"]) / steps,
-           "to_host_ms": 1e3 * (t2 - t1), "from_host_ms": 1e3 * (t3 - t2),
-           "device_bytes_per_element": s.device_bytes() / m,
-           "driver_bytes_per_element": None if used is None else used / m,
-           "model_bytes_per_element_substep": bpe,
-           "achieved_GB_s": bpe * es / kt["substeps"] / 1e9, "compile_and_warmup_s": compile_s,
-           "mean_damage": float(np.mean(st.damage)), "forcing_paths": s.forcing_paths, "wall_s": wall}
-    if cpu:
-        row.update(bench_cpu(n, substeps, dt, max(1, steps // 2)))
-        row.update(agreement(st0, s, dt, check_steps))
+    sim_mode = simulator_enabled()
+    free0 = None if sim_mode else cuda.current_context().get_memory_info()[0]
+    sim, build_s = build(n, "cuda", a.substeps, a.wind, a.out / f"gpu_{n}_{mode}", launch=mode,
+                         tpb=a.threads_per_block)
+    row = timed(sim, a.steps)
+    st = sim.model.stepper
+    used = None if sim_mode else free0 - cuda.current_context().get_memory_info()[0]
+    m = row["n_elements"]
+    kt = st.kernel_timings
+    r = row["n_nodes"] / m
+    bpe = bytes_per_element_substep(r, 4 if st._index_dtype == np.int32 else 8)
+    loop_s = kt["substeps"]
+    row.update(device="cuda", launch=st.launch_used, launch_note=st.launch_note, threads_per_block=st.tpb,
+               forcing_paths=st.forcing_paths, build_s=build_s,
+               substep_loop_per_s=row["es"] / loop_s if loop_s > 0 else None,
+               overhead_ms_per_step=row["kernel_timings_ms_per_step"]["forcing"]
+               + row["kernel_timings_ms_per_step"]["setup"],
+               transfer_ms_per_step=row["kernel_timings_ms_per_step"]["transfer"],
+               device_bytes_per_element=st.device_bytes() / m,
+               driver_bytes_per_element=None if used is None else used / m,
+               model_bytes_per_element_substep=bpe,
+               achieved_GB_s=bpe * row["es"] / loop_s / 1e9 if loop_s > 0 else None)
     return row
 
 
-def bench_cpu(n, substeps, dt, steps):
-    """CPU ExplicitSolver, serial and parallel kernels, same problem."""
-    from lagice.solvers import ExplicitSolver
+def cpu_bytes(sim):
+    """Bytes the CPU run keeps: the state's checkpointed fields, the mesh and its
+    adjacency, and the arrays the stepper holds between steps (not the forcing)."""
+    from lagice.fields import checkpoint_arrays
 
+    model = sim.model
+    st = model.stepper
+    mesh = model.mesh
+    arrays = list(checkpoint_arrays(model.state).values()) + [mesh.nodes, mesh.triangles, *mesh.node_elements]
+    for obj in (st, getattr(st, "nodes", None)):
+        if obj is not None:
+            arrays += [v for v in vars(obj).values() if isinstance(v, np.ndarray)]
+    return sum(a.nbytes for a in arrays)
+
+
+def bench_cpu(n, parallel, a):
+    sim, build_s = build(n, "cpu", a.substeps, a.wind, a.out / f"cpu_{n}_{parallel}", parallel=parallel)
+    row = timed(sim, max(1, a.steps // 2))
+    m = row["n_elements"]
+    tracemalloc.start()
+    base = tracemalloc.get_traced_memory()[0]
+    sim.run(n_steps=1)
+    peak = tracemalloc.get_traced_memory()[1] - base
+    tracemalloc.stop()
+    row.update(device="cpu", parallel=parallel, build_s=build_s, persistent_bytes_per_element=cpu_bytes(sim) / m,
+               step_peak_bytes_per_element=peak / m)
+    return row
+
+
+def agreement(n, a):
+    """Largest relative differences CPU vs GPU after ``--check-steps`` outer steps of the
+    same scene from the same initial state."""
     out = {}
-    for par in (False, True):
-        mesh, st, rheo, forces, _ = problem(n)
-        s = ExplicitSolver(rheo, mesh, forces=forces, substeps=substeps, parallel=par)
-        s.step(st, dt)  # compile
-        t0 = time.perf_counter()
-        n_sub = sum(s.step(st, dt).iterations for _ in range(steps))
-        out[f"cpu_{'parallel' if par else 'serial'}_element_substeps_per_s"] = mesh.n_elements * n_sub / (
-            time.perf_counter() - t0)
-    return out
-
-
-def agreement(st0, gpu_solver, dt, steps):
-    """Largest relative differences CPU vs GPU after ``steps`` outer steps from ``st0``."""
-    from lagice.solvers import ExplicitSolver
-    from lagice.solvers.cuda_explicit import CudaExplicitSolver
-
-    mesh = st0.mesh
-    rheo, forces = gpu_solver.rheology, gpu_solver.forces
-    a, b = copy_state(st0), copy_state(st0)
-    cpu = ExplicitSolver(rheo, mesh, forces=forces, substeps=gpu_solver.substeps)
-    dev = CudaExplicitSolver(rheo, mesh, forces=forces, substeps=gpu_solver.substeps, launch=gpu_solver.launch_used,
-                             threads_per_block=gpu_solver.tpb)
-    for _ in range(steps):
-        cpu.step(a, dt)
-        dev.step(b, dt)
-    out = {}
+    sims = {dev: build(n, dev, a.substeps, a.wind, a.out / f"check_{dev}_{n}")[0] for dev in ("cpu", "cuda")}
+    for s in sims.values():
+        s.run(n_steps=a.check_steps)
+    x, y = sims["cpu"].model.state, sims["cuda"].model.state
     for k in ("velocity", "stress", "damage"):
-        x, y = getattr(a, k), getattr(b, k)
-        out[f"max_rel_diff_{k}"] = float(np.abs(x - y).max() / max(np.abs(x).max(), 1e-300))
-    out["max_rel_diff_mean_velocity"] = float(np.abs(cpu.mean_velocity - dev.mean_velocity).max()
-                                              / np.abs(cpu.mean_velocity).max())
-    out["agreement_outer_steps"] = steps
+        u, v = getattr(x, k), getattr(y, k)
+        out[f"max_rel_diff_{k}"] = float(np.abs(u - v).max() / max(np.abs(u).max(), 1e-300))
+    out["agreement_outer_steps"] = a.check_steps
     return out
 
 
@@ -212,57 +203,71 @@ def main(argv=None):
     ap.add_argument("--elements", type=int, nargs="+", default=[200_000, 2_000_000])
     ap.add_argument("--steps", type=int, default=5)
     ap.add_argument("--substeps", type=int, default=100)
+    ap.add_argument("--wind", choices=["uniform", "cyclones"], default="uniform")
     ap.add_argument("--mode", choices=["auto", "cooperative", "launches", "both"], default="both")
     ap.add_argument("--threads-per-block", type=int, default=128)
-    ap.add_argument("--cpu", action="store_true", help="also time the CPU solver and check agreement")
+    ap.add_argument("--cpu", action="store_true", help="also time the CPU stepper and check agreement")
     ap.add_argument("--check-steps", type=int, default=3)
     ap.add_argument("--smoke", action="store_true", help="tiny sizes (for the CUDA simulator)")
-    ap.add_argument("--json", type=Path, default=Path("benchmarks/out/gpu.json"))
+    ap.add_argument("--out", type=Path, default=OUT / "gpu_runs", help="scratch folder of the runs")
+    ap.add_argument("--json", type=Path, default=OUT / "gpu.json")
     a = ap.parse_args(argv)
 
     from lagice.solvers.cuda_explicit import cuda_status, simulator_enabled
 
     ok, info = cuda_status()
     a.json.parent.mkdir(parents=True, exist_ok=True)
-    if not ok:
-        print(f"NO GPU: numba.cuda.is_available() is False ({info}).\n"
-              "Nothing was measured. Run this on a machine with an NVIDIA GPU (docs/gpu.md).")
-        a.json.write_text(json.dumps({"gpu": False, "reason": info}, indent=1))
-        return 0
     if simulator_enabled():
         print("SIMULATOR (NUMBA_ENABLE_CUDASIM=1): kernels run as Python threads; the figures below only "
               "show that the script runs and mean nothing about a GPU.")
-        if not a.smoke:
-            print("(forcing --smoke sizes)")
-        a.elements, a.steps, a.substeps, a.check_steps = [400], 1, 3, 1
-    elif a.smoke:
-        a.elements, a.steps, a.substeps = [2000], 2, 10
-    import numba
+        a.smoke = True
+    if a.smoke:
+        a.elements, a.steps, a.substeps, a.check_steps = [150], 1, 3, 1
+    report = {"gpu": ok, "device": info, "simulator": simulator_enabled(), "rows": []}
+    if not ok:
+        print(f"NO GPU: numba.cuda.is_available() is False ({info}).\n"
+              "No GPU figure was measured. Run this on a machine with an NVIDIA GPU (docs/gpu.md).")
+        report["reason"] = info
+    else:
+        import numba
 
-    print(f"device: {info}; numba {numba.__version__}")
-    modes = ["cooperative", "launches"] if a.mode == "both" else [a.mode]
-    print(f"{'elements':>9} {'launch':>11} {'sub/step':>8} {'Gel-sub/s':>10} {'loop G/s':>9} "
-          f"{'overhead ms':>11} {'sync ms':>8} {'B/elem':>7} {'GB/s':>7}")
-    rows = []
-    for n in a.elements:
-        for mode in modes:
-            r = bench_gpu(n, mode, a.steps, a.substeps, a.cpu and mode == modes[0], a.check_steps,
-                          a.threads_per_block)
-            rows.append(r)
-            print(f"{r['n_elements']:>9} {r['launch']:>11} {r['substeps_per_step']:>8.0f} "
-                  f"{r['element_substeps_per_s'] / 1e9:>10.3f} {r['substep_loop_per_s'] / 1e9:>9.3f} "
-                  f"{r['overhead_ms_per_outer_step']:>11.2f} {r['to_host_ms'] + r['from_host_ms']:>8.2f} "
-                  f"{r['device_bytes_per_element']:>7.0f} {r['achieved_GB_s']:>7.0f}", flush=True)
-            if r["launch_note"]:
-                print(f"  note: {r['launch_note']}")
-            if "cpu_serial_element_substeps_per_s" in r:
-                print(f"  CPU same mesh: serial {r['cpu_serial_element_substeps_per_s'] / 1e6:.1f} M/s, "
-                      f"parallel {r['cpu_parallel_element_substeps_per_s'] / 1e6:.1f} M/s; "
-                      f"GPU vs CPU after {r['agreement_outer_steps']} outer steps: max rel diff velocity "
-                      f"{r['max_rel_diff_velocity']:.2e}, stress {r['max_rel_diff_stress']:.2e}, damage "
-                      f"{r['max_rel_diff_damage']:.2e}, mean velocity {r['max_rel_diff_mean_velocity']:.2e}")
-    a.json.write_text(json.dumps({"gpu": True, "device": info, "simulator": simulator_enabled(), "rows": rows},
-                                 indent=1, default=str))
+        print(f"device: {info}; numba {numba.__version__}")
+        modes = ["cooperative", "launches"] if a.mode == "both" else [a.mode]
+        print(f"{'elements':>9} {'launch':>11} {'sub/step':>8} {'Gel-sub/s':>10} {'loop G/s':>9} "
+              f"{'setup ms':>9} {'xfer ms':>8} {'other ms':>9} {'B/elem':>7} {'GB/s':>7}")
+        for n in a.elements:
+            for mode in modes:
+                r = bench_gpu(n, mode, a)
+                report["rows"].append(r)
+                other = sum(v for k, v in r["component_ms_per_step"].items() if k != "dynamics")
+                loop = (r["substep_loop_per_s"] or 0.0) / 1e9
+                print(f"{r['n_elements']:>9} {r['launch']:>11} {r['substeps_per_step']:>8.0f} "
+                      f"{r['element_substeps_per_s_stepper'] / 1e9:>10.3f} {loop:>9.3f} "
+                      f"{r['overhead_ms_per_step']:>9.2f} {r['transfer_ms_per_step']:>8.2f} {other:>9.2f} "
+                      f"{r['device_bytes_per_element']:>7.0f} {r['achieved_GB_s'] or 0:>7.0f}", flush=True)
+                if r["launch_note"]:
+                    print(f"  note: {r['launch_note']}")
+                if r["driver_bytes_per_element"] is not None:
+                    print(f"  driver used-memory increase: {r['driver_bytes_per_element']:.0f} B/element")
+            if a.cpu:
+                agr = agreement(n, a)
+                report["rows"][-1].update(agr)
+                print(f"  GPU vs CPU after {agr['agreement_outer_steps']} outer steps: max rel diff velocity "
+                      f"{agr['max_rel_diff_velocity']:.2e}, stress {agr['max_rel_diff_stress']:.2e}, damage "
+                      f"{agr['max_rel_diff_damage']:.2e}")
+    if a.cpu:
+        print(f"{'elements':>9} {'CPU':>9} {'sub/step':>8} {'Mel-sub/s':>10} {'other ms':>9} "
+              f"{'B/elem kept':>11} {'B/elem step peak':>16}")
+        for n in a.elements:
+            for par in (False, True):
+                r = bench_cpu(n, par, a)
+                report["rows"].append(r)
+                other = sum(v for k, v in r["component_ms_per_step"].items() if k != "dynamics")
+                print(f"{r['n_elements']:>9} {'parallel' if par else 'serial':>9} {r['substeps_per_step']:>8.0f} "
+                      f"{r['element_substeps_per_s_stepper'] / 1e6:>10.1f} {other:>9.2f} "
+                      f"{r['persistent_bytes_per_element']:>11.0f} {r['step_peak_bytes_per_element']:>16.0f}",
+                      flush=True)
+    a.json.write_text(json.dumps(report, indent=1, default=str))
     print(f"wrote {a.json}")
     return 0
 

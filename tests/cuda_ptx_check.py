@@ -41,11 +41,11 @@ def signatures():
     mat = (A1,) * 8
     consts = (f8,) * 9
     return {
-        "substeps_cooperative": (i8, f8, *node, I2, A2, A2, A1, *mat, *consts, B1, A2, A2, C1),
+        "substeps_cooperative": (i8, f8, *node, I2, A2, A2, A1, *mat, *consts, B1, A2, A2, C1, A1),
         "node_substep_kernel": (f8, *node),
         "element_substep_kernel": (f8, I2, A2, A2, A2, A2, A1, *mat, *consts, B1, C1),
-        "finish_nodes_kernel": (i8, A2, A2, A2, C1),
-        "finish_elements_kernel": (I2, A2, A2, A2, A2, B1, C1),
+        "finish_nodes_kernel": (i8, A2, A2, A2, C1, A1),
+        "finish_elements_kernel": (I2, A2, A2, A2, A2, B1, A2, A1, C1),
         "geometry_kernel": (A2, I2, A2, A2, A1, A1, f8, A1, C1),
         "prepare_elements_kernel": (A1, A2, A1, A1, f8, f8, f8, f8, f8, f8, A1, A2, A1, A1, A1, A1, A1, B1, A1),
         "finish_moduli_kernel": (A1, A1, f8),

@@ -1,44 +1,55 @@
-"""CPU ExplicitSolver vs CudaExplicitSolver on the same tiny damaging problem.
+"""CPU ExplicitSolver vs CudaExplicitSolver through Model and Simulation on tiny
+damaging problems; writes one JSON report.
 
 Run by ``tests/test_cuda_explicit.py`` in a subprocess with
 ``NUMBA_ENABLE_CUDASIM=1`` (numba reads it at import, so the simulator must
-not leak into the rest of the test suite); prints one JSON object on stdout.
-Can be run by hand on a machine with a GPU (no simulator) to measure the
-agreement of the real device:
+not leak into the rest of the test suite). Can be run by hand on a machine
+with a GPU (no simulator) to measure the agreement of a real device (the
+report goes to REPORT.json, or to stdout):
 
-    python tests/cuda_sim_compare.py            # GPU, or
-    NUMBA_ENABLE_CUDASIM=1 python tests/cuda_sim_compare.py
+    python tests/cuda_sim_compare.py [REPORT.json]           # GPU, or
+    NUMBA_ENABLE_CUDASIM=1 python tests/cuda_sim_compare.py [REPORT.json]
 
-The problem (about 170 elements, 5 outer steps of 50 s, automatic sub-steps):
+The problem (about 60 elements, 4 outer steps of 50 s, automatic sub-steps):
 wind and ocean current from record fields (wind on a coarse uniform grid:
 time blend on the grid; current on a fine non-uniform grid: two-record
 interpolation and binary-search cells; one step lands on a record time:
-single record), ocean drag with a turning angle, Coriolis, a top edge
-pushed by a time-dependent prescribed velocity, coast at the bottom, low
-cohesion (damage within the first sub-steps), fast healing, a damage cap at
-0.3 (capping happens), non-uniform thickness and concentration, and the
-nodes moved with the mean velocity after every step (geometry re-uploaded).
+single record), ocean drag with a turning angle, Coriolis, a top edge pushed
+by a time-dependent prescribed velocity, coast at the bottom, low cohesion
+(damage within the first sub-steps), fast healing, a damage cap at 0.3
+(capping happens), non-uniform thickness and concentration, and the mesh
+moved by the MeshMotion component with the transport velocity (geometry
+re-uploaded, thickness and concentration changed on the host every step).
 """
 from __future__ import annotations
 
 import json
 import sys
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 
 from forcing.records import InMemoryRecords, RecordField, RegularGrid
+from lagice.drifters import Drifters
 from lagice.errors import ForcingError, SolverError
 from lagice.forces import Coriolis, OceanDrag, WindStress
+from lagice.lagrangian import MeshMotion
 from lagice.mesh import generate_mesh, rectangle_domain
+from lagice.model import Model
+from lagice.remesh import Remesher
 from lagice.rheology import MaxwellEB
+from lagice.simulation import Simulation
 from lagice.solvers import ExplicitSolver, VelocityBC
 from lagice.solvers.cuda_explicit import CudaExplicitSolver
 from lagice.state import IceState
 
 L = 100e3
 DT = 50.0
-STEPS = 5
+STEPS = 4
+TINY = {"threads_per_block": 32, "max_blocks": 2}  # several blocks, grid-stride loops, fast simulation
+FIELDS = ("velocity", "stress", "damage", "thickness", "concentration")
 
 
 def record_field(x, y, times, scale, seed, name, **kw):
@@ -53,10 +64,18 @@ def record_field(x, y, times, scale, seed, name, **kw):
     return RecordField(InMemoryRecords(times, grid, data, ("u", "v"), units="m s-1", name=name), **kw)
 
 
+def host_wind(t, x, y):
+    """A callable wind (evaluated on the host, then uploaded)."""
+    return 12.0 + 0.01 * t + 2.0 * np.sin(x / 3e4), 4.0 * np.cos(y / 2e4)
+
+
+def top_edge_u(t, x, y):
+    return 0.2 * min(1.0, t / 100.0) * (0.5 + x / L)
+
+
 def problem(variant="records"):
     poly, segs = rectangle_domain(L, L)
-    mesh = generate_mesh(poly, 12e3, segments={"top": segs["top"], "coast": segs["bottom"]},
-                         exterior_tag="free")
+    mesh = generate_mesh(poly, 20e3, segments={"top": segs["top"], "coast": segs["bottom"]}, exterior_tag="free")
     times = np.arange(0.0, 1000.0, 100.0)
     # wind: 6 x 6 uniform grid (36 points < nodes: blended in time on the grid)
     wind = record_field(np.linspace(-30e3, L + 30e3, 6), np.linspace(-30e3, L + 30e3, 6), times, 15.0, 1,
@@ -65,127 +84,274 @@ def problem(variant="records"):
     xo = np.sort(np.r_[-30e3, L + 30e3, np.random.default_rng(2).uniform(-29e3, L + 29e3, 23)])
     current = record_field(xo, np.linspace(-30e3, L + 30e3, 22), times, 0.05, 3, "current records")
     if variant == "host":  # a callable wind (host path) and a constant current (filled on the device)
-        wind = lambda t, x, y: (12.0 + 0.01 * t + 2.0 * np.sin(x / 3e4), 4.0 * np.cos(y / 2e4))
-        current = (0.03, -0.02)
+        wind, current = host_wind, (0.03, -0.02)
     forces = [WindStress(wind), OceanDrag(current, turning_angle_deg=25.0), Coriolis(latitude_deg=75.0)]
-    bcs = [VelocityBC("top", u=lambda t, x, y: 0.2 * min(1.0, t / 100.0) * (0.5 + x / L), v=-0.02)]
+    bcs = [VelocityBC("top", u=top_edge_u, v=-0.02)]
     rheo = MaxwellEB(cohesion_min_pa=1e3, cohesion_max_pa=3e3, healing_time_s=2e3, max_damage=0.3)
-    rng = np.random.default_rng(4)
     c = mesh.centroids()
     st = IceState.uniform(mesh, thickness_m=1.0 + 0.3 * np.sin(c[:, 0] / 2e4),
                           concentration=0.92 + 0.08 * np.cos(c[:, 1] / 3e4),
-                          cohesion_pa=rng.uniform(1e3, 3e3, mesh.n_elements))
+                          cohesion_pa=np.random.default_rng(4).uniform(1e3, 3e3, mesh.n_elements))
     return mesh, st, rheo, forces, bcs
 
 
-def run(kind, steps=STEPS, switch_after=None, remesh_after=None, **opts):
-    """Run ``steps`` outer steps; ``kind`` "cpu" or "cuda"; with ``switch_after``
-    the first steps run on the CPU and the rest on the device (a checkpoint
-    moving between devices); with ``remesh_after`` the state gets a new (copied)
-    mesh after that many steps and the solver ``reset_topology``, as a remesh
-    does (in ``sync="explicit"`` after ``to_host``, as docs/gpu.md asks)."""
-    mesh, st, rheo, forces, bcs = problem(opts.pop("variant", "records"))
-    heal = opts.pop("heal_callable", False)
-    heal_rate = (lambda s: 5e-4 * (1.0 + s.damage)) if heal else None  # reads the host damage
-    cpu = ExplicitSolver(rheo, mesh, bcs=bcs, forces=forces, heal_rate=heal_rate)
-    dev = None
-    n_capped = n_damaged = 0
-    substeps = []
-    for k in range(steps):
-        on_dev = kind == "cuda" and (switch_after is None or k >= switch_after)
-        if on_dev and dev is None:
-            dev = CudaExplicitSolver(rheo, mesh, bcs=bcs, forces=forces, heal_rate=heal_rate, **opts)
-        s = dev if on_dev else cpu
-        info = s.step(st, DT)
-        n_capped += info.n_capped
-        n_damaged += info.n_damaged
-        substeps.append(info.iterations)
-        mv = s.mean_velocity
-        mesh.nodes = mesh.nodes + DT * mv  # Lagrangian motion with the transport velocity
-        s.update_geometry()
-        if remesh_after is not None and k + 1 == remesh_after:
-            if getattr(s, "sync", "step") == "explicit":
-                s.to_host(st)
-            mesh = mesh.copy()
-            st.mesh = mesh
-            s.reset_topology(mesh)
-    s = dev if dev is not None else cpu
-    if getattr(s, "sync", "step") == "explicit":
-        assert set(s.host_stale) == {"velocity", "stress", "damage"}
-        s.to_host(st)
-    return {"velocity": st.velocity, "stress": st.stress, "damage": st.damage, "mean": s.mean_velocity,
-            "strain": s.last_strain_rate, "nodes": mesh.nodes, "n_capped": n_capped, "n_damaged": n_damaged,
-            "substeps": substeps, "solver": s}
+def heal_callable(state, t_s):
+    """A healing rate that reads the host damage (a device stepper must download it first)."""
+    return 5e-4 * (1.0 + state.damage)
+
+
+def stepper(kind, mesh, rheo, forces, bcs, heal=False, **opts):
+    kw = {"bcs": bcs, "forces": forces, "heal_rate": heal_callable if heal else None}
+    if kind == "cpu":
+        return ExplicitSolver(rheo, mesh, parallel=False, **kw)
+    if kind == "cpu_parallel":
+        return ExplicitSolver(rheo, mesh, parallel=True, **kw)
+    return CudaExplicitSolver(rheo, mesh, **kw, **{**TINY, **opts})
+
+
+def model(kind, variant="records", heal=False, remesh=False, **opts):
+    mesh, st, rheo, forces, bcs = problem(variant)
+    # the initial mesh has angles from 43.4°: a 46° threshold remeshes patches from the first step
+    rm = Remesher(20e3, min_angle_deg=46.0) if remesh else None
+    return Model(st, rheology=rheo, solver=stepper(kind, mesh, rheo, forces, bcs, heal, **opts), mover=MeshMotion(),
+                 remesher=rm)
+
+
+class Totals:
+    """Callback: capped / damaged counts and sub-steps of every step."""
+
+    def __init__(self):
+        self.n_capped = self.n_damaged = 0
+        self.substeps = []
+
+    def __call__(self, sim):
+        info = sim.model.last_report["solver"]
+        self.n_capped += info.n_capped
+        self.n_damaged += info.n_damaged
+        self.substeps.append(info.iterations)
+
+
+def run(m, steps=STEPS, max_speed_m_s=10.0):
+    sim = Simulation(m, dt=DT, stop=steps * DT, progress=False, max_speed_m_s=max_speed_m_s)
+    tot = Totals()
+    sim.add_callback(tot, every="1 steps")
+    sim.run()
+    return result(m, tot)
+
+
+def result(m, tot=None):
+    st = m.state
+    out = {f: getattr(st, f).copy() for f in FIELDS}
+    eps = m.strain_rate  # None right after a remesh
+    out.update(transport=m.transport_velocity.copy(), strain=np.zeros((0, 3)) if eps is None else eps.copy(),
+               nodes=m.mesh.nodes.copy(),
+               n_elements=m.mesh.n_elements, remeshes=st.counters.get("remesh_events", 0))
+    if tot is not None:
+        out.update(n_capped=tot.n_capped, n_damaged=tot.n_damaged, substeps=tot.substeps)
+    return out
 
 
 def rel_diff(a, b):
+    a, b = np.asarray(a), np.asarray(b)
+    if a.shape != b.shape:
+        return float("inf")
+    if a.size == 0:
+        return 0.0
     scale = float(np.abs(a).max())
     return float(np.abs(a - b).max()) / scale if scale > 0 else float(np.abs(a - b).max())
 
 
 def compare(ref, res):
-    out = {k: rel_diff(ref[k], res[k]) for k in ("velocity", "stress", "damage", "mean", "strain", "nodes")}
-    out["n_capped"] = [ref["n_capped"], res["n_capped"]]
-    out["n_damaged"] = [ref["n_damaged"], res["n_damaged"]]
-    out["substeps"] = [ref["substeps"], res["substeps"]]
+    out = {k: rel_diff(ref[k], res[k]) for k in (*FIELDS, "transport", "strain", "nodes")}
+    for k in ("n_capped", "n_damaged", "substeps", "n_elements", "remeshes"):
+        if k in ref and k in res:
+            out[k] = [ref[k], res[k]]
+    return out
+
+
+def resume_across(first, second, tmp):
+    """Run 2 steps on ``first`` with a checkpoint, then resume the checkpoint with a model on
+    ``second`` for the remaining steps (Simulation.resume(path, model=...))."""
+    m = model(first)
+    sim = Simulation(m, dt=DT, stop=STEPS * DT, progress=False)
+    sim.checkpoint("2 steps", Path(tmp) / f"{first}_{second}", keep=1)
+    sim.run(n_steps=2)
+    ck = sorted((Path(tmp) / f"{first}_{second}").glob("checkpoint_*.npz"))[-1]
+    sim2 = Simulation.resume(ck, model=model(second))
+    sim2.activities.pop("progress", None)
+    sim2.run()
+    return result(sim2.model)
+
+
+def forcing_error(kind):
+    """Nodes outside the forcing grid: the CPU's ForcingError text, state untouched."""
+    mesh, st, rheo, forces, bcs = problem()
+    s = stepper(kind, mesh, rheo, forces, bcs)
+    mesh.nodes = mesh.nodes + np.array([45e3, 0.0])
+    s.update_geometry()
+    v0 = st.velocity.copy()
+    try:
+        s.step(st, 0.0, DT)
+        msg = None
+    except ForcingError as exc:
+        msg = str(exc)
+    assert np.array_equal(st.velocity, v0)
+    return msg
+
+
+def nan_checker_message(kind, how):
+    """The NaN checker's SolverError: a NaN velocity at a free node ("nan"), or an ice
+    speed above a tiny bound ("speed")."""
+    m = model(kind, sync="explicit") if kind == "cuda" else model(kind)
+    if how == "nan":
+        free = int(np.setdiff1d(np.arange(m.mesh.n_nodes), m.mesh.boundary_edges)[0])  # an interior node
+        m.state.velocity[free] = np.nan
+    try:
+        run(m, max_speed_m_s=1e-3 if how == "speed" else 10.0)
+        return None
+    except SolverError as exc:
+        return str(exc)
+
+
+def downloads_per_step():
+    """sync="explicit" through Simulation with only the NaN checker: the device clears
+    velocity, stress and damage itself, so nothing is downloaded between steps."""
+    m = model("cuda", sync="explicit")
+    sim = Simulation(m, dt=DT, stop=STEPS * DT, progress=False)
+    stale = []
+    sim.activities["nan_checker"].run(sim)
+    for _ in range(2):
+        sim.model.step(DT)
+        sim.activities["nan_checker"].run(sim)
+        stale.append(list(m.stepper.host_stale))
+    return stale
+
+
+# -- the scene path: TOML, builder, Simulation, checkpoints moving between devices --------------
+#: wind_square at 100 km (66 elements), 4 steps of 10 min, weak ice (damage within the first step),
+#: full wind from the start, a checkpoint and a snapshot every 2 steps
+SCENE_OV = {"domain.resolution_m": 100e3, "run.duration": "40min", "solver.dt": 600.0, "run.progress": False,
+            "output.plot": False, "output.every": "2 steps", "checkpoint.every": "2 steps",
+            "initial.cohesion_pa": 2e3, "forcing.wind.params.ramp_h": 0.01}
+
+
+def scene_arrays(run_dir, step):
+    from lagice.io.checkpoint import read_checkpoint
+
+    arrays, _ = read_checkpoint(Path(run_dir) / "checkpoints" / f"checkpoint_{step:010d}.npz")
+    return arrays
+
+
+def scene_runs(tmp):
+    """Full runs on each device; then each run's step-2 checkpoint resumed on the other
+    device (``Simulation.resume(path, overrides={"solver.device": ...})``)."""
+    from lagice.scenes.builder import build_simulation
+    from lagice.scenes.config import load_scene
+
+    out = {}
+    sims = {}
+    for dev in ("cpu", "cuda"):
+        sim = build_simulation(load_scene("wind_square", {**SCENE_OV, "solver.device": dev}), Path(tmp) / dev)
+        sim.run()
+        sims[dev] = sim
+    out["fingerprints"] = [sims["cpu"].model.fingerprint(), sims["cuda"].model.fingerprint()]
+    out["stepper_types"] = [type(sims[d].model.stepper).__name__ for d in ("cpu", "cuda")]
+    out["mean_damage"] = float(np.mean(sims["cpu"].model.state.damage))
+    ref = scene_arrays(Path(tmp) / "cpu", 4)
+    out["keys"] = sorted(ref)
+    out["cuda_vs_cpu"] = {k: rel_diff(ref[k], v) for k, v in scene_arrays(Path(tmp) / "cuda", 4).items()
+                          if v.dtype.kind == "f"}
+    for a, b in (("cpu", "cuda"), ("cuda", "cpu")):
+        ck = Path(tmp) / a / "checkpoints" / f"checkpoint_{2:010d}.npz"
+        sim = Simulation.resume(ck, overrides={"solver.device": b}, out_dir=Path(tmp) / f"{a}_to_{b}")
+        out[f"{a}_to_{b}_stepper"] = type(sim.model.stepper).__name__
+        sim.run()
+        res = scene_arrays(Path(tmp) / f"{a}_to_{b}", 4)
+        out[f"resume_{a}_to_{b}"] = {k: rel_diff(ref[k], v) for k, v in res.items() if v.dtype.kind == "f"}
+    return out
+
+
+# -- rigid motion: the transport velocity moves nodes and drifters (tests/test_engine.py) ----
+CENTER = np.array([0.5 * L, 0.5 * L])
+OMEGA = 2e-6  # s-1
+U0 = np.array([0.08, -0.05])  # m s-1
+RIGID_DT = 200.0  # s: 20 sub-steps of 10 s, within the stability limit at 25 km
+
+
+def rigid(kind, xy):
+    if kind == "translation":
+        return np.broadcast_to(U0, xy.shape).copy()
+    d = xy - CENTER
+    return OMEGA * np.column_stack([-d[:, 1], d[:, 0]])
+
+
+def rigid_motion(device, motion):
+    poly, _ = rectangle_domain(L, L)
+    mesh = generate_mesh(poly, 25e3, exterior_tag="free")
+    st = IceState.uniform(mesh, thickness_m=1.0, concentration=1.0, cohesion_pa=1e9)
+    st.velocity = rigid(motion, mesh.nodes)
+    rheo = MaxwellEB(healing_time_s=None, cohesion_min_pa=1e9, cohesion_max_pa=1e9)
+    s = (ExplicitSolver(rheo, mesh, substeps=20) if device == "cpu"
+         else CudaExplicitSolver(rheo, mesh, substeps=20, sync="explicit", **TINY))
+    dr = Drifters([[30e3, 40e3], [60e3, 70e3], [50e3, 20e3]])
+    m = Model(st, rheology=rheo, solver=s, mover=MeshMotion(), drifters=dr)
+    x0, d0 = m.mesh.nodes.copy(), dr.positions.copy()
+    vs = []
+    sim = Simulation(m, dt=RIGID_DT, stop=3 * RIGID_DT, progress=False)
+    sim.add_callback(lambda s_: vs.append(s_.model.transport_velocity.copy()), every="1 steps")
+    sim.run()
+    ref = rigid(motion, x0)
+    x = x0.copy()
+    for v in vs:
+        x = x + RIGID_DT * v
+    out = {"first_vs_rigid": float(np.abs(vs[0] - ref).max() / np.abs(ref).max()),
+           "nodes_vs_sum": float(np.abs(m.mesh.nodes - x).max()),
+           "transport": np.array(vs), "nodes": m.mesh.nodes.copy()}
+    if motion == "translation":
+        out["nodes_vs_exact"] = float(np.abs(m.mesh.nodes - (x0 + 3 * RIGID_DT * U0)).max())
+        out["drifters_vs_exact"] = float(np.abs(dr.positions - (d0 + 3 * RIGID_DT * U0)).max())
     return out
 
 
 def main():
     t0 = time.perf_counter()
-    tiny = {"threads_per_block": 32, "max_blocks": 2}
-    ref = run("cpu")
-    ref_heal = run("cpu", heal_callable=True)
-    report = {"simulator": __import__("numba").config.ENABLE_CUDASIM == 1,
-              "n_elements": len(ref["damage"]), "damage_max": float(ref["damage"].max()),
-              "damaged_fraction": float(np.mean(ref["damage"] > 0))}
-    coop = run("cuda", remesh_after=3, **tiny)
-    report["paths"] = coop["solver"].forcing_paths
-    report["launch_auto"] = coop["solver"].launch_used
-    report["cooperative_step_sync"] = compare(ref, coop)
-    report["launches_explicit_sync"] = compare(ref, run("cuda", sync="explicit", launch="launches",
-                                                                 remesh_after=2, **tiny))
-    report["heal_callable_explicit_sync"] = compare(ref_heal, run("cuda", sync="explicit", heal_callable=True,
-                                                                  **tiny))
-    report["cpu_then_cuda"] = compare(ref, run("cuda", switch_after=2, **tiny))
-    host = run("cuda", variant="host", **tiny)
-    report["host_paths"] = host["solver"].forcing_paths
-    report["host_fields"] = compare(run("cpu", variant="host"), host)
-    # the same ForcingError as the CPU when the mesh leaves the record grid
-    msgs = []
-    for kind in ("cpu", "cuda"):
-        mesh, st, rheo, forces, bcs = problem()
-        s = (ExplicitSolver(rheo, mesh, bcs=bcs, forces=forces) if kind == "cpu"
-             else CudaExplicitSolver(rheo, mesh, bcs=bcs, forces=forces, **tiny))
-        mesh.nodes = mesh.nodes + np.array([45e3, 0.0])
-        s.update_geometry()
-        v0 = st.velocity.copy()
-        try:
-            s.step(st, DT)
-            msgs.append(None)
-        except ForcingError as exc:
-            msgs.append(str(exc))
-        assert np.array_equal(st.velocity, v0) and st.step == 0
-    report["outside_grid_messages"] = msgs
-    # a NaN velocity: SolverError on both, state untouched
-    msgs = []
-    for kind in ("cpu", "cuda"):
-        mesh, st, rheo, forces, bcs = problem()
-        s = (ExplicitSolver(rheo, mesh, bcs=bcs, forces=forces) if kind == "cpu"
-             else CudaExplicitSolver(rheo, mesh, bcs=bcs, forces=forces, **tiny))
-        free = int(np.flatnonzero(s.fixed.sum(axis=1) == 0)[0])
-        st.velocity[free] = np.nan
-        d0 = st.damage.copy()
-        try:
-            s.step(st, DT)
-            msgs.append(None)
-        except SolverError as exc:
-            msgs.append(str(exc).split(" (")[0])
-        assert np.array_equal(st.damage, d0) and st.step == 0
-    report["nan_messages"] = msgs
-    report["device_bytes_per_element"] = coop["solver"].device_bytes() / len(ref["damage"])
-    report["wall_s"] = time.perf_counter() - t0
-    json.dump(report, sys.stdout, default=lambda o: o.tolist() if hasattr(o, "tolist") else str(o))
+    rep = {"simulator": __import__("numba").config.ENABLE_CUDASIM == 1}
+    ref = run(model("cpu"))
+    rep.update(n_elements=ref["n_elements"], damage_max=float(ref["damage"].max()),
+               damaged_fraction=float(np.mean(ref["damage"] > 0)))
+    rep["cpu_parallel"] = compare(ref, run(model("cpu_parallel")))
+    coop = model("cuda")  # sync="step", launch="auto"
+    rep["cuda_step_sync"] = compare(ref, run(coop))
+    rep["paths"] = coop.stepper.forcing_paths
+    rep["launch_auto"] = coop.stepper.launch_used
+    rep["device_bytes_per_element"] = coop.stepper.device_bytes() / coop.mesh.n_elements
+    rep["cuda_explicit_sync_launches"] = compare(ref, run(model("cuda", sync="explicit", launch="launches")))
+    rep["heal_callable_explicit_sync"] = compare(run(model("cpu", heal=True)),
+                                                 run(model("cuda", heal=True, sync="explicit")))
+    rep["remesh_explicit_sync"] = compare(run(model("cpu", remesh=True)),
+                                          run(model("cuda", remesh=True, sync="explicit")))
+    host = model("cuda", variant="host", sync="explicit")
+    rep["host_fields"] = compare(run(model("cpu", variant="host")), run(host))
+    rep["host_paths"] = host.stepper.forcing_paths
+    with tempfile.TemporaryDirectory() as tmp:
+        rep["resume_cpu_to_cuda"] = compare(ref, resume_across("cpu", "cuda", tmp))
+        rep["resume_cuda_to_cpu"] = compare(ref, resume_across("cuda", "cpu", tmp))
+        rep["scene"] = scene_runs(tmp)
+    rep["outside_grid_messages"] = [forcing_error("cpu"), forcing_error("cuda")]
+    rep["nan_messages"] = [nan_checker_message("cpu", "nan"), nan_checker_message("cuda", "nan")]
+    rep["speed_messages"] = [nan_checker_message("cpu", "speed"), nan_checker_message("cuda", "speed")]
+    rep["stale_after_nan_check"] = downloads_per_step()
+    for motion in ("translation", "rotation"):
+        a, b = rigid_motion("cpu", motion), rigid_motion("cuda", motion)
+        rep[f"rigid_{motion}"] = {**{k: v for k, v in b.items() if k not in ("transport", "nodes")},
+                                  "transport_vs_cpu": rel_diff(a["transport"], b["transport"]),
+                                  "nodes_vs_cpu": rel_diff(a["nodes"], b["nodes"])}
+    rep["wall_s"] = time.perf_counter() - t0
+    text = json.dumps(rep, default=lambda o: o.tolist() if hasattr(o, "tolist") else str(o))
+    if len(sys.argv) > 1:
+        Path(sys.argv[1]).write_text(text)
+    else:
+        print(text)
 
 
 if __name__ == "__main__":

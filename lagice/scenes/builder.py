@@ -25,7 +25,15 @@ from ..simulation import Simulation
 from ..solvers import SOLVER_RHEOLOGY, SOLVERS, VelocityBC
 from ..state import IceState
 from . import components
-from .config import RHEOLOGY_KEYS, load_scene, physics_view, resolve_hook, spatial_values, time_space_callable
+from .config import (
+    RHEOLOGY_KEYS,
+    load_scene,
+    override_config,
+    physics_view,
+    resolve_hook,
+    spatial_values,
+    time_space_callable,
+)
 
 BUILDER = "lagice.scenes.builder:build_simulation"
 ROOT = Path(__file__).resolve().parents[2]
@@ -146,6 +154,9 @@ def build_rheology(cfg: dict):
 
 def validate_config(cfg: dict) -> None:
     """Every check that needs no mesh, so bad input fails before any work."""
+    from ..solvers.cuda_explicit import check_solver_device
+
+    check_solver_device(cfg["solver"])  # [solver] device: "cuda" needs the explicit stepper and a GPU
     if cfg["run"]["duration"] is None:
         raise ConfigError("run.duration is required (e.g. '28d')")
     duration = parse_duration(cfg["run"]["duration"], "run.duration")
@@ -308,7 +319,16 @@ def build_model(cfg: dict) -> Model:
     duration = parse_duration(cfg["run"]["duration"], "run.duration")
     parts = components.build(cfg, mesh, state, rheo, duration)
     opts = solver_options(cfg)
-    return Model(state, rheology=rheo, solver=cfg["solver"]["name"], solver_options=opts, bcs=bcs,
+    solver = cfg["solver"]["name"]
+    if cfg["solver"]["device"] == "cuda":  # the explicit stepper on the GPU (validate_config checked both)
+        from ..solvers.cuda_explicit import CudaExplicitSolver
+
+        heal = parts["healing"].rate if parts["healing"] is not None else None
+        # sync="explicit": the state stays on the device; the Model brings it to the host when an
+        # activity, a checkpoint or a remesh reads it (Model.needs_host_state, docs/gpu.md)
+        solver = CudaExplicitSolver(rheo, mesh, bcs=bcs, forces=parts["forces"], heal_rate=heal, sync="explicit",
+                                    **opts)
+    return Model(state, rheology=rheo, solver=solver, solver_options=opts, bcs=bcs,
                  forces=parts["forces"], thermo=parts["thermo"], healing=parts["healing"],
                  mover=parts["mover"], remesher=parts["remesher"], drifters=build_drifters(cfg, poly),
                  config=cfg, fingerprint_config=physics_view(cfg), rng=rng)
@@ -338,9 +358,15 @@ def build_drifters(cfg, poly):
 
 
 # -- the simulation ------------------------------------------------------------------
-def build_simulation(cfg: dict, out_dir=None, progress: bool | None = None) -> Simulation:
+def build_simulation(cfg: dict, out_dir=None, progress: bool | None = None, overrides=None) -> Simulation:
     """Model + Simulation with the output, time-series and checkpoint activities of
-    the config, writing into ``out_dir`` (default ``runs/SCENE``)."""
+    the config, writing into ``out_dir`` (default ``runs/SCENE``). ``overrides``
+    (``{"table.key": value}``) change the config first, e.g. when a checkpoint
+    resumes on another device: ``Simulation.resume(path, overrides={"solver.device":
+    "cuda"})`` (keys outside :data:`~lagice.scenes.config.NON_PHYSICS` change the
+    fingerprint, and the resume is refused)."""
+    if overrides:
+        cfg = override_config(cfg, overrides)
     model = build_model(cfg)
     prog = cfg["run"]["progress"] if progress is None else progress
     sim = Simulation(model, dt=time_step_s(cfg), stop=cfg["run"]["duration"], progress=prog, builder=BUILDER,

@@ -56,7 +56,7 @@ SCHEMA = {
         "linear_solver": (str, None), "tol": (NUM, None), "max_iter": (int, None),
         "allow_unstable": (bool, False), "safety": (NUM, None), "parallel": (bool, None),
         "velocity": (str, None), "velocity_params": (dict, {}),
-        "device": (str, "cpu"),  # "cpu" (default) or "cuda" (lagice.solvers.cuda_explicit)
+        "device": (str, "cpu"),
     },
     "boundary": {"*": {"u": (EXPR, None), "v": (EXPR, None)}},
     "forcing": {
@@ -87,7 +87,10 @@ RHEOLOGY_KEYS = {
 #: config keys that do not change the trajectory of a run (left out of the checkpoint
 #: fingerprint, so a run can be extended, re-scheduled or re-described on resume)
 NON_PHYSICS = {"scene": ("name", "description", "extends", "source"), "run": ("duration", "progress", "max_speed_m_s"),
-               "output": None, "checkpoint": None}
+               "output": None, "checkpoint": None,
+               # where the explicit stepper runs (CPU serial/parallel kernels, GPU): same physics, results
+               # equal to round-off (docs/gpu.md), so a checkpoint resumes on another device
+               "solver": ("device", "parallel")}
 
 SCENE_DIR = Path(__file__).resolve().parents[2] / "examples"
 _MODFUNC = re.compile(r"^[A-Za-z_][\w.]*:[A-Za-z_]\w*$")
@@ -249,6 +252,19 @@ def physics_view(cfg: dict) -> dict:
                  or ((fc.get("air_temperature") or {}).get("kind") == "synthetic"))
     if by_length:
         out["run"]["duration"] = cfg["run"]["duration"]
+    return out
+
+
+def override_config(cfg: dict, overrides) -> dict:
+    """A validated configuration with ``overrides`` (``{"table.key": value}`` or
+    ``["table.key=value", ...]``) applied and validated again, e.g.
+    ``{"solver.device": "cuda"}`` when resuming a checkpoint on another device
+    (``Simulation.resume(path, overrides=...)`` passes them to the builder)."""
+    raw = copy.deepcopy({k: v for k, v in cfg.items() if not k.startswith("_")})
+    source = raw["scene"].pop("source", None)
+    out = validate(apply_overrides(raw, overrides), source or "<config>")
+    if source is not None:
+        out["scene"]["source"] = source
     return out
 
 

@@ -10,6 +10,10 @@ explicit   Maxwell-EB               lumped mass, N elastic sub-steps per step
 evp        viscous-plastic          mEVP iterations (adaptive α, β)
 prescribed (none)                   kinematic: the velocity is given
 ========== ======================== =============================================
+
+The explicit stepper also runs on an NVIDIA GPU (``[solver] device = "cuda"``):
+:class:`lagice.solvers.cuda_explicit.CudaExplicitSolver`, imported only when
+asked for (docs/gpu.md).
 """
 from ..boundary import DirichletSet, VelocityBC
 from .base import StepInfo, TimeStepper

@@ -1,10 +1,13 @@
-"""GPU explicit Maxwell-EB stepper (issue 15): :class:`CudaExplicitSolver`.
+"""GPU explicit Maxwell-EB time stepper (issue 15): :class:`CudaExplicitSolver`.
 
 The same outer step as :class:`lagice.solvers.explicit.ExplicitSolver`, with
 every per-element and per-node loop on an NVIDIA GPU through ``numba.cuda``
-(kernels in :mod:`lagice.solvers.cuda_kernels`), state kept on the device
-between outer steps. Design, sync rules and measured agreement with the CPU
-kernels: ``docs/gpu.md``.
+(kernels in :mod:`lagice.solvers.cuda_kernels`), the state kept on the device
+between outer steps. It follows :class:`lagice.solvers.base.TimeStepper`:
+``step(state, t_s, dt_s)`` advances velocity, stress and damage over
+[t_s, t_s + dt_s] (the model owns the clock), :attr:`transport_velocity` is the
+mean of the sub-step velocities, :attr:`last_strain_rate` its strain rate.
+Design, sync rules and measured agreement with the CPU stepper: ``docs/gpu.md``.
 
 What runs where, per outer step
 -------------------------------
@@ -19,16 +22,23 @@ device:
   as :class:`forcing.records.RecordField`), E, λ, exp(−c*(1−A)), strengths,
   lumped mass, adjacency weights, wind force and drag coefficients, then the
   sub-step loop (node velocity + element stress/damage/healing), the sub-step
-  mean velocity (transport velocity) and its strain rate.
+  mean velocity (transport velocity) and its strain rate, and the checks the
+  NaN checker needs (non-finite counts, largest speed).
 
 Two host↔device synchronisations per outer step read a handful of counters:
 after the setup (E_max for the sub-step count; forcing points outside the
-grid / non-finite) and after the sub-steps (capped elements, damaged
-elements, non-finite velocities).
+grid / non-finite) and after the sub-steps (capped, damaged and non-finite
+counts, largest speed).
 
 Launches per sub-step: none with the cooperative kernel (``launch="auto"``
 where the device supports it: one launch runs all sub-steps with grid-wide
 barriers); two with ``launch="launches"`` (node kernel, element kernel).
+
+The node system (prescribed dofs from :class:`~lagice.boundary.DirichletSet`,
+P1 geometry, lumped mass and adjacency weights) is the device counterpart of
+:class:`lagice.fem.NodeSystem`: the prescribed dofs and the fixed flags are
+built on the host from the same ``DirichletSet``, everything per element and
+per node is computed on the device.
 """
 from __future__ import annotations
 
@@ -38,10 +48,11 @@ import warnings
 
 import numpy as np
 
+from ..boundary import DirichletSet
 from ..errors import ConfigError, ForcingError, SolverError
 from ..forces import Coriolis, OceanDrag, WindStress, evaluate_vector
 from ..rheology import MaxwellEB
-from .base import LumpedMassSolver, StepInfo
+from .base import StepInfo
 from .explicit import ExplicitSolver
 
 #: values of ``[solver] device``
@@ -50,9 +61,9 @@ DEVICES = ("cpu", "cuda")
 KERNELS = ("forcing", "setup", "substeps", "transfer")
 SYNC_MODES = ("step", "explicit")
 LAUNCH_MODES = ("auto", "cooperative", "launches")
-#: state fields the device advances (host copies go stale in sync="explicit")
+#: state fields the device advances (their host copies go stale between steps in sync="explicit")
 DEVICE_OWNED = ("velocity", "stress", "damage")
-#: state fields only the host changes (thermodynamics, remapping); the device keeps read-only copies
+#: state fields only host code changes (mesh motion, thermodynamics, remapping): uploaded at every step
 HOST_OWNED = ("thickness", "concentration", "cohesion")
 STATE_FIELDS = DEVICE_OWNED + HOST_OWNED
 _DEV_KEY = {"velocity": "vel", "stress": "sigma", "damage": "damage", "thickness": "h",
@@ -100,26 +111,18 @@ def require_cuda(key: str = "solver.device") -> str:
 
 
 def check_solver_device(sv: dict) -> None:
-    """Check ``[solver] device`` of a scene before any mesh work (issue 15):
-    a known value, a usable GPU for ``"cuda"``, and the explicit solver."""
+    """Check ``[solver] device`` of a scene before any mesh work (issue 15): a known
+    value; for ``"cuda"``, the explicit stepper (the only one with a GPU version)
+    and a usable GPU."""
     dev = sv.get("device", "cpu")
     if dev not in DEVICES:
         raise ConfigError(f"solver.device = {dev!r}: expected one of {list(DEVICES)}")
     if dev == "cuda":
-        require_cuda("solver.device")
         if sv.get("name") != "explicit":
-            raise ConfigError(f'solver.device = "cuda" runs the explicit solver only; solver.name = '
-                              f'{sv.get("name")!r} (set solver.name = "explicit", or solver.device = "cpu")')
-
-
-def build_cuda_solver(rheology, mesh, bcs, forces, healing, options: dict):
-    """The scene builder's CUDA solver (``[solver] device = "cuda"``), with the
-    healing component wired as :class:`lagice.model.Model` does for CPU solvers.
-    ``sync="step"``: today's Model reads the host state after every step."""
-    heal = None
-    if healing is not None:
-        heal = lambda st: healing(st, st.time_s)
-    return CudaExplicitSolver(rheology, mesh, bcs=bcs, forces=forces, heal_rate=heal, sync="step", **options)
+            raise ConfigError(f'solver.device = "cuda" runs the explicit stepper only; solver.name = '
+                              f'{sv.get("name")!r} has no GPU version (set solver.name = "explicit", or '
+                              f'solver.device = "cpu")')
+        require_cuda("solver.device")
 
 
 # ----------------------------------------------------------------------------
@@ -238,22 +241,26 @@ class _NodeField:
 
 
 # ----------------------------------------------------------------------------
-# the solver
+# the stepper
 # ----------------------------------------------------------------------------
-class CudaExplicitSolver(LumpedMassSolver):
-    """Explicit Maxwell-EB stepper on a CUDA GPU (``[solver] device = "cuda"``).
+class CudaExplicitSolver:
+    """Explicit Maxwell-EB time stepper on a CUDA GPU (``[solver] device = "cuda"``).
 
     Args (as :class:`~lagice.solvers.explicit.ExplicitSolver`):
         rheology, mesh, bcs, forces (``WindStress``, ``OceanDrag``, ``Coriolis``;
-        at most one of each of the first two), substeps, heal_rate, safety,
-        allow_unstable.
+        at most one of each of the first two), substeps, heal_rate (``(state, t_s)
+        -> (m,) [s-1]``), safety, allow_unstable.
+        parallel: the CPU stepper's choice of kernel builds; accepted so that a
+            scene's ``[solver]`` options work on both devices, and without effect
+            here (the CPU builds give bit-identical results either way).
     Device options (keyword only):
         sync: ``"step"`` (default): the host state (velocity, stress, damage) is
             brought up to date after every step and uploaded again before the
-            next, so any host code may read and write it (what today's
-            :class:`~lagice.model.Model` needs); ``"explicit"``: the state stays
-            on the device between steps and the caller syncs with
-            :meth:`to_host` / :meth:`from_host` (``docs/gpu.md``: what to call when).
+            next, so any host code may read and write it between steps;
+            ``"explicit"``: the state stays on the device between steps and
+            host code asks for it with :meth:`to_host` (the model does:
+            :meth:`lagice.model.Model.needs_host_state`; ``docs/gpu.md``: who
+            calls what, when).
         launch: ``"auto"`` (cooperative single-launch sub-step loop where
             possible, else ``"launches"``), ``"cooperative"``, ``"launches"``
             (two kernels per sub-step).
@@ -261,29 +268,30 @@ class CudaExplicitSolver(LumpedMassSolver):
         max_blocks: cap on blocks per launch (None: one thread per entity; every
             kernel is a grid-stride loop, so any cap is correct).
 
-    Attributes as ExplicitSolver: ``mean_velocity`` (transport velocity, mean
-    over the sub-steps) and ``last_strain_rate`` (its strain rate) are
-    downloaded on first access after a step; ``area``, ``b``, ``c``, ``td`` on
+    After a step, ``state.velocity`` is the last sub-step's velocity (in
+    ``sync="explicit"`` once downloaded), :attr:`transport_velocity` the mean
+    over the sub-steps and :attr:`last_strain_rate` its strain rate (both
+    downloaded on first access after a step); ``area``, ``b``, ``c``, ``td`` on
     first access after a geometry update; ``dx_min``, ``last_substeps``.
     ``kernel_timings`` [s]: ``forcing`` (host forcing work and record uploads),
     ``setup`` (device setup through the mid-step sync), ``substeps`` (sub-step
     loop, mean velocity and strain rate, to the end-of-step sync),
-    ``transfer`` (state copies of :meth:`from_host` / :meth:`to_host` made by
-    ``step`` in ``sync="step"``). ``StepInfo.timings`` maps them as
-    assembly = forcing + setup + transfer, solve = substeps, damage = 0
+    ``transfer`` (state uploads at the start of the step and, in
+    ``sync="step"``, the download at its end). ``StepInfo.timings`` maps them
+    as assembly = forcing + setup + transfer, solve = substeps, damage = 0
     (fused into the sub-step kernels).
     """
 
-    name = "explicit_cuda"
+    name = "explicit"
     device = "cuda"
 
     def __init__(self, rheology: MaxwellEB, mesh, bcs=(), forces=(), substeps: int | None = None,
-                 heal_rate=None, safety: float = 0.7, allow_unstable: bool = False, *,
-                 sync: str = "step", launch: str = "auto", threads_per_block: int = 128,
-                 max_blocks: int | None = None):
+                 heal_rate=None, safety: float = 0.7, allow_unstable: bool = False,
+                 parallel: bool | None = None, *, sync: str = "step", launch: str = "auto",
+                 threads_per_block: int = 128, max_blocks: int | None = None):
         self.device_name = require_cuda("solver.device")
         if not isinstance(rheology, MaxwellEB):
-            raise ConfigError(f"rheology must be MaxwellEB; got {type(rheology).__name__}")
+            raise ConfigError(f"the explicit stepper solves the Maxwell-EB rheology; got {type(rheology).__name__}")
         if substeps is not None:
             if int(substeps) != substeps or int(substeps) < 1:
                 raise ConfigError(f"substeps = {substeps!r} must be an integer >= 1 (or None: automatic)")
@@ -307,7 +315,7 @@ class CudaExplicitSolver(LumpedMassSolver):
         self.safety = float(safety)
         self.allow_unstable = bool(allow_unstable)
         self.heal_rate = heal_rate
-        self.parallel = None
+        self.parallel = parallel
         self.sync = sync
         self.launch = launch
         self.launch_used = None  # "cooperative" or "launches", set at the first step
@@ -345,7 +353,7 @@ class CudaExplicitSolver(LumpedMassSolver):
         self._pres_static = all(not callable(bc.u) and not callable(bc.v) for bc in self.bcs)
         self.reset_topology(mesh)
 
-    # -- sub-step choice: the CPU solver's own rules (same N, same refusals) -------
+    # -- sub-step choice: the CPU stepper's own rules (same N, same refusals) -------
     substeps_for = ExplicitSolver.substeps_for
     _check_stability = ExplicitSolver._check_stability
 
@@ -363,20 +371,29 @@ class CudaExplicitSolver(LumpedMassSolver):
     def _launch(self, kernel, size: int, *args) -> None:
         kernel[self._blocks(size), self.tpb](*args)
 
-    # -- topology and geometry ----------------------------------------------------------
+    # -- topology and geometry (the device node system) ---------------------------------
     def reset_topology(self, mesh) -> None:
-        """New mesh (remesh, checkpoint load): drop every device array; the next
-        :meth:`step` uploads the whole state from the host."""
+        """New mesh (remesh, checkpoint load): drop every device array and rebuild the
+        prescribed dofs; the next :meth:`step` uploads the whole state from the host."""
         self._d = {}
         self._resident = None
         self._host_stale = set()
+        self._host_ref = {}
         self._geom_cache = {}
+        self._have_results = False
+        self._transport = self._strain = None
+        self._last_check = None
         for f in (self._wind, self._ocean):
             if f is not None:
                 f.reset()
         self._heal_const = None
         self._pres_done = False
-        super().reset_topology(mesh)  # DirichletSet, fixed flags, then update_geometry()
+        self.mesh = mesh
+        self.dirichlet = DirichletSet(mesh, self.bcs)  # as lagice.fem.NodeSystem
+        fixed = np.zeros((mesh.n_nodes, 2), np.int8)
+        fixed.reshape(-1)[self.dirichlet.dofs] = 1
+        self.fixed = fixed
+        self.update_geometry()
 
     def _ensure_topology(self) -> None:
         if self._d:
@@ -417,14 +434,14 @@ class CudaExplicitSolver(LumpedMassSolver):
         from . import cuda_kernels as K
 
         self._d["counters"].copy_to_device(np.zeros(K.N_COUNTERS, np.int64))
-        sc = np.empty(K.N_SCALARS)
+        sc = np.zeros(K.N_SCALARS)
         sc[K.S_E_MAX] = -math.inf
         sc[K.S_AREA_MIN] = math.inf
         self._d["scalars"].copy_to_device(sc)
 
     def update_geometry(self) -> None:
-        """Nodes moved on the host (Lagrangian step): upload them and recompute
-        shape gradients, areas, td and ``dx_min`` on the device."""
+        """Nodes moved on the host (mesh motion): upload them and recompute shape
+        gradients, areas, td and ``dx_min`` on the device."""
         from . import cuda_kernels as K
 
         self._ensure_topology()
@@ -440,9 +457,6 @@ class CudaExplicitSolver(LumpedMassSolver):
             raise SolverError(f"{int(cnt[K.C_INVERTED])} inverted elements in the mesh")
         self.dx_min = float(np.sqrt(2.0 * sc[K.S_AREA_MIN]))
 
-    #: the name the sync API uses in docs/gpu.md
-    invalidate_geometry = update_geometry
-
     def _geom(self, key):
         if key not in self._geom_cache:
             self._geom_cache[key] = self._d[key].copy_to_host()
@@ -455,23 +469,16 @@ class CudaExplicitSolver(LumpedMassSolver):
 
     # -- results downloaded on demand ------------------------------------------------------
     @property
-    def mean_velocity(self):
-        """(n, 2) mean velocity over the last step's sub-steps [m s-1] (transport velocity)."""
-        if self._mean is None and self._have_results:
-            self._mean = self._d["mean_vel"].copy_to_host()
-        return self._mean
-
-    @mean_velocity.setter
-    def mean_velocity(self, value):
-        if value is not None:
-            raise AttributeError("mean_velocity is computed on the device; it can only be cleared (None)")
-        self._mean = None
-        self._strain = None
-        self._have_results = False
+    def transport_velocity(self):
+        """(n, 2) [m s-1] mean of the last step's sub-step velocities (what moves the
+        nodes; :class:`~lagice.solvers.base.TimeStepper`), None before a step."""
+        if self._transport is None and self._have_results:
+            self._transport = self._d["mean_vel"].copy_to_host()
+        return self._transport
 
     @property
     def last_strain_rate(self):
-        """(m, 3) strain rate of :attr:`mean_velocity` [s-1]."""
+        """(m, 3) [s-1] strain rate of :attr:`transport_velocity`, None before a step."""
         if self._strain is None and self._have_results:
             self._strain = self._d["strain"].copy_to_host()
         return self._strain
@@ -483,24 +490,27 @@ class CudaExplicitSolver(LumpedMassSolver):
         return tuple(f for f in DEVICE_OWNED if f in self._host_stale)
 
     def to_host(self, state, fields=DEVICE_OWNED) -> None:
-        """Copy device-advanced fields into ``state`` (new host arrays, as the CPU
-        solver assigns them). Call before host code reads velocity, stress or
-        damage in ``sync="explicit"`` (output, checkpoint, remesh, diagnostics).
-        A no-op for a state the device does not hold (its host copy is the newest)."""
-        if self._resident is not state:
-            return
+        """Bring the device-advanced ``fields`` (default: velocity, stress, damage) of
+        ``state`` up to date on the host (new host arrays, as the CPU stepper assigns
+        them). In ``sync="explicit"``, call before host code reads or edits them
+        (:meth:`lagice.model.Model.needs_host_state` does). Free when the host copy
+        is current or the device does not hold ``state``."""
         for f in fields:
             if f not in STATE_FIELDS:
                 raise ConfigError(f"to_host: unknown field {f!r}; expected some of {list(STATE_FIELDS)}")
-            if f in DEVICE_OWNED:
-                setattr(state, f, self._d[_DEV_KEY[f]].copy_to_host())
+        if self._resident is not state:
+            return
+        for f in fields:
+            if f in self._host_stale:
+                arr = self._d[_DEV_KEY[f]].copy_to_host()
+                setattr(state, f, arr)
+                self._host_ref[f] = arr
                 self._host_stale.discard(f)
 
     def from_host(self, state, fields=None) -> None:
         """Upload ``fields`` (default: all of :data:`STATE_FIELDS`) of ``state`` to the
-        device. Call after host code changed them (thermodynamics: thickness,
-        concentration; edits of velocity, stress, damage). A state the device has
-        not seen is always uploaded whole."""
+        device now. :meth:`step` does this by itself for every field whose host copy
+        may have changed (docs/gpu.md); a state the device has not seen is uploaded whole."""
         self._ensure_topology()
         if self._resident is not state:
             fields = STATE_FIELDS
@@ -510,16 +520,43 @@ class CudaExplicitSolver(LumpedMassSolver):
         for f in fields:
             if f not in STATE_FIELDS:
                 raise ConfigError(f"from_host: unknown field {f!r}; expected some of {list(STATE_FIELDS)}")
-            if f in self._host_stale:
-                raise SolverError(f"from_host({f!r}): the host copy is older than the device's; call "
-                                  f"to_host(state, [{f!r}]) before changing it on the host")
+            host = getattr(state, f)
             shape = {"velocity": (n, 2), "stress": (m, 3)}.get(f, (m,))
-            arr = np.ascontiguousarray(getattr(state, f), np.float64)
+            arr = np.ascontiguousarray(host, np.float64)
             if arr.shape != shape:
                 raise SolverError(f"state.{f} has shape {arr.shape}; expected {shape} for this mesh "
                                   "(call reset_topology after replacing the mesh)")
             self._d[_DEV_KEY[f]].copy_to_device(arr)
+            self._host_ref[f] = host
+            self._host_stale.discard(f)
         self._resident = state
+
+    def _upload_for_step(self, state) -> None:
+        """Before a step: the host-owned fields, and every device-owned field whose host
+        copy is current (host code may have edited it since it was downloaded) or was
+        replaced by a new array (assigned on the host)."""
+        if self._resident is not state:
+            self.from_host(state)
+            return
+        fields = list(HOST_OWNED)
+        for f in DEVICE_OWNED:
+            if f not in self._host_stale or getattr(state, f) is not self._host_ref.get(f):
+                fields.append(f)
+        self.from_host(state, fields)
+
+    def device_check(self, max_speed_m_s: float) -> tuple[tuple, bool]:
+        """For the NaN checker (:class:`lagice.activities.NaNChecker`): ``(fields, ok)``
+        where ``fields`` are the state fields whose host copies are stale and ``ok``
+        is True when the device found them finite at the end of the last step, with
+        every ice speed below ``max_speed_m_s`` [m s-1] — the host may then skip them.
+        ``ok`` False: download them and check on the host (the host names the place)."""
+        stale = self.host_stale
+        if not stale or self._last_check is None:
+            return (), True
+        bad_nodes, bad_elems, speed2 = self._last_check
+        # margin: the host's np.hypot may differ from sqrt(u² + v²) in the last bit
+        ok = bad_nodes == 0 and bad_elems == 0 and math.sqrt(speed2) <= max_speed_m_s * (1.0 - 1e-9)
+        return stale, ok
 
     def device_bytes(self) -> int:
         """Bytes held in device arrays (mesh, state, work arrays, forcing records)."""
@@ -551,7 +588,7 @@ class CudaExplicitSolver(LumpedMassSolver):
                 raise SolverError(f"no block of {self.tpb} threads of the cooperative kernel fits on the device")
             self._coop_max = int(mx)
             self.launch_used = "cooperative"
-        except Exception as exc:  # compile, link or driver failures all mean "not available"
+        except Exception as exc:  # noqa: BLE001 - compile, link or driver failures all mean "not available"
             if self.launch == "cooperative":
                 raise SolverError(f"launch = 'cooperative' is not available on {self.device_name}: {exc}") from exc
             self.launch_note = f"cooperative sub-step kernel unavailable ({type(exc).__name__}: {exc})"
@@ -559,18 +596,24 @@ class CudaExplicitSolver(LumpedMassSolver):
             self.launch_used = "launches"
         return self.launch_used
 
-    def step(self, state, dt: float) -> StepInfo:
+    def step(self, state, t_s: float, dt_s: float) -> StepInfo:
+        """Advance velocity, stress and damage of ``state`` over [t_s, t_s + dt_s]
+        (:class:`~lagice.solvers.base.TimeStepper`). A stability ConfigError or a
+        ForcingError leaves the state untouched; a non-finite result is committed,
+        as on the CPU, for the NaN checker to report."""
         from . import cuda_kernels as K
 
-        if not dt > 0:
-            raise ConfigError(f"dt = {dt!r} s must be > 0")
+        if not dt_s > 0:
+            raise ConfigError(f"dt = {dt_s!r} s must be > 0")
         if state.mesh is not self.mesh:
-            raise SolverError("state.mesh is not this solver's mesh: call reset_topology(state.mesh) after "
+            raise SolverError("state.mesh is not this stepper's mesh: call reset_topology(state.mesh) after "
                               "replacing the mesh (remesh, checkpoint load)")
         kt = {k: 0.0 for k in KERNELS}
         t0 = time.perf_counter()
-        if self.sync == "step" or self._resident is not state:
+        if self.sync == "step":
             self.from_host(state)
+        else:
+            self._upload_for_step(state)
         d = self._d
         rh, p = self.rheology, self.rheology.params
         t1 = time.perf_counter()
@@ -580,7 +623,7 @@ class CudaExplicitSolver(LumpedMassSolver):
         self._reset_counters()
         mesh = self.mesh
         n, m = mesh.n_nodes, mesh.n_elements
-        t_new = state.time_s + dt
+        t_new = t_s + dt_s
         self._launch(K.prepare_elements_kernel, m, d["damage"], d["sigma"], d["conc"], d["coh"], float(p.E0),
                      float(p.relaxation_time_s), float(p.concentration_c), float(p.alpha), rh._denom, rh.q,
                      d["damage_w"], d["sigma_w"], d["e_dt"], d["gamma"], d["conc_factor"], d["sig_c"],
@@ -589,9 +632,8 @@ class CudaExplicitSolver(LumpedMassSolver):
             self._wind.evaluate(self, t_new, d["wind"])
         self._ocean.evaluate(self, t_new, d["current"])
         if self.heal_rate is not None:
-            if "damage" in self._host_stale:  # the callable reads the host state
-                self.to_host(state, ("damage",))
-            heal = np.ascontiguousarray(self.heal_rate(state), np.float64)
+            self.to_host(state, ("damage",))  # the callable reads the host state (start-of-step damage)
+            heal = np.ascontiguousarray(self.heal_rate(state, t_s), np.float64)
             if heal.shape != (m,):
                 raise SolverError(f"heal_rate returned shape {heal.shape}; expected ({m},) [s-1]")
             d["heal"].copy_to_device(heal)
@@ -604,7 +646,7 @@ class CudaExplicitSolver(LumpedMassSolver):
         if d["dofs"] is not None and not (self._pres_static and self._pres_done):
             from numba import cuda
 
-            v0 = cuda.to_device(np.ascontiguousarray(self.dirichlet.values(state.time_s), np.float64))
+            v0 = cuda.to_device(np.ascontiguousarray(self.dirichlet.values(t_s), np.float64))
             v1 = cuda.to_device(np.ascontiguousarray(self.dirichlet.values(t_new), np.float64))
             self._launch(K.scatter_prescribed_kernel, v0.shape[0], d["dofs"], v0, v1, d["pres0"], d["pres1"])
             self._pres_done = True
@@ -614,15 +656,15 @@ class CudaExplicitSolver(LumpedMassSolver):
         # -- mid-step sync: E_max, forcing checks, sub-step count ------------------------------
         cnt = d["counters"].copy_to_host()
         E_max = float(d["scalars"].copy_to_host()[K.S_E_MAX]) if m else float(p.E0)
-        n_sub = self.substeps_for(dt, E_max)
-        dt_s = dt / n_sub
-        self._check_stability(dt_s, E_max)
+        n_sub = self.substeps_for(dt_s, E_max)
+        dt_sub = dt_s / n_sub
+        self._check_stability(dt_sub, E_max)
         if self._wind is not None:
             self._wind.check(cnt, t_new, mesh.nodes)
         self._ocean.check(cnt, t_new, mesh.nodes)
-        self._launch(K.finish_moduli_kernel, m, d["e_dt"], d["gamma"], dt_s)
+        self._launch(K.finish_moduli_kernel, m, d["e_dt"], d["gamma"], dt_sub)
         self._launch(K.prepare_nodes_kernel, n, d["ptr"], d["elems"], d["local"], d["area"], d["h"], d["b"],
-                     d["c"], float(p.rho_ice), dt_s, d["wind"], int(self._wind is not None), self._c_air,
+                     d["c"], float(p.rho_ice), dt_sub, d["wind"], int(self._wind is not None), self._c_air,
                      self._drag_coef, self._f_cor, d["vel"], d["vel_w"], d["vel_sum"], d["m_dt"], d["fext"],
                      d["cda"], d["half_mf"], d["wb"], d["wc"])
         t3 = time.perf_counter()
@@ -637,8 +679,8 @@ class CudaExplicitSolver(LumpedMassSolver):
         mat = (d["conc_factor"], d["coh"], d["sig_c"], d["sig_t"], d["td"], d["heal"], d["e_dt"], d["gamma"])
         consts = (kxx, kxy, kss, rh.q, rh._denom, float(p.max_damage), float(p.E0),
                   float(p.relaxation_time_s), float(p.alpha))
-        coop_args = (n_sub, dt_s, *node_args, d["tri"], d["b"], d["c"], d["damage_w"], *mat, *consts,
-                     d["flag"], d["mean_vel"], d["strain"], d["counters"])
+        coop_args = (n_sub, dt_sub, *node_args, d["tri"], d["b"], d["c"], d["damage_w"], *mat, *consts,
+                     d["flag"], d["mean_vel"], d["strain"], d["counters"], d["scalars"])
         if self._choose_launch(coop_args) == "cooperative":
             blocks = min(self._coop_max, self._blocks(max(n, m)))
             K.substeps_cooperative[blocks, self.tpb](*coop_args)
@@ -647,32 +689,29 @@ class CudaExplicitSolver(LumpedMassSolver):
                          d["flag"], d["counters"])
             for k in range(n_sub):
                 self._launch(K.node_substep_kernel, n, (k + 1) / n_sub, *node_args)
-                self._launch(K.element_substep_kernel, m, dt_s, *elem_args)
-            self._launch(K.finish_nodes_kernel, n, n_sub, d["vel_w"], d["vel_sum"], d["mean_vel"], d["counters"])
+                self._launch(K.element_substep_kernel, m, dt_sub, *elem_args)
+            self._launch(K.finish_nodes_kernel, n, n_sub, d["vel_w"], d["vel_sum"], d["mean_vel"], d["counters"],
+                         d["scalars"])
             self._launch(K.finish_elements_kernel, m, d["tri"], d["b"], d["c"], d["mean_vel"], d["strain"],
-                         d["flag"], d["counters"])
+                         d["flag"], d["sigma_w"], d["damage_w"], d["counters"])
         cnt = d["counters"].copy_to_host()
+        speed2 = float(d["scalars"].copy_to_host()[K.S_SPEED2_MAX])
         t4 = time.perf_counter()
         kt["substeps"] = t4 - t3
-        if cnt[K.C_NONFINITE]:
-            raise SolverError(f"non-finite velocity at t = {t_new:.6g} s (explicit solver on CUDA, Δt = {dt:g} s, "
-                              f"{n_sub} sub-steps of {dt_s:.3g} s): sub-step beyond the stability limit?")
 
         # -- commit: the working arrays become the state -----------------------------------------
         for a, w in (("vel", "vel_w"), ("sigma", "sigma_w"), ("damage", "damage_w")):
             d[a], d[w] = d[w], d[a]
-        state.time_s = t_new
-        state.step += 1
-        self._mean = self._strain = None
+        self._host_stale = set(DEVICE_OWNED)
+        self._transport = self._strain = None
         self._have_results = True
+        self._last_check = (int(cnt[K.C_NONFINITE]), int(cnt[K.C_NONFINITE_ELEM]), speed2)
         self.last_substeps = n_sub
         n_capped = int(cnt[K.C_CAPPED])
         rh.n_capped_total += n_capped
         if self.sync == "step":
             self.to_host(state)
             kt["transfer"] += time.perf_counter() - t4
-        else:
-            self._host_stale = set(DEVICE_OWNED)
         for k, v in kt.items():
             self.kernel_timings[k] += v
         info = StepInfo(iterations=n_sub, residual=0.0, n_damaged=int(cnt[K.C_DAMAGED]), n_capped=n_capped)

@@ -3,7 +3,7 @@
 
 Same arithmetic as the CPU kernels, operation for operation:
 
-* :func:`lagice.solvers.explicit.solve_node_2x2` and
+* :func:`lagice.fem.solve_node_2x2` and
   :func:`lagice.rheology._principal` are the CPU solver's own numba functions:
   numba compiles a CPU ``@njit`` function called from a CUDA kernel for the
   CUDA target, so there is one source;
@@ -34,17 +34,19 @@ from numba import cuda
 
 from forcing.records import _bilinear
 
-from ..fem import element_strain_rate
-from ..rheology import _principal
-from .explicit import solve_node_2x2
+from ..fem import element_strain_rate, solve_node_2x2
+from ..rheology.maxwell_eb import _principal
 
-# counter slots (int64)
+# counter slots (int64): C_NONFINITE counts nodes with a non-finite velocity,
+# C_NONFINITE_ELEM elements with a non-finite stress or damage (end of the step)
 C_CAPPED, C_DAMAGED, C_NONFINITE, C_INVERTED = 0, 1, 2, 3
 C_WIND_OUT, C_WIND_BAD, C_OCEAN_OUT, C_OCEAN_BAD = 4, 5, 6, 7
-N_COUNTERS = 8
-# scalar slots (float64)
-S_E_MAX, S_AREA_MIN = 0, 1
-N_SCALARS = 2
+C_NONFINITE_ELEM = 8
+N_COUNTERS = 9
+# scalar slots (float64): S_SPEED2_MAX = largest u² + v² [m2 s-2] of the finite
+# end-of-step velocities (the NaN checker's speed bound, checked on the device)
+S_E_MAX, S_AREA_MIN, S_SPEED2_MAX = 0, 1, 2
+N_SCALARS = 3
 
 strain_rate_dev = cuda.jit(device=True)(element_strain_rate.py_func)
 bilinear_dev = cuda.jit(device=True)(_bilinear.py_func)
@@ -196,25 +198,32 @@ def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigm
 
 @cuda.jit(device=True)
 def finish_node(i, vel, vel_sum, n_sub, mean_vel):
-    """Mean velocity over the sub-steps (``vel_sum / n_sub``); returns 1 when the
-    last sub-step's velocity is not finite."""
+    """Mean velocity over the sub-steps (``vel_sum / n_sub``); returns (1, 0) when the
+    last sub-step's velocity is not finite, else (0, u² + v²)."""
     mean_vel[i, 0] = vel_sum[i, 0] / n_sub
     mean_vel[i, 1] = vel_sum[i, 1] / n_sub
     u = vel[i, 0]
     v = vel[i, 1]
     if math.isnan(u) or math.isinf(u) or math.isnan(v) or math.isinf(v):
-        return 1
-    return 0
+        return 1, 0.0
+    return 0, u * u + v * v
 
 
 @cuda.jit(device=True)
-def finish_element(e, tri, b, c, mean_vel, strain, damaged_flag):
-    """Strain rate of the mean velocity; returns the element's damaged flag."""
+def finish_element(e, tri, b, c, mean_vel, strain, damaged_flag, sigma, damage):
+    """Strain rate of the mean velocity; returns the element's damaged flag and 1
+    when its stress or damage is not finite (else 0)."""
     exx, eyy, exy = strain_rate_dev(tri, b, c, mean_vel, e)
     strain[e, 0] = exx
     strain[e, 1] = eyy
     strain[e, 2] = exy
-    return damaged_flag[e]
+    bad = 0
+    for k in range(3):
+        if math.isnan(sigma[e, k]) or math.isinf(sigma[e, k]):
+            bad = 1
+    if math.isnan(damage[e]) or math.isinf(damage[e]):
+        bad = 1
+    return damaged_flag[e], bad
 
 
 # ----------------------------------------------------------------------------
@@ -224,7 +233,7 @@ def finish_element(e, tri, b, c, mean_vel, strain, damaged_flag):
 def substeps_cooperative(n_sub, dt_s, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current,
                          cos_t, sin_t, half_mf, fixed, pres0, pres1, tri, b, c, damage, conc_factor,
                          cohesion, sigma_c, sigma_t, td, heal_rate, e_dt, gamma, kxx, kxy, kss, q, denom,
-                         max_damage, E0, lambda0, alpha, damaged_flag, mean_vel, strain, counters):
+                         max_damage, E0, lambda0, alpha, damaged_flag, mean_vel, strain, counters, scalars):
     """All ``n_sub`` sub-steps, then the mean velocity and its strain rate, in one
     launch: the node and element phases are separated by a grid-wide barrier
     (cooperative groups), so the grid must be co-resident (launch with at most
@@ -247,18 +256,28 @@ def substeps_cooperative(n_sub, dt_s, vel, vel_sum, sigma, ptr, elems, wb, wc, m
                                      max_damage, E0, lambda0, alpha, damaged_flag)
         grid.sync()
     bad = 0
+    s2max = 0.0
     for i in range(start, n, stride):
-        bad += finish_node(i, vel, vel_sum, n_sub, mean_vel)
+        nb, s2 = finish_node(i, vel, vel_sum, n_sub, mean_vel)
+        bad += nb
+        s2max = max2(s2max, s2)
     grid.sync()
     ndam = 0
+    bad_e = 0
     for e in range(start, m, stride):
-        ndam += finish_element(e, tri, b, c, mean_vel, strain, damaged_flag)
+        fl, nb = finish_element(e, tri, b, c, mean_vel, strain, damaged_flag, sigma, damage)
+        ndam += fl
+        bad_e += nb
     if capped:
         cuda.atomic.add(counters, C_CAPPED, capped)
     if bad:
         cuda.atomic.add(counters, C_NONFINITE, bad)
+    if bad_e:
+        cuda.atomic.add(counters, C_NONFINITE_ELEM, bad_e)
     if ndam:
         cuda.atomic.add(counters, C_DAMAGED, ndam)
+    if s2max > 0.0:
+        cuda.atomic.max(scalars, S_SPEED2_MAX, s2max)
 
 
 # ----------------------------------------------------------------------------
@@ -287,21 +306,31 @@ def element_substep_kernel(dt_s, tri, b, c, vel, sigma, damage, conc_factor, coh
 
 
 @cuda.jit
-def finish_nodes_kernel(n_sub, vel, vel_sum, mean_vel, counters):
+def finish_nodes_kernel(n_sub, vel, vel_sum, mean_vel, counters, scalars):
     bad = 0
+    s2max = 0.0
     for i in range(cuda.grid(1), vel.shape[0], cuda.gridsize(1)):
-        bad += finish_node(i, vel, vel_sum, n_sub, mean_vel)
+        nb, s2 = finish_node(i, vel, vel_sum, n_sub, mean_vel)
+        bad += nb
+        s2max = max2(s2max, s2)
     if bad:
         cuda.atomic.add(counters, C_NONFINITE, bad)
+    if s2max > 0.0:
+        cuda.atomic.max(scalars, S_SPEED2_MAX, s2max)
 
 
 @cuda.jit
-def finish_elements_kernel(tri, b, c, mean_vel, strain, damaged_flag, counters):
+def finish_elements_kernel(tri, b, c, mean_vel, strain, damaged_flag, sigma, damage, counters):
     ndam = 0
+    bad_e = 0
     for e in range(cuda.grid(1), tri.shape[0], cuda.gridsize(1)):
-        ndam += finish_element(e, tri, b, c, mean_vel, strain, damaged_flag)
+        fl, nb = finish_element(e, tri, b, c, mean_vel, strain, damaged_flag, sigma, damage)
+        ndam += fl
+        bad_e += nb
     if ndam:
         cuda.atomic.add(counters, C_DAMAGED, ndam)
+    if bad_e:
+        cuda.atomic.add(counters, C_NONFINITE_ELEM, bad_e)
 
 
 # ----------------------------------------------------------------------------
@@ -384,7 +413,7 @@ def finish_moduli_kernel(e_buf, lam_buf, dt_s):
 def prepare_nodes_kernel(ptr, elems, local, area, h, b, c, rho, dt_s, wind, has_wind, c_air, drag_coef,
                          coriolis_f, vel, vel_w, vel_sum, m_dt, fext, cda, half_mf, wb, wc):
     """Per node: lumped mass and area (``fem.lumped_mass``), adjacency weights
-    (``explicit._adjacency_weights``, thickness-weighted), m/Δt_s, wind force
+    (``fem._adjacency_weights``, thickness-weighted), m/Δt_s, wind force
     a·τa with τa = (ρa Ca |Ua|) Ua (``WindStress.stress``), drag coefficient
     a·ρw·Cw, ½ m f; working copy of the velocity, zeroed velocity sum."""
     n = ptr.shape[0] - 1
@@ -422,7 +451,7 @@ def prepare_nodes_kernel(ptr, elems, local, area, h, b, c, rho, dt_s, wind, has_
 
 @cuda.jit
 def scatter_prescribed_kernel(dofs, vals0, vals1, pres0, pres1):
-    """pres.reshape(-1)[dofs] = vals (``LumpedMassSolver._prescribed_velocity``)."""
+    """pres.reshape(-1)[dofs] = vals (``fem.NodeSystem.prescribed_velocity``)."""
     for j in range(cuda.grid(1), dofs.shape[0], cuda.gridsize(1)):
         d = dofs[j]
         pres0[d // 2, d % 2] = vals0[j]
