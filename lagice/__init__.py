@@ -1,10 +1,18 @@
 """lagice: Lagrangian Maxwell-Elasto-Brittle sea-ice model."""
 __version__ = "0.2.0"  # the one version source (pyproject.toml reads it)
 
-from .errors import ConfigError, ForcingError, LagiceError, MeshError, RestartError, SolverError  # noqa: E402
+from .errors import (  # noqa: E402
+    ConfigError,
+    ForcingError,
+    LagiceError,
+    MeshError,
+    OutputError,
+    RestartError,
+    SolverError,
+)
 
 __all__ = ["__version__", "LagiceError", "ConfigError", "MeshError", "ForcingError", "RestartError",
-           "SolverError", "Model", "Simulation"]
+           "SolverError", "OutputError", "Model", "Simulation", "open_run"]
 
 
 def __getattr__(name):  # lazy: keep `import lagice` light
@@ -14,4 +22,7 @@ def __getattr__(name):  # lazy: keep `import lagice` light
     if name == "Simulation":
         from .simulation import Simulation
         return Simulation
+    if name == "open_run":
+        from .io.run import open_run
+        return open_run
     raise AttributeError(name)

@@ -11,7 +11,9 @@ An activity has ``name``, ``schedule`` and
 * ``initialize(sim)`` — once before the loop (a fresh or a resumed run);
 * ``__call__(sim)`` — when the schedule is due;
 * ``finalize(sim)`` — once after the loop (``at_end`` activities run then too,
-  when they did not just run).
+  when they did not just run);
+* ``teardown(sim)`` — always, when :meth:`Simulation.run` returns or raises
+  (release what ``initialize`` took: signal handlers, progress bars).
 
 Before an activity with ``needs_host_state`` (the default) runs, the model brings
 the state fields a device stepper keeps on its device up to date on the host
@@ -19,8 +21,11 @@ the state fields a device stepper keeps on its device up to date on the host
 """
 from __future__ import annotations
 
+import logging
 import math
+import signal
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -44,7 +49,7 @@ class Activity:
 
     def initialize(self, sim) -> None:
         self.schedule.initialize(sim.model)
-        if self.at_start and sim.model.clock.iteration == 0:
+        if self.at_start and (sim.model.clock.iteration == 0 or getattr(sim, "branched_from", None)):
             self.run(sim)
 
     def run(self, sim) -> None:
@@ -59,6 +64,9 @@ class Activity:
     def finalize(self, sim) -> None:
         if self.at_end and self.last_iteration != sim.model.clock.iteration:
             self.run(sim)
+
+    def teardown(self, sim) -> None:
+        pass
 
 
 class SnapshotOutput(Activity):
@@ -114,11 +122,31 @@ class TimeSeriesOutput(Activity):
         self.writer.flush()
 
 
+class DrifterOutput(Activity):
+    """The drifter trajectories as a CF trajectory file
+    (:class:`lagice.io.drifters.DrifterWriter`), rewritten when due and at the end."""
+
+    name = "drifter_output"
+    at_end = True
+
+    def __init__(self, schedule, writer):
+        super().__init__(schedule)
+        self.writer = writer
+
+    def __call__(self, sim):
+        if sim.model.drifters is not None:
+            self.writer.write(sim.model)
+
+
 class Checkpointer(Activity):
     """Checkpoints (:func:`lagice.io.checkpoint.write_checkpoint`), the last ``keep``
-    kept. Flushes the time-series writers first so their files match the checkpoint."""
+    kept: when the schedule is due (``None``: never), at the end of the run (so a
+    finished run can be extended) and when the run is stopped. Flushes the time-series
+    writers first so their files match the checkpoint. Removes the temporary files of
+    killed writes when a run starts."""
 
     name = "checkpointer"
+    at_end = True
 
     def __init__(self, schedule, directory, keep: int = 3):
         from .errors import ConfigError
@@ -128,49 +156,91 @@ class Checkpointer(Activity):
         super().__init__(schedule)
         self.directory = Path(directory)
         self.keep = int(keep)
+        self.last_path = None
+
+    def initialize(self, sim):
+        from .io.checkpoint import clean_stale_temporaries
+
+        for p in clean_stale_temporaries(self.directory):
+            logging.getLogger("lagice").info(f"removed a temporary file left by an interrupted write: {p}")
+        super().initialize(sim)
 
     def __call__(self, sim):
         for act in sim.activities.values():
             if isinstance(act, TimeSeriesOutput):
                 act.writer.flush()
-        sim.write_checkpoint()
+        self.last_path = sim.write_checkpoint()
 
 
 class Progress(Activity):
-    """A progress line every ``every`` of wall time: simulated day, percentage, rate
-    (simulated days per wall hour, over this session's steps only, so it is right
-    after a resume), ETA, remesh count and the volume budget."""
+    """Progress of the run: simulated day, percentage, rate, ETA, remesh count and the
+    volume budget. On a terminal a ``tqdm`` bar updated every step (rate and ETA from
+    this session's steps); otherwise (a log file, a batch queue) a line every
+    ``every`` of wall time with the rate in simulated days per wall hour, also over
+    this session's steps only, so both are right after a resume. Silent when the
+    ``lagice`` logger is above INFO (``--log-level warning``)."""
 
     name = "progress"
     at_end = True
     needs_host_state = False  # clock, counters and the volume budget only
 
-    def __init__(self, schedule="wall 10s", stream=None):
+    def __init__(self, schedule="wall 10s", stream=None, bar: bool | None = None):
         super().__init__(schedule)
         self.stream = stream
+        self.bar = bar
+        self._line_schedule = self.schedule
         self._t0 = None
         self._sim0 = None
+        self._bar = None
+
+    def _quiet(self) -> bool:
+        return logging.getLogger("lagice").getEffectiveLevel() > logging.INFO
 
     def initialize(self, sim):
+        stream = self.stream or sys.stdout
+        use_bar = self.bar if self.bar is not None else bool(getattr(stream, "isatty", lambda: False)())
+        self._bar = None
+        if use_bar and not self._quiet():
+            from tqdm import tqdm
+
+            self.schedule = IterationInterval(1)
+            self._bar = tqdm(total=sim.n_steps, initial=sim.model.clock.iteration, unit="step", file=stream,
+                             dynamic_ncols=True, mininterval=0.5, smoothing=0.1,
+                             desc=str(sim.model.config.get("scene", {}).get("name", "lagice")))
+        else:
+            self.schedule = self._line_schedule
         super().initialize(sim)
         self._t0 = time.perf_counter()
         self._sim0 = sim.model.clock.time_s
 
     def __call__(self, sim):
         m = sim.model
+        if self._quiet():
+            return
+        b = m.volume_budget()
+        if self._bar is not None:
+            self._bar.update(m.clock.iteration - self._bar.n)
+            self._bar.set_postfix_str(f"day {m.clock.time_s / 86400.0:.2f}, remeshes "
+                                      f"{m.state.counters.get('remesh_count', 0)}, volume drift "
+                                      f"{b['relative_residual']:+.1e}", refresh=False)
+            return
         wall = time.perf_counter() - self._t0
         done = m.clock.time_s - self._sim0
         rate = done / 86400.0 / wall * 3600.0 if wall > 0 else float("nan")
         frac = m.clock.time_s / sim.stop_time if sim.stop_time else float("nan")
         left = sim.stop_time - m.clock.time_s if sim.stop_time else float("nan")
         eta = left / done * wall if done > 0 else float("nan")
-        b = m.volume_budget()
         eta_s = _fmt_wall(eta) if math.isfinite(eta) else "?"
         print(f"  day {m.clock.time_s / 86400.0:7.3f}  {100 * frac:5.1f} %  step {m.clock.iteration}/{sim.n_steps}  "
               f"{rate:8.1f} sim-days/wall-hour  ETA {eta_s}  remeshes {m.state.counters.get('remesh_count', 0)}  "
               f"volume {b['current_m3']:.4e} m3 (thermo {b['thermodynamic_m3']:+.2e}, outflow "
               f"{b['outflow_m3']:.2e}, drift {b['relative_residual']:+.1e})",
               file=self.stream or sys.stdout, flush=True)
+
+    def teardown(self, sim):
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
 
 
 def _fmt_wall(s: float) -> str:
@@ -257,6 +327,43 @@ class StopCondition(Activity):
     def __call__(self, sim):
         if self.condition(sim):
             sim.request_stop(self.reason)
+
+
+class SignalStop(StopCondition):
+    """Stops the run cleanly on SIGTERM or SIGINT (batch-queue pre-emption, Ctrl-C):
+    the signal only sets a flag; after the current step the simulation writes a
+    checkpoint and its end-of-run outputs, and returns with ``stop_reason`` naming the
+    signal. A second signal of the same kind acts as usual (Ctrl-C twice interrupts
+    at once). Handlers are installed only in the main thread, for the run's duration."""
+
+    name = "signal_stop"
+    SIGNALS = ("SIGTERM", "SIGINT")
+
+    def __init__(self):
+        super().__init__(lambda sim: self.received is not None, "signal received")
+        self.received = None
+        self._old = {}
+
+    def _handler(self, signum, frame):
+        self.received = signal.Signals(signum).name
+        self.reason = f"{self.received} received"
+        old = self._old.pop(signum, None)  # the next one acts as usual
+        if old is not None:
+            signal.signal(signum, old)
+
+    def initialize(self, sim):
+        super().initialize(sim)
+        self.received = None
+        if threading.current_thread() is not threading.main_thread():
+            return
+        for name in self.SIGNALS:
+            num = getattr(signal, name)
+            self._old[num] = signal.signal(num, self._handler)
+
+    def teardown(self, sim):
+        for num, old in self._old.items():
+            signal.signal(num, old)
+        self._old = {}
 
 
 class WallTimeLimit(StopCondition):

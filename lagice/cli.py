@@ -1,57 +1,170 @@
 """Command line.
 
-    lagice run SCENE [--out DIR] [--set key=value ...]   run a bundled scene or a TOML file
-    lagice resume CHECKPOINT                              continue a run (file or directory)
+    lagice [--version] [--log-level LEVEL] COMMAND ...
+    lagice run SCENE [--out DIR] [--overwrite | --resume] [--set key=value ...]
+                                                          run a bundled scene or a TOML file
+    lagice resume RUN_DIR|CHECKPOINT [--set key=value ...]
+                                                          continue (or extend: --set run.duration=60d) a run
+    lagice branch CHECKPOINT [--out DIR] [--set key=value ...]
+                                                          a new run from a checkpoint, changed physics allowed
     lagice plot RUN_DIR                                   redraw the run's own figure
     lagice info FILE                                      describe a netCDF output or checkpoint
     lagice diagnose OUTPUT [--window-steps K] [--coast-buffer-km B]
                                                           deformation statistics (JSON + PNG)
     lagice scenes                                         list bundled scenes
+
+A new run writes to ``runs/SCENE-YYYYmmdd-HHMMSS/`` (linked as ``runs/SCENE-latest``)
+unless ``--out`` names a folder, which must be empty (``--overwrite`` replaces a
+previous run in it, ``--resume`` continues it). SIGTERM/SIGINT stop a run cleanly
+with a checkpoint (exit 0). Errors in the input, the files or the file system print
+one line and exit with status 2 (``--log-level debug`` shows the traceback).
 """
 from __future__ import annotations
 
 import argparse
 import json
+import logging
 import sys
 from pathlib import Path
 
 from .errors import LagiceError
 
+log = logging.getLogger("lagice")
+
+
+class _StdoutBelowWarning(logging.Handler):
+    """INFO and DEBUG lines to stdout, warnings and errors to stderr, as ``lagice: ...``."""
+
+    def emit(self, record):
+        try:
+            msg = self.format(record)
+            if record.levelno >= logging.WARNING:
+                print(f"lagice: {record.levelname.lower()}: {msg}", file=sys.stderr, flush=True)
+            else:
+                print(f"lagice: {msg}", file=sys.stdout, flush=True)
+        except Exception:  # noqa: BLE001 - logging must never raise
+            self.handleError(record)
+
+
+def setup_logging(level: str = "info") -> None:
+    """The ``lagice`` logger at ``level`` (debug, info, warning, error)."""
+    lvl = getattr(logging, str(level).upper(), None)
+    if not isinstance(lvl, int):
+        raise LagiceError(f"--log-level {level!r}: expected debug, info, warning or error")
+    for h in list(log.handlers):
+        if isinstance(h, _StdoutBelowWarning):
+            log.removeHandler(h)
+    log.addHandler(_StdoutBelowWarning())
+    log.setLevel(lvl)
+    log.propagate = False
+
+
+_COMPILE_NOTICE = []
+
+
+def _announce_numba_compilation() -> None:
+    """One line when numba starts compiling a kernel (a first run on this machine, or
+    after an upgrade); kernels load from numba's cache afterwards (no such line)."""
+    try:
+        from numba.core import event
+    except ImportError:  # pragma: no cover
+        return
+
+    class _Listener(event.Listener):
+        def on_start(self, ev):
+            if not _COMPILE_NOTICE:
+                _COMPILE_NOTICE.append(1)
+                log.info("numba is compiling the kernels this run needs (first run only: they are cached "
+                         "for later runs; this can take a minute)")
+
+        def on_end(self, ev):
+            pass
+
+    event.register("numba:compile", _Listener())
+
+
+def _where(out: Path) -> str:
+    return str(out) if out.is_absolute() else f"{out} ({out.resolve()})"
+
 
 def _run(args) -> int:
+    from .rundir import claim
     from .scenes import DEFAULT_SCENE
-    from .scenes.builder import build_simulation, finish
+    from .scenes.builder import build_simulation, resume_simulation, validate_config
     from .scenes.config import load_scene
 
     name = args.scene or DEFAULT_SCENE
     cfg = load_scene(name, args.set)
-    out = Path(args.out or Path("runs") / cfg["scene"]["name"])
-    print(f"lagice: running scene {cfg['scene']['name']!r} ({cfg['scene']['source']}) -> {out}/", flush=True)
+    validate_config(cfg)  # every check that needs no mesh and no folder
+    out = Path(args.out) if args.out else None
+    if args.resume and out is None:
+        raise LagiceError("--resume needs --out DIR (the run folder to continue)")
+    if out is not None and args.resume and (out / "checkpoints").is_dir() and any(
+            (out / "checkpoints").glob("checkpoint_*.npz")):
+        return _continue(resume_simulation(out, config=cfg), out, resumed=True)
+    if out is not None:
+        claim(out, overwrite=args.overwrite)
     sim = build_simulation(cfg, out)
-    _report(finish(sim))
+    log.info(f"running scene {cfg['scene']['name']!r} ({cfg['scene']['source']}) -> {_where(sim.out_dir)}/")
+    if out is None:
+        log.info(f"(also reachable as {sim.out_dir.parent / (cfg['scene']['name'] + '-latest')}/)")
+    return _continue(sim, sim.out_dir)
+
+
+def _continue(sim, run_dir: Path, resumed: bool = False) -> int:
+    """Run ``sim`` to its end (or a stop) and report; a finished run is left untouched."""
+    from .scenes.builder import finish
+
+    clock = sim.model.clock
+    if resumed or sim.resumed_from is not None:
+        if sim.finished:
+            log.info(f"the run in {run_dir}/ already finished at step {clock.iteration} (day "
+                     f"{clock.time_s / 86400:.3f}); nothing to do. Extend it with: lagice resume {run_dir} "
+                     f"--set run.duration=...")
+            return 0
+        log.info(f"resuming {sim.model.config.get('scene', {}).get('name', '?')!r} from {sim.resumed_from} "
+                 f"(step {clock.iteration}, day {clock.time_s / 86400:.3f}) -> {run_dir}/")
+    res = finish(sim)
+    _report(res, sim)
     return 0
 
 
-def _report(res):
-    print(f"lagice: done in {res['wall_s']:.1f} s wall")
+def _report(res, sim):
+    s = res["summary"]
+    out = Path(res["out_dir"])
+    if s.get("stop_reason"):
+        ck = s.get("checkpoint")
+        print(f"lagice: stopped at step {s['steps']} (day {s['time_s'] / 86400:.3f}): {s['stop_reason']}; "
+              f"checkpoint {ck if ck else '(none: this simulation has no checkpointer)'}")
+        if ck:
+            print(f"  resume with: lagice resume {out}")
+        return
+    print(f"lagice: done in {res['wall_s']:.1f} s wall (whole run)")
+    print(f"  outputs: {out.resolve()}/")
     print(f"  output: {Path(res['netcdf']).resolve()}")
     if res.get("png"):
         print(f"  plot:   {Path(res['png']).resolve()}")
 
 
 def _resume(args) -> int:
-    from .scenes.builder import finish
-    from .simulation import Simulation
+    from .scenes.builder import resume_simulation
+    from .simulation import load_checkpoint, run_folder_of
 
-    ck = Path(args.checkpoint)
-    ck_dir = ck if ck.is_dir() else ck.parent
-    run_dir = ck_dir.parent if ck_dir.name == "checkpoints" else ck_dir
-    sim = Simulation.resume(ck, out_dir=run_dir)
-    clock = sim.model.clock
-    print(f"lagice: resuming {sim.model.config.get('scene', {}).get('name', '?')!r} from "
-          f"{sim.resumed_from} (step {clock.iteration}, day {clock.time_s / 86400:.3f}) -> {run_dir}/", flush=True)
-    _report(finish(sim))
-    return 0
+    path = load_checkpoint(args.checkpoint)[0]
+    run_dir = run_folder_of(path)
+    sim = resume_simulation(path, args.set)
+    return _continue(sim, run_dir, resumed=True)
+
+
+def _branch(args) -> int:
+    from .scenes.builder import branch_simulation
+
+    sim = branch_simulation(args.checkpoint, args.out, args.set, overwrite=args.overwrite)
+    p = sim.branched_from
+    log.info(f"branching {sim.model.config['scene']['name']!r} from {p['checkpoint']} (step "
+             f"{sim.model.clock.iteration}, day {sim.model.clock.time_s / 86400:.3f}, sha256 {p['sha256'][:12]}...) "
+             f"-> {_where(sim.out_dir)}/")
+    return _continue(sim, sim.out_dir)
 
 
 def _plot(args) -> int:
@@ -90,18 +203,31 @@ def _info(args) -> int:
     p = Path(args.file)
     if not p.exists():
         raise LagiceError(f"file {p} does not exist")
-    if p.suffix == ".npz":
+    if p.is_dir():
+        raise LagiceError(f"{p} is a folder; give a netCDF output (.nc) or a checkpoint (.npz)")
+    with open(p, "rb") as f:
+        head = f.read(8)
+    if p.suffix == ".npz" or head[:4] == b"PK\x03\x04":
         from .io.checkpoint import read_checkpoint
         arrays, meta = read_checkpoint(p)
         print(f"checkpoint {p}: step {meta['step']}, t = {meta['clock']['time_s']:.1f} s, "
               f"format {meta.get('format_version')}, lagice {meta.get('lagice_version')}, "
               f"scene {meta.get('config', {}).get('scene', {}).get('name')}, "
               f"fingerprint {meta.get('scene_fingerprint')}")
+        parent = meta.get("config", {}).get("_parent")
+        if parent:
+            print(f"  branched from {parent['checkpoint']} (sha256 {parent['sha256']})")
         for k, a in arrays.items():
             print(f"  {k}: {a.dtype} {a.shape}")
         return 0
+    if head[:3] != b"CDF" and head[:8] != b"\x89HDF\r\n\x1a\n":
+        raise LagiceError(f"{p} is neither a netCDF file nor a lagice checkpoint (it starts with {head[:8]!r})")
     import xarray as xr
-    with xr.open_dataset(p) as ds:
+    try:
+        ds = xr.open_dataset(p, decode_times=False)
+    except Exception as exc:  # noqa: BLE001 - any reader failure is a bad file
+        raise LagiceError(f"{p}: cannot read it as netCDF ({type(exc).__name__}: {exc})") from None
+    with ds:
         print(ds)
     return 0
 
@@ -155,39 +281,77 @@ def _scenes(args) -> int:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="lagice", description="Lagrangian Maxwell-EB sea-ice model")
+    from . import __version__
+
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--log-level", default=argparse.SUPPRESS, metavar="LEVEL",
+                        help="debug, info (default), warning or error; debug also prints tracebacks")
+    ap = argparse.ArgumentParser(prog="lagice", description="Lagrangian Maxwell-EB sea-ice model", parents=[common])
+    ap.add_argument("--version", action="version", version=f"lagice {__version__}")
     sub = ap.add_subparsers(dest="cmd", required=True)
-    r = sub.add_parser("run", help="run a scene (bundled name or TOML file)")
+    sets = {"action": "append", "metavar": "KEY=VALUE",
+            "help": "override a scene key: table.key=value (e.g. run.duration=2d)"}
+    r = sub.add_parser("run", help="run a scene (bundled name or TOML file)", parents=[common])
     r.add_argument("scene", nargs="?", help="scene name or path.toml (default: uniaxial_compression)")
-    r.add_argument("--out", help="output directory (default runs/SCENE)")
-    r.add_argument("--set", action="append", metavar="KEY=VALUE",
-                   help="override a scene key: table.key=value (e.g. run.duration=2d)")
+    r.add_argument("--out", help="output folder, empty or new (default: a new runs/SCENE-YYYYmmdd-HHMMSS, "
+                                 "linked as runs/SCENE-latest)")
+    how = r.add_mutually_exclusive_group()
+    how.add_argument("--overwrite", action="store_true", help="replace the previous run in --out (deleted first)")
+    how.add_argument("--resume", action="store_true",
+                     help="continue the run in --out from its newest checkpoint (start it if there is none)")
+    r.add_argument("--set", **sets)
     r.set_defaults(func=_run)
-    s = sub.add_parser("resume", help="resume from a checkpoint file or directory")
+    s = sub.add_parser("resume", parents=[common],
+                       help="continue a run from its folder, checkpoint folder or a checkpoint file; "
+                            "--set run.duration=... extends it, output.*/checkpoint.* may change")
     s.add_argument("checkpoint")
+    s.add_argument("--set", **sets)
     s.set_defaults(func=_resume)
-    p = sub.add_parser("plot", help="redraw the figure of a run directory (or its snapshot folder)")
+    b = sub.add_parser("branch", parents=[common],
+                       help="start a new run from a checkpoint with changed settings (forcing, parameters)")
+    b.add_argument("checkpoint")
+    b.add_argument("--out", help="output folder of the new run (default: a new runs/SCENE-YYYYmmdd-HHMMSS)")
+    b.add_argument("--overwrite", action="store_true", help="replace the previous run in --out")
+    b.add_argument("--set", **sets)
+    b.set_defaults(func=_branch)
+    p = sub.add_parser("plot", help="redraw the figure of a run directory (or its snapshot folder)", parents=[common])
     p.add_argument("output")
     p.add_argument("--png")
     p.set_defaults(func=_plot)
-    i = sub.add_parser("info", help="describe an output file or checkpoint")
+    i = sub.add_parser("info", help="describe an output file or checkpoint", parents=[common])
     i.add_argument("file")
     i.set_defaults(func=_info)
-    d = sub.add_parser("diagnose", help="deformation statistics of a run (JSON + PNG)")
+    d = sub.add_parser("diagnose", help="deformation statistics of a run (JSON + PNG)", parents=[common])
     d.add_argument("output")
     d.add_argument("--window-steps", type=int, default=1, help="snapshots spanned by the window")
     d.add_argument("--coast-buffer-km", type=float, default=0.0,
                    help="analyse only elements this far from the mesh boundary (seed 000: 150 km)")
     d.add_argument("--out")
     d.set_defaults(func=_diagnose)
-    sc = sub.add_parser("scenes", help="list bundled scenes")
+    sc = sub.add_parser("scenes", help="list bundled scenes", parents=[common])
     sc.set_defaults(func=_scenes)
     args = ap.parse_args(argv)
+    level = getattr(args, "log_level", "info")
     try:
+        setup_logging(level)
+        if args.cmd in ("run", "resume", "branch"):
+            _announce_numba_compilation()
         return args.func(args)
-    except LagiceError as exc:
-        print(f"lagice: error: {exc}", file=sys.stderr)
+    except (LagiceError, OSError) as exc:
+        if isinstance(exc, OSError) and not isinstance(exc, LagiceError):
+            where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+            msg = f"{where}{exc.strerror or exc}"
+        else:
+            msg = str(exc)
+        if log.isEnabledFor(logging.DEBUG):
+            import traceback
+
+            traceback.print_exc()
+        print(f"lagice: error: {msg}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("lagice: interrupted (a second Ctrl-C: no checkpoint was written)", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

@@ -26,6 +26,10 @@ class RestartError(LagiceError):
     """A checkpoint is unreadable, truncated, corrupted or incompatible."""
 
 
+class OutputError(LagiceError):
+    """An output or checkpoint file could not be written (disk full, read-only folder)."""
+
+
 class SolverError(LagiceError):
     """A time step could not be completed (divergence, NaN, inverted element)."""
 

@@ -192,24 +192,49 @@ class Coriolis:
 
     Args:
         f: Coriolis parameter [s-1] (constant), or
-        latitude_deg: f = 2Ω sin(latitude) (exactly one of the two).
+        latitude_deg: f = 2Ω sin(latitude) (constant), or
+        crs: the model plane's CRS (pyproj string): f = 2Ω sin(φ) with φ the latitude
+            of each node where it is now (exactly one of the three).
     """
 
-    def __init__(self, f: float | None = None, latitude_deg: float | None = None):
-        if (f is None) == (latitude_deg is None):
-            raise ConfigError("Coriolis: give exactly one of f [s-1] or latitude_deg [deg]")
+    def __init__(self, f: float | None = None, latitude_deg: float | None = None, crs=None):
+        if sum(v is not None for v in (f, latitude_deg, crs)) != 1:
+            raise ConfigError("Coriolis: give exactly one of f [s-1], latitude_deg [deg] or crs (per-node latitude)")
+        self.crs = crs
+        self._cache = None
+        if crs is not None:
+            from .crs import model_crs
+
+            model_crs(crs, "Coriolis crs")
+            self.f = None
+            return
         if latitude_deg is not None:
             check_range("latitude_deg", latitude_deg, -90.0, 90.0, unit="deg")
             f = coriolis_from_latitude(latitude_deg)
         self.f = check_range("Coriolis f", f, -2e-4, 2e-4, unit="s-1")
 
+    def f_at(self, nodes: np.ndarray):
+        """f [s-1] at ``nodes`` (n, 2) [m]: the constant, or 2Ω sin φ per node (cached
+        while the nodes do not move)."""
+        if self.crs is None:
+            return self.f
+        c = self._cache
+        if c is not None and c[0].shape == nodes.shape and np.array_equal(c[0], nodes):
+            return c[1]
+        from .crs import latitudes
+        from .params import OMEGA_EARTH
+
+        f = 2.0 * OMEGA_EARTH * np.sin(np.deg2rad(latitudes(self.crs, nodes[:, 0], nodes[:, 1])))
+        self._cache = (nodes.copy(), f)
+        return f
+
     def linearise(self, t, nodes, vel, mass_per_area):
         mpa = np.broadcast_to(np.asarray(mass_per_area, np.float64), (len(nodes),))
-        A = (mpa * self.f)[:, None, None] * ROT90[None, :, :]
+        A = (mpa * self.f_at(nodes))[:, None, None] * ROT90[None, :, :]
         return A, np.zeros((len(nodes), 2))
 
     def add_explicit_terms(self, t, nodes, terms: ExplicitTerms) -> None:
-        terms.coriolis += self.f
+        terms.coriolis += self.f_at(nodes)
 
 
 def standard_forces(wind=None, current=None, drag: DragParams | None = None,

@@ -223,8 +223,12 @@ class Model:
                 "components": {c.name: c.checkpoint_state()[1] for c in self.components},
                 "timings": self.timings}
 
-    def load_state(self, arrays: dict, meta: dict) -> None:
-        """Replace the state with checkpointed arrays (exact, bit for bit)."""
+    def load_state(self, arrays: dict, meta: dict, fresh_components: bool = False) -> list[str]:
+        """Replace the state with checkpointed arrays (exact, bit for bit).
+
+        A component of this model that the checkpoint does not hold is an error, or,
+        with ``fresh_components`` (a branch that switches a component on), keeps its
+        freshly built state; returns the names of such components."""
         mesh = Mesh(arrays["mesh_nodes"].copy(), arrays["mesh_triangles"].copy(),
                     arrays["mesh_boundary_edges"].copy(), arrays["mesh_boundary_tags"].copy(),
                     tuple(meta["tag_names"]))
@@ -239,9 +243,19 @@ class Model:
         self.timings = {**dict.fromkeys(TIMING_KEYS, 0.0), **meta.get("timings", {})}
         self.stepper.reset_topology(mesh)
         comp_meta = meta.get("components", {})
+        fresh = []
         for c in self.components:
             pre = f"component.{c.name}."
-            c.restore({k[len(pre):]: v for k, v in arrays.items() if k.startswith(pre)}, comp_meta.get(c.name, {}))
+            held = {k[len(pre):]: v for k, v in arrays.items() if k.startswith(pre)}
+            if c.name not in comp_meta and not held:
+                if not fresh_components:
+                    from .errors import RestartError
+
+                    raise RestartError(f"the checkpoint holds no state of component {c.name!r}, which this model has")
+                fresh.append(c.name)
+                continue
+            c.restore(held, comp_meta.get(c.name, {}))
+        return fresh
 
 
 def _rng_state_json(rng) -> dict:

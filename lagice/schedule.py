@@ -10,7 +10,10 @@ called with the model):
   interval (``"6h"``, ``3600``);
 * :class:`IterationInterval` — every N outer steps (``"10 steps"``);
 * :class:`WallTimeInterval` — every so much wall-clock time (``"wall 55min"``),
-  for batch queues.
+  for batch queues;
+* :class:`AnyOf` — due when any of several schedules is (``checkpoint.every`` and
+  ``checkpoint.every_wall`` together); :class:`Never` — never due (an activity that
+  only runs at the end of a run or when it is stopped).
 
 :func:`parse_schedule` turns those strings into schedules.
 """
@@ -128,11 +131,42 @@ class WallTimeInterval(Schedule):
         return f"WallTimeInterval({self.interval:g} s)"
 
 
+class Never(Schedule):
+    """Never due (the activity runs only at the start, the end or a requested stop)."""
+
+    def __call__(self, model) -> bool:
+        return False
+
+    def __repr__(self):
+        return "Never()"
+
+
+class AnyOf(Schedule):
+    """Due when any of ``schedules`` is due (each is called every step, so each
+    keeps its own state)."""
+
+    def __init__(self, *schedules):
+        self.schedules = [s for s in schedules if s is not None]
+
+    def initialize(self, model) -> None:
+        for s in self.schedules:
+            s.initialize(model)
+
+    def __call__(self, model) -> bool:
+        due = [s(model) for s in self.schedules]
+        return any(due)
+
+    def __repr__(self):
+        return f"AnyOf({', '.join(map(repr, self.schedules))})"
+
+
 def parse_schedule(value, name: str = "every") -> Schedule:
     """A schedule from a :class:`Schedule`, a duration (``"6h"``, seconds: simulated
     time), ``"N steps"`` (iterations) or ``"wall 55min"`` / ``"55min wall"`` (wall time)."""
     if isinstance(value, Schedule):
         return value
+    if value is None:
+        return Never()
     if isinstance(value, str):
         m = _STEPS.match(value)
         if m:

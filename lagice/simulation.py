@@ -27,9 +27,11 @@ from .activities import (
     Activity,
     Callback,
     Checkpointer,
+    DrifterOutput,
     GridOutput,
     NaNChecker,
     Progress,
+    SignalStop,
     SnapshotOutput,
     TimeSeriesOutput,
     VTUOutput,
@@ -51,10 +53,13 @@ class Simulation:
             ``model.config`` (stored in checkpoints for :meth:`resume`).
         nan_check: stop with a clear error at the first NaN/Inf in the state, or at an
             ice speed above ``max_speed_m_s`` [m s-1] (:class:`~lagice.activities.NaNChecker`).
+        handle_signals: stop cleanly on SIGTERM/SIGINT (:class:`~lagice.activities.SignalStop`):
+            checkpoint (if there is a checkpointer), end-of-run outputs, ``stop_reason``.
     """
 
     def __init__(self, model, dt, stop, progress: bool = True, builder: str | None = None,
-                 progress_every_s: float = 10.0, nan_check: bool = True, max_speed_m_s: float = 10.0):
+                 progress_every_s: float = 10.0, nan_check: bool = True, max_speed_m_s: float = 10.0,
+                 handle_signals: bool = True):
         self.model = model
         self.dt = parse_duration(dt, "dt")
         self.stop_time = parse_duration(stop, "stop")
@@ -67,6 +72,8 @@ class Simulation:
         self.activities: dict[str, Activity] = {}
         if nan_check:
             self.add(NaNChecker(max_speed_m_s=max_speed_m_s))
+        if handle_signals:
+            self.add(SignalStop())
         if progress:
             self.add(Progress(f"wall {progress_every_s}s"))
         self.wall_total = 0.0
@@ -74,6 +81,7 @@ class Simulation:
         self.stop_reason = None
         self._stop_requested = None
         self.resumed_from = None
+        self.branched_from = None
         self.out_dir = None
 
     @property
@@ -91,15 +99,17 @@ class Simulation:
             self.activities["progress"] = self.activities.pop("progress")
         return self
 
-    def output(self, every, path, crs_epsg: int | None = 3413, vtu: bool = False,
+    def output(self, every, path, crs="EPSG:3413", vtu: bool = False,
                start_date: str = "2000-01-01 00:00:00", grid_resolution_m: float | None = None,
-               title: str = "lagice snapshot"):
-        """Snapshots every ``every`` into ``path`` (plus VTU files and regular-grid
-        averages when asked, on the same schedule)."""
+               title: str = "lagice snapshot", drifters_path=None):
+        """Snapshots every ``every`` into ``path`` (plus VTU files, regular-grid
+        averages and the drifter trajectory file ``drifters_path`` when asked, on the
+        same schedule). ``crs``: the model plane's CRS (any pyproj input; None: no
+        grid mapping), written as the CF grid mapping of every file."""
         from .io.snapshots import SnapshotWriter
 
         path = Path(path)
-        self.add(SnapshotOutput(every, SnapshotWriter(path, crs_epsg, start_date, title)))
+        self.add(SnapshotOutput(every, SnapshotWriter(path, crs, start_date, title)))
         if vtu:
             from .io.vtu import VTUWriter
 
@@ -107,7 +117,11 @@ class Simulation:
         if grid_resolution_m:
             from .io.gridded import GridWriter
 
-            self.add(GridOutput(every, GridWriter(path, grid_resolution_m, crs_epsg, start_date)))
+            self.add(GridOutput(every, GridWriter(path, grid_resolution_m, crs, start_date)))
+        if drifters_path is not None:
+            from .io.drifters import DrifterWriter
+
+            self.add(DrifterOutput(every, DrifterWriter(drifters_path, crs, start_date)))
         return self
 
     def add_timeseries(self, path, diagnostics, every, start_date: str = "2000-01-01 00:00:00"):
@@ -157,29 +171,33 @@ class Simulation:
         self.stop_reason = None
         self._t_run = time.perf_counter()
         acts = list(self.activities.values())
-        for act in acts:
-            act.initialize(self)
-        while model.clock.iteration < target:
-            model.step(self.dt)
+        try:
             for act in acts:
-                if act.schedule(model):
-                    act.run(self)
-            if model.last_report.get("non_finite"):
-                NaNChecker(1)(self)  # a run without a NaN checker still stops, with the same message
+                act.initialize(self)
+            while model.clock.iteration < target:
+                model.step(self.dt)
+                for act in acts:
+                    if act.schedule(model):
+                        act.run(self)
+                if model.last_report.get("non_finite"):
+                    NaNChecker(1)(self)  # a run without a NaN checker still stops, with the same message
+                if self._stop_requested:
+                    break
             if self._stop_requested:
-                break
-        if self._stop_requested:
-            self.stop_reason = self._stop_requested
-            if self.checkpointer is not None and self.checkpointer.last_iteration != model.clock.iteration:
-                self.checkpointer.run(self)
-        for act in acts:
-            if act.at_end and (model.clock.iteration == self.n_steps or self._stop_requested):
-                act.finalize(self)
-            elif isinstance(act, TimeSeriesOutput):
-                act.writer.flush()
-        model.needs_host_state()  # the caller reads model.state next
-        self.wall_total = self.wall_s
-        self._t_run = None
+                self.stop_reason = self._stop_requested
+                if self.checkpointer is not None and self.checkpointer.last_iteration != model.clock.iteration:
+                    self.checkpointer.run(self)
+            for act in acts:
+                if act.at_end and (model.clock.iteration == self.n_steps or self._stop_requested):
+                    act.finalize(self)
+                elif isinstance(act, TimeSeriesOutput):
+                    act.writer.flush()
+            model.needs_host_state()  # the caller reads model.state next
+        finally:
+            for act in acts:
+                act.teardown(self)
+            self.wall_total = self.wall_s
+            self._t_run = None
         return self.summary()
 
     @property
@@ -192,12 +210,19 @@ class Simulation:
         return self.model.clock.iteration >= self.n_steps
 
     def summary(self) -> dict:
+        """Simulated time and steps, wall time (all sessions of the run, resumed parts
+        included, like the component ``timings``), remesh count, ice volume budget,
+        why the run stopped early (None: it reached its end) and the last checkpoint."""
         m = self.model
         st = m.state
-        return {"time_s": m.clock.time_s, "steps": m.clock.iteration, "wall_s": self.wall_s,
+        ck = self.checkpointer
+        return {"time_s": m.clock.time_s, "steps": m.clock.iteration, "stop_time_s": self.stop_time,
+                "finished": self.finished, "wall_s": self.wall_s,
                 "timings": dict(m.timings), "remesh_count": st.counters.get("remesh_count", 0),
                 "ice_volume_m3": st.ice_volume_m3, "volume_budget": m.volume_budget(),
-                "stop_reason": self.stop_reason}
+                "stop_reason": self.stop_reason,
+                "checkpoint": str(ck.last_path) if ck is not None and ck.last_path is not None else None,
+                "branched_from": self.branched_from}
 
     # -- checkpoint / resume ---------------------------------------------------------
     def _meta(self) -> dict:
@@ -217,39 +242,62 @@ class Simulation:
                                 keep=c.keep)
 
     @classmethod
-    def resume(cls, checkpoint, model=None, builder=None, **builder_kw) -> Simulation:
+    def resume(cls, checkpoint, model=None, builder=None, config: dict | None = None, **builder_kw) -> Simulation:
         """Resume from a checkpoint file or a checkpoint directory (newest usable one).
 
         The model is rebuilt with the checkpoint's ``builder`` and ``config``
-        (or pass ``model=`` / ``builder=``); its fingerprint (the physics) must match.
+        (or pass ``model=`` / ``builder=``; ``config=`` replaces the stored
+        configuration, e.g. with a longer ``run.duration`` or other output
+        schedules); its fingerprint (the physics) must match the checkpoint's.
         Outputs go to the run folder of the checkpoint (the parent of its
         ``checkpoints`` folder) unless ``out_dir=`` is given.
         Checkpoints are read by their format version (:data:`lagice.io.checkpoint.FORMAT_VERSION`).
         """
-        path = Path(checkpoint)
-        if path.is_dir():
-            path, arrays, meta, skipped = latest_valid_checkpoint(path)
-            for s in skipped:
-                print(f"lagice: skipped damaged checkpoint: {s}", file=sys.stderr)
-        else:
-            arrays, meta = read_checkpoint(path)
+        path, arrays, meta = load_checkpoint(checkpoint)
         if model is None:
             spec = builder or meta.get("builder")
             if not spec:
                 raise RestartError(f"checkpoint {path} names no builder; pass model= to resume it")
             if "out_dir" not in builder_kw:  # the run folder the checkpoint lives in
-                ck_dir = path.parent
-                builder_kw["out_dir"] = ck_dir.parent if ck_dir.name == "checkpoints" else ck_dir
-            sim = _call_builder(spec, meta["config"], **builder_kw)
+                builder_kw["out_dir"] = run_folder_of(path)
+            sim = _call_builder(spec, meta["config"] if config is None else config, **builder_kw)
         else:
             sim = cls(model, dt=meta["simulation"]["dt_s"], stop=meta["simulation"]["stop_s"])
         if sim.model.fingerprint() != meta.get("scene_fingerprint"):
             raise RestartError(f"checkpoint {path} belongs to another scene or configuration "
                                f"(fingerprint {meta.get('scene_fingerprint')}, model {sim.model.fingerprint()})")
         sim.model.load_state(arrays, meta)
+        if sim.model.clock.time_s > sim.stop_time * (1 + 1e-12):
+            raise RestartError(f"checkpoint {path} is at t = {sim.model.clock.time_s:g} s, after the end of the run "
+                               f"({sim.stop_time:g} s): give a run.duration of at least "
+                               f"{sim.model.clock.time_s:g} s")
+        if abs(meta.get("simulation", {}).get("dt_s", sim.dt) - sim.dt) > 1e-12 * sim.dt:
+            raise RestartError(f"checkpoint {path} was written with dt = {meta['simulation']['dt_s']:g} s; this "
+                               f"simulation has dt = {sim.dt:g} s (the step count would not match)")
         sim.wall_total = float(meta.get("simulation", {}).get("wall_s", 0.0))
         sim.resumed_from = path
         return sim
+
+
+def load_checkpoint(checkpoint):
+    """``(path, arrays, meta)`` of a checkpoint file, or of the newest usable one in a
+    checkpoint or run folder (damaged newer ones are reported and skipped)."""
+    path = Path(checkpoint)
+    if path.is_dir() and (path / "checkpoints").is_dir() and not list(path.glob("checkpoint_*.npz")):
+        path = path / "checkpoints"  # a run folder
+    if path.is_dir():
+        path, arrays, meta, skipped = latest_valid_checkpoint(path)
+        for s in skipped:
+            print(f"lagice: skipped damaged checkpoint: {s}", file=sys.stderr)
+    else:
+        arrays, meta = read_checkpoint(path)
+    return path, arrays, meta
+
+
+def run_folder_of(checkpoint_path) -> Path:
+    """The run folder a checkpoint file belongs to (the parent of its ``checkpoints`` folder)."""
+    ck_dir = Path(checkpoint_path).parent
+    return ck_dir.parent if ck_dir.name == "checkpoints" else ck_dir
 
 
 def _call_builder(spec: str, config: dict, **kw):
@@ -261,4 +309,4 @@ def _call_builder(spec: str, config: dict, **kw):
     return fn(config, **kw)
 
 
-__all__ = ["Simulation", "FORMAT_VERSION"]
+__all__ = ["Simulation", "FORMAT_VERSION", "load_checkpoint", "run_folder_of"]

@@ -70,7 +70,7 @@ def test_nodes_drifters_snapshots_move_with_the_transport_velocity(stepper, kind
     d0 = model.drifters.positions.copy()
     dt, n = 600.0, 6
     sim = Simulation(model, dt=dt, stop=n * dt, progress=False)
-    sim.output(every="1 steps", path=tmp_path, crs_epsg=None)
+    sim.output(every="1 steps", path=tmp_path, crs=None)
     rec = Recorder()
     sim.add_callback(rec, every="1 steps")
     sim.run()

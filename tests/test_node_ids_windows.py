@@ -46,7 +46,7 @@ def test_window_across_a_remesh_follows_nodes(tmp_path):
     the remeshed elements are left out and counted."""
     st = _state()
     model = Model(st)
-    w = SnapshotWriter(tmp_path / "snaps", crs_epsg=None)
+    w = SnapshotWriter(tmp_path / "snaps", crs=None)
     w.write(model)
     ev = remesh_if_needed(st, 5e3, flagged=[st.mesh.n_elements // 2])
     st.counters["mesh_epoch"] = 1
@@ -70,7 +70,7 @@ def test_window_without_ids_across_remesh_is_refused(tmp_path):
     st = _state()
     st.node_id = None
     model = Model(st)
-    w = SnapshotWriter(tmp_path, crs_epsg=None)
+    w = SnapshotWriter(tmp_path, crs=None)
     w.write(model)
     remesh_if_needed(st, 5e3, flagged=[3])
     st.node_id = None

@@ -15,19 +15,14 @@ CONVENTIONS_UGRID = "CF-1.8 UGRID-1.0"
 CONVENTIONS = "CF-1.8"
 
 
-def crs_variable(crs_epsg: int | None):
-    """A scalar ``crs`` grid-mapping variable with CF attributes and WKT, or None."""
-    if crs_epsg is None:
+def crs_variable(crs):
+    """A scalar ``crs`` grid-mapping variable with CF attributes and WKT for ``crs``
+    (any pyproj input: ``"EPSG:3413"``, an EPSG number, a PROJ string), or None."""
+    if crs is None:
         return None
-    import pyproj
+    from ..crs import cf_grid_mapping
 
-    crs = pyproj.CRS.from_epsg(int(crs_epsg))
-    attrs = crs.to_cf()
-    attrs["crs_wkt"] = crs.to_wkt()
-    if attrs.get("grid_mapping_name") == "polar_stereographic" and "latitude_of_projection_origin" not in attrs:
-        # CF requires it; pyproj omits it for the variant-B (standard parallel) definition
-        attrs["latitude_of_projection_origin"] = 90.0 if attrs.get("standard_parallel", 90.0) > 0 else -90.0
-    return xr.DataArray(np.int32(0), attrs=attrs)
+    return xr.DataArray(np.int32(0), attrs=cf_grid_mapping(crs))
 
 
 _COMMIT = None
@@ -54,7 +49,9 @@ def git_commit() -> str | None:
 
 def provenance(title: str, config: dict | None = None, extra: dict | None = None) -> dict:
     """Global attributes: Conventions, title, history, source (lagice version and
-    commit), the scene configuration as JSON, plus ``extra``."""
+    commit), the scene configuration as JSON, the parent checkpoint of a branched run
+    (``lagice_parent_checkpoint``, ``lagice_parent_checkpoint_sha256``, from
+    ``config["_parent"]``), plus ``extra``."""
     from .. import __version__
 
     now = datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
@@ -67,6 +64,12 @@ def provenance(title: str, config: dict | None = None, extra: dict | None = None
     if config:
         attrs["lagice_config"] = json.dumps({k: v for k, v in config.items() if not str(k).startswith("_")},
                                             sort_keys=True, default=str)
+        parent = config.get("_parent")
+        if parent:
+            attrs["lagice_parent_checkpoint"] = str(parent["checkpoint"])
+            attrs["lagice_parent_checkpoint_sha256"] = str(parent["sha256"])
+            attrs["history"] += (f"\n{now}: branched from checkpoint {parent['checkpoint']} (step {parent['step']}, "
+                                 f"sha256 {parent['sha256']})")
     attrs.update(extra or {})
     return attrs
 
@@ -83,6 +86,35 @@ def write_netcdf_atomic(ds: xr.Dataset, path: Path) -> Path:
     tmp = path.with_suffix(path.suffix + ".tmp")
     enc = {v: {"_FillValue": None} for v in ds.variables
            if ds[v].dtype.kind in "fiu" and "_FillValue" not in ds[v].encoding and not ds[v].isnull().any()}
-    ds.to_netcdf(tmp, encoding=enc)
-    os.replace(tmp, path)
+    with atomic_write_errors(path, tmp):
+        ds.to_netcdf(tmp, encoding=enc)
+        os.replace(tmp, path)
     return path
+
+
+class atomic_write_errors:
+    """Context manager for a write through ``tmp``: on failure the temporary file is
+    removed and the error becomes an :class:`~lagice.errors.OutputError` naming
+    ``path`` and the reason (disk full, read-only folder, ...)."""
+
+    def __init__(self, path, tmp=None):
+        self.path = Path(path)
+        self.tmp = Path(tmp) if tmp is not None else None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, typ, exc, tb):
+        if exc is None:
+            return False
+        if self.tmp is not None:
+            try:
+                self.tmp.unlink(missing_ok=True)
+            except OSError:
+                pass
+        from ..errors import LagiceError, OutputError
+
+        if isinstance(exc, LagiceError) or not isinstance(exc, Exception):
+            return False
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else f"{type(exc).__name__}: {exc}"
+        raise OutputError(f"cannot write {self.path}: {reason}") from exc

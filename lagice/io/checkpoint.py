@@ -7,8 +7,11 @@ generator state, and the SHA-256 of every array (name, dtype, shape, bytes).
 
 Writing goes to ``NAME.tmp-PID`` in the same directory, is flushed and
 fsync'ed, then renamed over ``NAME`` (``os.replace`` is atomic on POSIX), so a
-run killed mid-write leaves the previous checkpoints intact; stale ``.tmp-*``
-files are ignored and cleaned up. The last ``keep`` checkpoints are kept.
+run killed mid-write leaves the previous checkpoints intact; a failed write
+(disk full, read-only folder) removes its temporary file and raises
+:class:`~lagice.errors.OutputError`; stale ``.tmp-PID`` files of a killed
+writer are ignored when reading and removed when the next run starts
+(:func:`clean_stale_temporaries`). The last ``keep`` checkpoints are kept.
 Any unreadable, truncated, corrupted (checksum) or incompatible (version,
 scene) file raises :class:`~lagice.errors.RestartError`.
 """
@@ -26,7 +29,7 @@ import numpy as np
 
 from ..errors import RestartError
 
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
 _NAME = re.compile(r"^checkpoint_(\d{10})\.npz$")
 
 
@@ -62,11 +65,14 @@ def write_checkpoint(directory, step: int, arrays: dict, meta: dict, keep: int =
     np.savez(buf, __meta__=np.frombuffer(json.dumps(header).encode(), dtype=np.uint8), **arrays)
     final = directory / checkpoint_name(step)
     tmp = directory / f"{final.name}.tmp-{os.getpid()}"
-    with open(tmp, "wb") as f:
-        f.write(buf.getbuffer())
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, final)
+    from .cf import atomic_write_errors
+
+    with atomic_write_errors(final, tmp):
+        with open(tmp, "wb") as f:
+            f.write(buf.getbuffer())
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, final)
     try:
         dfd = os.open(directory, os.O_RDONLY)
         os.fsync(dfd)
@@ -76,6 +82,45 @@ def write_checkpoint(directory, step: int, arrays: dict, meta: dict, keep: int =
     for old in list_checkpoints(directory)[:-keep] if keep > 0 else []:
         old.unlink(missing_ok=True)
     return final
+
+
+_TMP = re.compile(r"^checkpoint_\d{10}\.npz\.tmp-(\d+)$")
+
+
+def _pid_alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:
+        return True  # exists, owned by someone else
+    return True
+
+
+def clean_stale_temporaries(directory) -> list[Path]:
+    """Remove the ``checkpoint_*.npz.tmp-PID`` files a killed writer left in
+    ``directory`` (those of a process that no longer runs); returns them."""
+    directory = Path(directory)
+    if not directory.is_dir():
+        return []
+    removed = []
+    for p in directory.iterdir():
+        m = _TMP.match(p.name)
+        if m and not _pid_alive(int(m.group(1))):
+            p.unlink(missing_ok=True)
+            removed.append(p)
+    return removed
+
+
+def file_sha256(path) -> str:
+    """SHA-256 of a file's bytes (the parent checkpoint of a branched run)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
 
 
 def list_checkpoints(directory) -> list[Path]:

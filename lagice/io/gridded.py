@@ -103,37 +103,41 @@ def conservative_grid_average(nodes, triangles, fields: dict, x_edges, y_edges):
     return out, den / cell
 
 
-def gridded_dataset(model, resolution_m: float, crs_epsg: int | None = 3413, start_date="2000-01-01 00:00:00",
+def gridded_dataset(model, resolution_m: float, crs="EPSG:3413", start_date="2000-01-01 00:00:00",
                     title: str = "lagice regular-grid output"):
     """xarray Dataset of the model's scalar element fields (field registry, those
-    written to snapshots) averaged conservatively on a regular projected grid."""
+    written to snapshots) averaged conservatively on a regular projected grid.
+
+    The grid is a fixed lattice of the CRS plane (cell edges at whole multiples of
+    ``resolution_m``) covering the mesh at that time: files written at different
+    times (a mesh that moves) share the lattice, so they align into one time series
+    (:func:`lagice.open_run`); cells a file does not reach are simply not covered."""
     import xarray as xr
 
     from ..fields import ELEMENT, FIELDS
     from .cf import CONVENTIONS, crs_variable, provenance, time_coordinate
 
     state = model.state
-    x0, y0 = state.mesh.nodes.min(axis=0)
-    x1, y1 = state.mesh.nodes.max(axis=0)
-    nx = max(1, int(np.ceil((x1 - x0) / resolution_m)))
-    ny = max(1, int(np.ceil((y1 - y0) / resolution_m)))
-    xe = x0 + resolution_m * np.arange(nx + 1)
-    ye = y0 + resolution_m * np.arange(ny + 1)
+    lo = np.floor(state.mesh.nodes.min(axis=0) / resolution_m).astype(np.int64)
+    hi = np.ceil(state.mesh.nodes.max(axis=0) / resolution_m).astype(np.int64)
+    hi = np.maximum(hi, lo + 1)
+    xe = resolution_m * np.arange(lo[0], hi[0] + 1)
+    ye = resolution_m * np.arange(lo[1], hi[1] + 1)
     specs = [f for f in FIELDS.values() if f.location == ELEMENT and f.snapshot and not f.components
              and getattr(state, f.name, None) is not None]
     means, cov = conservative_grid_average(state.mesh.nodes, state.mesh.triangles,
                                            {f.name: getattr(state, f.name) for f in specs}, xe, ye)
     ds = xr.Dataset(coords={
-        "x": ("x", 0.5 * (xe[1:] + xe[:-1]), {"units": "m", "standard_name": "projection_x_coordinate",
-                                              "axis": "X"}),
-        "y": ("y", 0.5 * (ye[1:] + ye[:-1]), {"units": "m", "standard_name": "projection_y_coordinate",
-                                              "axis": "Y"}),
+        "x": ("x", resolution_m * (np.arange(lo[0], hi[0]) + 0.5), {
+            "units": "m", "standard_name": "projection_x_coordinate", "axis": "X"}),
+        "y": ("y", resolution_m * (np.arange(lo[1], hi[1]) + 0.5), {
+            "units": "m", "standard_name": "projection_y_coordinate", "axis": "Y"}),
         "time": time_coordinate(model.clock.time_s, start_date),
     })
     gm = {}
-    crs = crs_variable(crs_epsg)
-    if crs is not None:
-        ds["crs"] = crs
+    crs_var = crs_variable(crs)
+    if crs_var is not None:
+        ds["crs"] = crs_var
         gm = {"grid_mapping": "crs"}
     for f in specs:
         attrs = {"units": f.units, "long_name": f"{f.long_name}, conservative cell average", **gm,
@@ -151,7 +155,7 @@ class GridWriter:
     """Writes ``grid_SSSSSSSS.nc``: element fields conservatively averaged on a
     regular grid of ``resolution_m`` [m] (see :func:`gridded_dataset`)."""
 
-    def __init__(self, directory, resolution_m: float, crs_epsg: int | None = 3413,
+    def __init__(self, directory, resolution_m: float, crs="EPSG:3413",
                  start_date: str = "2000-01-01 00:00:00"):
         from pathlib import Path
 
@@ -160,12 +164,12 @@ class GridWriter:
         check_range("output.grid_resolution_m", resolution_m, 0.0, None, low_open=True, unit="m")
         self.dir = Path(directory)
         self.resolution_m = float(resolution_m)
-        self.crs_epsg = crs_epsg
+        self.crs = crs
         self.start_date = start_date
 
     def write(self, model):
         from .cf import write_netcdf_atomic
 
         self.dir.mkdir(parents=True, exist_ok=True)
-        ds = gridded_dataset(model, self.resolution_m, self.crs_epsg, self.start_date)
+        ds = gridded_dataset(model, self.resolution_m, self.crs, self.start_date)
         return write_netcdf_atomic(ds, self.dir / f"grid_{int(model.clock.iteration):08d}.nc")

@@ -21,20 +21,20 @@ import xarray as xr
 
 from ..deformation import invariants
 from ..fields import DIAGNOSTICS, FIELDS, cf_attrs
-from .cf import CONVENTIONS_UGRID, crs_variable, provenance, time_coordinate, write_netcdf_atomic
+from .cf import CONVENTIONS_UGRID, atomic_write_errors, crs_variable, provenance, time_coordinate, write_netcdf_atomic
 from .ugrid import mesh_dataset
 
 
-def snapshot_dataset(model, crs_epsg: int | None = 3413, start_date: str = "2000-01-01 00:00:00",
+def snapshot_dataset(model, crs="EPSG:3413", start_date: str = "2000-01-01 00:00:00",
                      title: str = "lagice snapshot", extra: dict | None = None):
     """The snapshot of ``model`` (state, clock, transport velocity, deformation
     rates) as an xarray Dataset with UGRID and CF attributes."""
     state = model.state
     ds = mesh_dataset(state.mesh)
     gm = None
-    crs = crs_variable(crs_epsg)
-    if crs is not None:
-        ds["crs"] = crs
+    crs_var = crs_variable(crs)
+    if crs_var is not None:
+        ds["crs"] = crs_var
         gm = "crs"
         ds["mesh_node_x"].attrs["grid_mapping"] = gm
         ds["mesh_node_y"].attrs["grid_mapping"] = gm
@@ -75,11 +75,11 @@ def snapshot_dataset(model, crs_epsg: int | None = 3413, start_date: str = "2000
 class SnapshotWriter:
     """Writes snapshots of a model and keeps ``index.json`` up to date (atomically)."""
 
-    def __init__(self, directory, crs_epsg: int | None = 3413, start_date: str = "2000-01-01 00:00:00",
+    def __init__(self, directory, crs="EPSG:3413", start_date: str = "2000-01-01 00:00:00",
                  title: str = "lagice snapshot", extra: dict | None = None):
         self.dir = Path(directory)
         self.start_date = start_date
-        self.crs_epsg = crs_epsg
+        self.crs = crs
         self.title = title
         self.extra = dict(extra or {})
 
@@ -87,7 +87,7 @@ class SnapshotWriter:
         self.dir.mkdir(parents=True, exist_ok=True)
         step = int(model.clock.iteration)
         path = self.dir / f"snapshot_{step:08d}.nc"
-        ds = snapshot_dataset(model, self.crs_epsg, self.start_date, self.title, self.extra)
+        ds = snapshot_dataset(model, self.crs, self.start_date, self.title, self.extra)
         write_netcdf_atomic(ds, path)
         self._index_add({"file": path.name, "time_s": model.clock.time_s, "step": step,
                          "mesh_epoch": int(model.state.counters.get("mesh_epoch", 0))})
@@ -99,8 +99,9 @@ class SnapshotWriter:
         entries = [e for e in entries if e["step"] < entry["step"]]  # a resumed run rewrites later ones
         entries.append(entry)
         tmp = idx_path.with_suffix(".json.tmp")
-        tmp.write_text(json.dumps(entries, indent=1))
-        os.replace(tmp, idx_path)
+        with atomic_write_errors(idx_path, tmp):
+            tmp.write_text(json.dumps(entries, indent=1))
+            os.replace(tmp, idx_path)
 
 
 def snapshot_dir(path) -> Path:

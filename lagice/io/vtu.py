@@ -12,6 +12,7 @@ import numpy as np
 
 from ..deformation import invariants
 from ..fields import FIELDS, NODE
+from .cf import atomic_write_errors
 
 
 def vtu_arrays(model) -> tuple[dict, dict]:
@@ -50,12 +51,14 @@ class VTUWriter:
         path = self.dir / f"snapshot_{step:08d}.vtu"
         point, cell = vtu_arrays(model)
         pts = np.column_stack([mesh.nodes, np.zeros(mesh.n_nodes)])
+        t = np.array([model.clock.time_s])
         m = meshio.Mesh(pts, [("triangle", mesh.triangles)], point_data=point,
                         cell_data={k: [v] for k, v in cell.items()},
-                        field_data={"TIME": np.array([model.clock.time_s])})
+                        field_data={"TimeValue": t, "TIME": t})  # TimeValue: the name ParaView reads
         tmp = path.with_suffix(".tmp.vtu")
-        m.write(tmp)
-        os.replace(tmp, path)
+        with atomic_write_errors(path, tmp):
+            m.write(tmp)
+            os.replace(tmp, path)
         self._collection_add(step, model.clock.time_s, path.name)
         return path
 
@@ -74,5 +77,6 @@ class VTUWriter:
         lines += [f'    <DataSet timestep="{t!r}" group="" part="0" file={quoteattr(f)}/>' for t, f in entries]
         lines += ["  </Collection>", "</VTKFile>", ""]
         tmp = self.pvd.with_suffix(".pvd.tmp")
-        tmp.write_text("\n".join(lines))
-        os.replace(tmp, self.pvd)
+        with atomic_write_errors(self.pvd, tmp):
+            tmp.write_text("\n".join(lines))
+            os.replace(tmp, self.pvd)

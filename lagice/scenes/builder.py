@@ -59,21 +59,7 @@ def build_domain(d: dict):
             raise ConfigError(f"domain.vertices/islands: not a polygon: {exc}") from exc
         sides = {}
     elif kind == "file":
-        if not d["file"]:
-            raise ConfigError("domain.file is required for a file domain (GeoJSON polygon in metres)")
-        p = Path(d["file"])
-        if not p.is_absolute() and not p.exists():
-            p = ROOT / d["file"]
-        if not p.exists():
-            raise ConfigError(f"domain.file = {d['file']!r}: file not found")
-        try:
-            gj = json.loads(p.read_text())
-            geom = shape(gj["features"][0]["geometry"] if "features" in gj else gj.get("geometry", gj))
-        except Exception as exc:  # noqa: BLE001
-            raise ConfigError(f"domain.file = {d['file']!r}: cannot read a GeoJSON polygon: {exc}") from exc
-        if geom.geom_type == "MultiPolygon":
-            geom = max(geom.geoms, key=lambda g: g.area)
-        poly, sides = geom, {}
+        poly, sides = _file_polygon(d), {}
     elif kind == "function":
         if not d["function"]:
             raise ConfigError("domain.function = 'module:function' is required for a function domain")
@@ -106,6 +92,84 @@ def build_domain(d: dict):
         check_range("domain.resolution_m", res, 0.0, None, low_open=True, unit="m")
         size = res
     return poly, segs, d["exterior_tag"], size
+
+
+def _geojson_crs(gj: dict) -> str | None:
+    """The CRS a GeoJSON file declares: the (pre-RFC 7946) ``crs`` member, or a
+    ``crs`` property of its first feature; None when it declares none."""
+    c = gj.get("crs")
+    if isinstance(c, dict):
+        name = (c.get("properties") or {}).get("name")
+        if name:
+            return str(name)
+    feats = gj.get("features") or []
+    if feats and isinstance(feats[0], dict):
+        val = (feats[0].get("properties") or {}).get("crs")
+        if isinstance(val, str):
+            return val
+    return None
+
+
+def _file_polygon(d: dict):
+    """The domain polygon of a GeoJSON file, in the scene CRS (``domain.crs``).
+
+    The file's CRS is ``domain.file_crs``, else the one the file declares, else the
+    scene CRS. A file in another CRS (e.g. lon/lat, ``EPSG:4326``) is projected; a
+    file read in a metric CRS whose coordinates look like degrees is an error."""
+    from ..crs import check_not_degrees, model_crs, parse_crs, project_geometry
+
+    if not d["file"]:
+        raise ConfigError("domain.file is required for a file domain (GeoJSON polygon)")
+    p = Path(d["file"])
+    if not p.is_absolute() and not p.exists():
+        p = ROOT / d["file"]
+    if not p.exists():
+        raise ConfigError(f"domain.file = {d['file']!r}: file not found")
+    try:
+        gj = json.loads(p.read_text())
+        geom = shape(gj["features"][0]["geometry"] if "features" in gj else gj.get("geometry", gj))
+    except Exception as exc:  # noqa: BLE001
+        raise ConfigError(f"domain.file = {d['file']!r}: cannot read a GeoJSON polygon: {exc}") from exc
+    if geom.geom_type == "MultiPolygon":
+        geom = max(geom.geoms, key=lambda g: g.area)
+    if geom.geom_type != "Polygon":
+        raise ConfigError(f"domain.file = {d['file']!r}: the geometry is a {geom.geom_type}; expected a Polygon")
+    target = model_crs(d["crs"], "domain.crs")
+    declared = d["file_crs"] or _geojson_crs(gj)
+    key = f"domain.file = {d['file']!r}"
+    if declared is None:
+        check_not_degrees(geom.bounds, key, f"domain.crs = {d['crs']!r}")
+        return geom
+    src = parse_crs(declared, "domain.file_crs" if d["file_crs"] else f"{key} (its crs)")
+    if src.is_projected:
+        check_not_degrees(geom.bounds, key, f"its CRS {declared!r}")
+    if src == target:
+        return geom
+    try:
+        out = project_geometry(geom, src, target)
+    except Exception as exc:  # noqa: BLE001
+        raise ConfigError(f"{key}: cannot project from {declared!r} to domain.crs = {d['crs']!r}: {exc}") from exc
+    if not out.is_valid or not np.all(np.isfinite(np.asarray(out.exterior.coords))):
+        raise ConfigError(f"{key}: projected from {declared!r} to domain.crs = {d['crs']!r} it is not a valid "
+                          f"polygon (does the domain.crs cover the region?)")
+    return out
+
+
+def domain_polygon(cfg: dict):
+    """The domain polygon in the scene CRS, as the mesh will cover it (rotated as asked)."""
+    d = cfg["domain"]
+    poly = build_domain(d)[0]
+    if d["rotate_deg"]:
+        poly = shapely.affinity.rotate(poly, d["rotate_deg"], origin=poly.centroid)
+    return poly
+
+
+def _domain_points(poly, n: int = 30) -> np.ndarray:
+    """Points spanning a polygon (its vertices and an n x n grid over its bounding box)."""
+    x0, y0, x1, y1 = poly.bounds
+    gx, gy = np.meshgrid(np.linspace(x0, x1, n), np.linspace(y0, y1, n))
+    v = np.asarray(poly.exterior.coords)
+    return np.vstack([v, np.column_stack([gx.ravel(), gy.ravel()])])
 
 
 def build_mesh(cfg: dict):
@@ -153,13 +217,23 @@ def build_rheology(cfg: dict):
 
 
 def validate_config(cfg: dict) -> None:
-    """Every check that needs no mesh, so bad input fails before any work."""
+    """Every check that needs no mesh, so bad input fails before any work: keys,
+    types and ranges of every table (forcing generator keywords, remesh/thermo/
+    healing parameters, drifters, output and checkpoint settings), the scene CRS
+    and start date, the domain geometry (polygon, coastline file projected into
+    the scene CRS), drifter positions inside it, and gridded forcing files
+    (variables, units, dates covering the run, NaN over the domain)."""
+    from ..crs import model_crs
     from ..solvers.cuda_explicit import check_solver_device
 
     check_solver_device(cfg["solver"])  # [solver] device: "cuda" needs the explicit stepper and a GPU
     if cfg["run"]["duration"] is None:
         raise ConfigError("run.duration is required (e.g. '28d')")
     duration = parse_duration(cfg["run"]["duration"], "run.duration")
+    model_crs(cfg["domain"]["crs"], "domain.crs")
+    if cfg["domain"]["file_crs"] is not None and cfg["domain"]["kind"] != "file":
+        raise ConfigError(f"domain.file_crs applies to domain.kind = 'file' only (kind is {cfg['domain']['kind']!r})")
+    components.parse_start_date(cfg["run"]["start_date"])
     dt = time_step_s(cfg)
     n = duration / dt
     if abs(n - round(n)) > 1e-9 * max(1.0, n) or round(n) < 1:
@@ -179,8 +253,7 @@ def validate_config(cfg: dict) -> None:
         raise ConfigError("solver 'prescribed' updates no damage: set healing.law = 'none'")
     solver_options(cfg)
     parse_schedule(cfg["output"]["every"], "output.every")
-    if cfg["checkpoint"]["every"] is not None:
-        parse_schedule(cfg["checkpoint"]["every"], "checkpoint.every")
+    checkpoint_schedule(cfg)
     if isinstance(cfg["checkpoint"]["keep"], bool) or cfg["checkpoint"]["keep"] < 1:
         raise ConfigError(f"checkpoint.keep = {cfg['checkpoint']['keep']!r}: expected an integer >= 1")
     timeseries_diagnostics(cfg)
@@ -193,9 +266,13 @@ def validate_config(cfg: dict) -> None:
     if dr["count"] < 0:
         raise ConfigError(f"drifters.count = {dr['count']}: expected an integer >= 0")
     if dr["positions_m"] is not None:
-        arr = np.asarray(dr["positions_m"], dtype=object)
-        if arr.ndim != 2 or arr.shape[1] != 2:
-            raise ConfigError(f"drifters.positions_m: expected a list of [x, y] pairs in m; got {dr['positions_m']!r}")
+        pos = dr["positions_m"]
+        if not all(isinstance(p, list) and len(p) == 2 and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                                                 and np.isfinite(v) for v in p) for p in pos):
+            raise ConfigError(f"drifters.positions_m = {pos!r}: expected a list of [x, y] pairs of numbers in m")
+        if dr["count"] and dr["count"] != len(pos):
+            raise ConfigError(f"drifters.count = {dr['count']} and drifters.positions_m ({len(pos)} positions) "
+                              f"disagree; give one of them")
     d = cfg["domain"]
     known_tags = set(d["segments"]) | {d["exterior_tag"], "coast"}
     for tag, bc in cfg["boundary"].items():
@@ -213,7 +290,36 @@ def validate_config(cfg: dict) -> None:
             resolve_hook(val, "initial.stress_pa")
             continue
         spatial_values(val, *probe, f"initial.{key}")
-    components.validate(cfg)
+    components.validate(cfg, duration)
+    poly = domain_polygon(cfg)  # no mesh yet: the polygon only
+    if not poly.is_valid or poly.area <= 0:
+        raise ConfigError(f"domain: the polygon is not valid ({shapely.validation.explain_validity(poly)})")
+    if dr["positions_m"]:
+        for k, p in enumerate(dr["positions_m"]):
+            if not poly.contains(shapely.Point(p)):
+                raise ConfigError(f"drifters.positions_m[{k}] = {p!r} lies outside the domain (bounds "
+                                  f"{tuple(round(b) for b in poly.bounds)} m in domain.crs)")
+    components.check_forcing_files(cfg, _domain_points(poly), duration)
+
+
+def checkpoint_schedule(cfg: dict):
+    """The checkpoint schedule: ``checkpoint.every`` (simulated time, steps or
+    ``"wall 55min"``) and/or ``checkpoint.every_wall`` (wall-clock time, e.g.
+    ``"55min"``, for batch queues); None when neither is set (a checkpoint is
+    still written at the end of the run and when it is stopped)."""
+    from ..schedule import AnyOf, WallTimeInterval
+
+    ck = cfg["checkpoint"]
+    every = parse_schedule(ck["every"], "checkpoint.every") if ck["every"] is not None else None
+    wall = None
+    if ck["every_wall"] is not None:
+        w = ck["every_wall"]
+        if isinstance(w, str) and w.strip().startswith("wall"):
+            w = w.strip()[4:].strip()
+        wall = WallTimeInterval(w, "checkpoint.every_wall")
+    if every is None or wall is None:
+        return every or wall
+    return AnyOf(every, wall)
 
 
 def timeseries_diagnostics(cfg: dict) -> dict | None:
@@ -305,8 +411,10 @@ def initial_state(cfg: dict, mesh, rheo, rng) -> IceState:
     return state
 
 
-def build_model(cfg: dict) -> Model:
-    validate_config(cfg)
+def build_model(cfg: dict, validated: bool = False) -> Model:
+    """The model of a scene (``validated``: :func:`validate_config` already ran)."""
+    if not validated:
+        validate_config(cfg)
     mesh, poly = build_mesh(cfg)
     rng = np.random.default_rng(cfg["run"]["seed"])
     rheo = build_rheology(cfg)
@@ -359,56 +467,171 @@ def build_drifters(cfg, poly):
 
 # -- the simulation ------------------------------------------------------------------
 def build_simulation(cfg: dict, out_dir=None, progress: bool | None = None, overrides=None) -> Simulation:
-    """Model + Simulation with the output, time-series and checkpoint activities of
-    the config, writing into ``out_dir`` (default ``runs/SCENE``). ``overrides``
+    """Model + Simulation with the output, time-series, drifter and checkpoint
+    activities of the config, writing into ``out_dir`` (default a new folder
+    ``runs/SCENE-YYYYmmdd-HHMMSS``, linked as ``runs/SCENE-latest``).
+
+    Order: every check that needs no mesh (:func:`validate_config`), then the output
+    folder is created and proved writable (:func:`lagice.rundir.prepare`: a
+    read-only folder fails here, before any mesh work), then the mesh and the model.
+    A checkpointer is always added: it writes when ``checkpoint.every`` /
+    ``checkpoint.every_wall`` are due, at the end of the run (so it can be
+    extended) and when the run is stopped (SIGTERM/SIGINT). ``overrides``
     (``{"table.key": value}``) change the config first, e.g. when a checkpoint
     resumes on another device: ``Simulation.resume(path, overrides={"solver.device":
     "cuda"})`` (keys outside :data:`~lagice.scenes.config.NON_PHYSICS` change the
     fingerprint, and the resume is refused)."""
+    from .. import rundir
+
     if overrides:
         cfg = override_config(cfg, overrides)
-    model = build_model(cfg)
+    validate_config(cfg)
+    if out_dir is None:
+        out = rundir.new_run_dir(cfg["scene"]["name"])
+        rundir.prepare(out, cfg)
+        rundir.update_latest(out, cfg["scene"]["name"])
+    else:
+        out = Path(out_dir)
+        rundir.prepare(out, cfg if not (out / rundir.MARKER).exists() or cfg.get("_parent") else None)
+    model = build_model(cfg, validated=True)
     prog = cfg["run"]["progress"] if progress is None else progress
     sim = Simulation(model, dt=time_step_s(cfg), stop=cfg["run"]["duration"], progress=prog, builder=BUILDER,
                      max_speed_m_s=cfg["run"]["max_speed_m_s"])
-    out = Path(out_dir) if out_dir is not None else Path("runs") / cfg["scene"]["name"]
     sim.out_dir = out
     oc = cfg["output"]
-    sim.output(oc["every"], out / "snapshots", crs_epsg=oc["crs_epsg"], vtu=oc["vtu"],
+    sim.output(oc["every"], out / "snapshots", crs=cfg["domain"]["crs"], vtu=oc["vtu"],
                start_date=cfg["run"]["start_date"], grid_resolution_m=oc["grid_resolution_m"],
-               title=f"lagice {cfg['scene']['name']}: {cfg['scene']['description']}".rstrip(": "))
+               title=f"lagice {cfg['scene']['name']}: {cfg['scene']['description']}".rstrip(": "),
+               drifters_path=out / "drifters.nc" if model.drifters is not None else None)
     diags = timeseries_diagnostics(cfg)
     if diags:
         sim.add_timeseries(out / "timeseries.nc", diags, oc["timeseries"]["every"], cfg["run"]["start_date"])
-    if cfg["checkpoint"]["every"] is not None:
-        sim.checkpoint(cfg["checkpoint"]["every"], out / "checkpoints", keep=cfg["checkpoint"]["keep"])
+    sim.checkpoint(checkpoint_schedule(cfg), out / "checkpoints", keep=cfg["checkpoint"]["keep"])
     return sim
 
 
-def run_scene(name_or_path, out_dir=None, overrides=None, progress=None) -> dict:
+def run_scene(name_or_path, out_dir=None, overrides=None, progress=None, overwrite: bool = False) -> dict:
+    """Run a scene into a new folder (or ``out_dir``: empty, or replaced with ``overwrite``)."""
+    from .. import rundir
+
     cfg = load_scene(name_or_path, overrides)
+    if out_dir is not None:
+        validate_config(cfg)
+        rundir.claim(out_dir, overwrite)
     sim = build_simulation(cfg, out_dir, progress)
     return finish(sim)
 
 
-def finish(sim: Simulation) -> dict:
-    """Run a (new or resumed) simulation to its end, then write the summary and the plot."""
+# -- extend and branch ---------------------------------------------------------------
+#: keys a branch cannot change: the state (mesh, fields, clock) comes from the checkpoint
+BRANCH_FIXED = ("domain", "initial", "solver.dt", "run.start_date")
+
+
+def resume_simulation(checkpoint, overrides=None, progress: bool | None = None, config: dict | None = None
+                      ) -> Simulation:
+    """Continue the run of ``checkpoint`` (a file, or the newest usable one in a
+    checkpoint or run folder) in its run folder, with ``overrides`` that leave the
+    physics unchanged: ``run.duration`` (extend), ``output.*``, ``checkpoint.*``,
+    ``run.progress``... Anything else is refused, naming the keys (use
+    :func:`branch_simulation`). The result is bit-identical to a straight run."""
+    from ..errors import RestartError
+    from ..simulation import load_checkpoint
+    from .config import changed_keys, length_dependent_forcing, override_config
+
+    path, arrays, meta = load_checkpoint(checkpoint)
+    old = meta["config"]
+    if config is not None:  # a full scene config (lagice run SCENE --out DIR --resume)
+        cfg = {**config, **{k: v for k, v in old.items() if k.startswith("_")}}
+    else:
+        cfg = override_config(old, overrides) if overrides else old
+    if cfg is not old:
+        moved = changed_keys(physics_view(old), physics_view(cfg))
+        if moved == ["run.duration"] and length_dependent_forcing(cfg):
+            tables = ", ".join(length_dependent_forcing(cfg))
+            raise RestartError(
+                f"cannot extend this run: {tables} draws its random records over the whole run, so changing "
+                f"run.duration would change the forcing already used. Start such runs with a fixed "
+                f"{length_dependent_forcing(cfg)[0]}.horizon (e.g. '120d'; they can then be extended up to it), or "
+                f"branch a new run from this checkpoint (lagice branch {path} --set run.duration=...: its forcing "
+                f"is drawn anew)")
+        if moved:
+            raise RestartError(
+                f"the settings change the physics of the run ({', '.join(moved)}); a resumed run continues the same "
+                f"physics (only run.duration, output.* and checkpoint.* may change). To change it, branch a new run "
+                f"from the checkpoint: lagice branch {path} --set ...")
+    from ..simulation import Simulation, run_folder_of
+
+    sim = Simulation.resume(path, config=cfg, out_dir=run_folder_of(path), progress=progress)
+    return sim
+
+
+def branch_simulation(checkpoint, out_dir=None, overrides=None, progress: bool | None = None,
+                      overwrite: bool = False) -> Simulation:
+    """A new run in ``out_dir`` (a new folder by default) that starts from the state of
+    ``checkpoint`` with ``overrides`` (forcing, rheology, remeshing... may change; the
+    fingerprint then differs: branching is explicit). Keys of :data:`BRANCH_FIXED` cannot
+    change. Its outputs record the parent checkpoint (path and SHA-256: global
+    attributes ``lagice_parent_checkpoint*``, ``lagice_run.json``, checkpoints)."""
+    from .. import rundir
+    from ..errors import RestartError
+    from ..io.checkpoint import file_sha256
+    from ..simulation import load_checkpoint
+    from .config import changed_keys, override_config
+
+    path, arrays, meta = load_checkpoint(checkpoint)
+    old = meta["config"]
+    cfg = override_config(old, overrides)
+    for key in changed_keys({k: v for k, v in old.items() if not k.startswith("_")},
+                            {k: v for k, v in cfg.items() if not k.startswith("_")}):
+        if any(key == f or key.startswith(f + ".") for f in BRANCH_FIXED):
+            raise RestartError(f"--set {key}: a branch starts from the checkpoint's state (mesh, fields, clock), so "
+                               f"{', '.join(BRANCH_FIXED)} cannot change")
+    if meta["clock"]["time_s"] >= parse_duration(cfg["run"]["duration"], "run.duration") * (1 - 1e-12):
+        raise RestartError(f"the checkpoint is at t = {meta['clock']['time_s']:g} s; the branch's run.duration "
+                           f"= {cfg['run']['duration']!r} leaves nothing to run: set a longer run.duration")
+    path = path.resolve()
+    cfg["_parent"] = {"checkpoint": str(path), "sha256": file_sha256(path), "step": int(meta["step"]),
+                      "time_s": float(meta["clock"]["time_s"]), "scene": old["scene"]["name"],
+                      "fingerprint": meta.get("scene_fingerprint")}
+    validate_config(cfg)
+    if out_dir is not None:
+        rundir.claim(out_dir, overwrite)
+    sim = build_simulation(cfg, out_dir, progress)
+    fresh = sim.model.load_state(arrays, meta, fresh_components=True)
+    if fresh:
+        import logging
+
+        logging.getLogger("lagice").info(f"branch: component(s) {', '.join(fresh)} start fresh (not in the parent)")
+    if abs(meta["simulation"]["dt_s"] - sim.dt) > 1e-12 * sim.dt:  # pragma: no cover - solver.dt is fixed above
+        raise RestartError("the branch's time step differs from the checkpoint's")
+    sim.branched_from = {"checkpoint": str(path), "sha256": cfg["_parent"]["sha256"]}
+    return sim
+
+
+def finish(sim: Simulation, plot: bool = True) -> dict:
+    """Run a (new or resumed) simulation to its end (or until it is stopped), then
+    write ``summary.json`` and, when it finished, the plot."""
     summary = sim.run()
     out = Path(sim.out_dir if sim.out_dir is not None else ".")
     out.mkdir(parents=True, exist_ok=True)
     cfg = sim.model.config
     summary["scene"] = cfg["scene"]["name"]
-    dr = sim.model.drifters
     res = {"summary": summary, "netcdf": out / "snapshots" / "index.json", "wall_s": summary["wall_s"],
            "png": None, "out_dir": out}
-    (out / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
-    res["png"] = plot_scene(cfg, out, summary, dr)
+    from ..io.cf import atomic_write_errors
+
+    with atomic_write_errors(out / "summary.json", out / "summary.json.tmp"):
+        (out / "summary.json.tmp").write_text(json.dumps(summary, indent=1, default=str))
+        (out / "summary.json.tmp").replace(out / "summary.json")
+    if plot and sim.stop_reason is None:
+        res["png"] = plot_scene(cfg, out, summary)
     return res
 
 
 def plot_scene(cfg: dict, out: Path, summary: dict | None = None, drifters=None):
     """The scene's own figure: ``output.plot`` true (the standard run plot), false
-    (none) or a ``module:function`` hook ``f(run_dir, png_path, summary)``."""
+    (none) or a ``module:function`` hook ``f(run_dir, png_path, summary)``. Drifter
+    trajectories come from the run's drifter file (``drifters.nc``) unless given."""
     spec = cfg["output"]["plot"]
     if spec is False:
         return None
@@ -417,5 +640,9 @@ def plot_scene(cfg: dict, out: Path, summary: dict | None = None, drifters=None)
         return resolve_hook(spec, "output.plot")(Path(out), png, summary)
     from ..plotting import plot_run
 
-    return plot_run(Path(out) / "snapshots", png, summary,
-                    trajectories=drifters.trajectories() if drifters is not None else None)
+    traj = drifters.trajectories() if drifters is not None else None
+    if traj is None and (Path(out) / "drifters.nc").exists():
+        from ..io.drifters import read_trajectories
+
+        traj = read_trajectories(Path(out) / "drifters.nc")
+    return plot_run(Path(out) / "snapshots", png, summary, trajectories=traj)

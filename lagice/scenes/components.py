@@ -23,6 +23,20 @@ clockwise), ``file``, ``expression``, ``function``. air_temperature ``kind``:
 ``synthetic`` (``synthetic_air_temperature`` keywords), ``constant`` (value_c),
 ``file``, ``expression`` (``value``).
 
+Every keyword is checked before any mesh work: its name against the generator's
+signature, its type and range against :mod:`.checks` (explicit specs, else the
+generator's annotations and defaults), then the generator itself runs once on a
+tiny grid so its own range checks fire early. ``file`` kinds take the scene's
+CRS (``[domain] crs``) and model time 0 is ``run.start_date``: records are
+aligned by their CF dates (``crs`` and ``reference_time`` are not keys of a
+scene). Files are opened and checked (variables, units, dates covering the
+whole run, NaN over the domain) before meshing (:func:`check_forcing_files`).
+
+``random``/``cyclones`` winds and ``synthetic`` air temperature draw their
+records over ``[0, run.duration]``, so the run length is part of their physics
+and such a run cannot be extended on resume; ``horizon = "120d"`` draws them over
+a fixed span instead (the run can then be extended up to it).
+
 Mesh motion, remeshing and drifters are components of their own
 (:class:`lagice.lagrangian.MeshMotion`, :class:`lagice.remesh.Remesher`,
 :class:`lagice.drifters.Drifters`); this module builds them from the scene.
@@ -33,7 +47,8 @@ import inspect
 
 import numpy as np
 
-from ..errors import ConfigError
+from ..errors import ConfigError, ForcingError
+from . import checks
 from .config import resolve_hook, time_space_callable
 
 WIND_KINDS = ("uniform", "random", "cyclones", "file", "expression", "function")
@@ -81,11 +96,89 @@ def _generators(key: str, kind: str):
 def _check_kwargs(t: dict, key: str, kind: str) -> None:
     gen = _generators(key, kind)
     if gen is not None:
-        _kwargs(t, key, *gen)
+        _kwargs({k: v for k, v in t.items() if k != "horizon"}, key, *gen)
+        checks.check_keywords(f"forcing.{key}", {k: v for k, v in t.items() if k not in ("kind", "horizon")},
+                              gen[0])
 
 
-def validate(cfg: dict) -> None:
-    """Checks before any mesh work (kinds, parameter names, dependencies)."""
+#: keys the builder fills for ``file`` kinds (one CRS and one date per scene)
+_FILLED = {"crs": "the scene's CRS is [domain] crs", "reference_time": "model time 0 is run.start_date"}
+
+
+def _generator_table(t: dict, key: str, kind: str) -> dict:
+    """The keywords of a generator table: ``horizon`` (length-dependent kinds only)
+    and the builder-filled keys of file kinds are refused here with a clear message."""
+    for k, why in _FILLED.items():
+        if kind == "file" and k in t:
+            raise ConfigError(f"forcing.{key}.{k} is not a scene key: {why}")
+    if "horizon" in t and (key, kind) not in _LENGTH_KINDS:
+        raise ConfigError(f"forcing.{key}.horizon applies to random forcing drawn over the run "
+                          f"({', '.join(f'{a}.kind = {b!r}' for a, b in _LENGTH_KINDS)}), not to kind {kind!r}")
+    return {k: v for k, v in t.items() if k not in ("kind", "horizon")}
+
+
+_LENGTH_KINDS = (("wind", "random"), ("wind", "cyclones"), ("air_temperature", "synthetic"))
+
+
+def draw_span_s(t: dict, key: str, duration_s: float) -> float:
+    """The span [s] random forcing is drawn over: ``horizon`` if set, else the run."""
+    from ..schedule import parse_duration
+
+    if t.get("horizon") is None:
+        return duration_s
+    h = parse_duration(t["horizon"], f"forcing.{key}.horizon")
+    if h < duration_s - 1e-9:
+        raise ConfigError(f"forcing.{key}.horizon = {t['horizon']!r} ({h:g} s) is shorter than run.duration "
+                          f"({duration_s:g} s); the forcing would run out: set horizon >= run.duration")
+    return h
+
+
+def start_day_of_year(start_date) -> float:
+    """Day of year of ``run.start_date`` (1.0 = 1 January 00:00), fractional."""
+    import datetime as _dt
+
+    d = parse_start_date(start_date)
+    jan1 = _dt.datetime(d.year, 1, 1, tzinfo=d.tzinfo)
+    return 1.0 + (d - jan1).total_seconds() / 86400.0
+
+
+def parse_start_date(value, key: str = "run.start_date"):
+    """``run.start_date`` as a datetime (ISO 8601, e.g. ``"2026-01-15 00:00:00"``)."""
+    import datetime as _dt
+
+    if not isinstance(value, str):
+        raise ConfigError(f"{key} = {value!r}: expected a date string like '2026-01-15 00:00:00'")
+    try:
+        d = _dt.datetime.fromisoformat(value.strip())
+    except ValueError:
+        raise ConfigError(f"{key} = {value!r}: not a date; expected ISO 8601 like '2026-01-15 00:00:00'") from None
+    if d.tzinfo is not None and d.utcoffset() != _dt.timedelta(0):
+        raise ConfigError(f"{key} = {value!r}: give the date in UTC (no time-zone offset)")
+    return d.replace(tzinfo=None)
+
+
+def _tiny_grid():
+    from forcing.records import RegularGrid
+
+    return RegularGrid([0.0, 1.0], [0.0, 1.0])
+
+
+def _dry_run(cfg: dict, key: str, kind: str, duration_s: float) -> None:
+    """Run a synthetic generator once on a tiny grid so its own checks fire before meshing."""
+    t = cfg["forcing"][key]
+    seed = cfg["run"]["seed"]
+    span = draw_span_s(t, key, duration_s)
+    if key == "wind":
+        build_wind(t, _tiny_grid(), (0.0, 1.0, 0.0, 1.0), span, seed)
+    elif key == "ocean":
+        build_ocean(t, _tiny_grid())
+    else:
+        build_air_temperature(t, _tiny_grid(), span, seed, start_date=cfg["run"]["start_date"])
+
+
+def validate(cfg: dict, duration_s: float) -> None:
+    """Checks before any mesh work: kinds, parameter names, types and ranges,
+    dependencies between tables, and the synthetic generators run once on a tiny grid."""
     law = cfg["healing"]["law"]
     if law not in HEAL_LAWS:
         raise ConfigError(f"healing.law = {law!r}: expected one of {list(HEAL_LAWS)}")
@@ -96,43 +189,129 @@ def validate(cfg: dict) -> None:
         raise ConfigError("thermo.enabled = true needs [forcing.air_temperature]")
     if cfg["remesh"]["enabled"] and not cfg["lagrangian"]["enabled"]:
         raise ConfigError("remesh.enabled = true needs lagrangian.enabled = true (a fixed mesh never distorts)")
-    for key, kinds in (("wind", WIND_KINDS), ("ocean", OCEAN_KINDS)):
+    checks.check_value("forcing.grid_spacing_m", fc["grid_spacing_m"],
+                       checks.Spec(checks.NUMBER, 0.0, None, low_open=True, unit="m"))
+    for key, kinds in (("wind", WIND_KINDS), ("ocean", OCEAN_KINDS), ("air_temperature", AIR_KINDS)):
         t = fc[key]
         if t is None:
             continue
         kind = _kind(t, key, kinds)
+        _generator_table(t, key, kind)
         if kind == "function":
             _function_field(t, key)
         elif kind == "expression":
-            _vector_expr(t, key)
+            if key == "air_temperature":
+                _scalar_expr(t, key)
+            else:
+                _vector_expr(t, key)
+        elif key == "air_temperature" and kind == "constant":
+            _constant_air(t)
+        elif key == "air_temperature":
+            _check_air_kwargs(t, kind, cfg["run"]["start_date"])
         else:
             _check_kwargs(t, key, kind)
-    if fc["air_temperature"] is not None:
-        _kind(fc["air_temperature"], "air_temperature", AIR_KINDS)
+        if kind in ("uniform", "random", "cyclones", "gyre", "synthetic"):
+            _dry_run(cfg, key, kind, duration_s)
     if fc["coriolis"] is not None:
-        bad = set(fc["coriolis"]) - {"latitude_deg", "f_s"}
-        if bad or len(fc["coriolis"]) != 1:
-            raise ConfigError("[forcing.coriolis] takes exactly one of latitude_deg or f_s "
-                              f"(got keys {sorted(fc['coriolis'])})")
+        _check_coriolis(fc["coriolis"])
     if fc["drag"] is not None:
         from ..params import DragParams
-        try:
-            DragParams(**fc["drag"])
-        except TypeError as exc:
-            raise ConfigError(f"[forcing.drag]: {exc}; known keys: {sorted(DragParams.__dataclass_fields__)}") from None
+
+        checks.check_dataclass_params("forcing.drag", DragParams, fc["drag"])
+    if cfg["thermo"]["params"] and not cfg["thermo"]["enabled"]:
+        raise ConfigError("thermo.params is set but thermo.enabled = false: the parameters would not be used")
     if cfg["thermo"]["enabled"]:
         from thermo.zero_layer import ThermoParams
-        try:
-            ThermoParams(**cfg["thermo"]["params"])
-        except TypeError as exc:
-            raise ConfigError(f"[thermo.params]: {exc}; known keys: "
-                              f"{sorted(ThermoParams.__dataclass_fields__)}") from None
+
+        checks.check_dataclass_params("thermo.params", ThermoParams, cfg["thermo"]["params"])
+    _check_healing(cfg)
+    if cfg["remesh"]["params"] and not cfg["remesh"]["enabled"]:
+        raise ConfigError("remesh.params is set but remesh.enabled = false: the parameters would not be used")
     if cfg["remesh"]["enabled"]:
-        from ..remesh import Remesher
-        Remesher(1.0, cfg["remesh"]["min_angle_deg"], **cfg["remesh"]["params"])
+        _check_remesh(cfg["remesh"])
     if cfg["lagrangian"]["enabled"]:
         from ..lagrangian import MeshMotion
         MeshMotion(cfg["lagrangian"]["min_area_ratio"], cfg["lagrangian"]["max_halvings"])
+
+
+def _check_coriolis(c: dict) -> None:
+    bad = set(c) - {"latitude_deg", "f_s"}
+    if bad or len(c) != 1:
+        raise ConfigError("[forcing.coriolis] takes exactly one of latitude_deg or f_s "
+                          f"(got keys {sorted(c)})")
+    if "f_s" in c:
+        checks.check_value("forcing.coriolis.f_s", c["f_s"], checks.Spec(checks.NUMBER, -2e-4, 2e-4, unit="s-1"))
+    elif c["latitude_deg"] != "crs":
+        if isinstance(c["latitude_deg"], str):
+            raise ConfigError(f"forcing.coriolis.latitude_deg = {c['latitude_deg']!r}: expected a latitude in "
+                              f"[-90, 90] deg, or 'crs' (each node's latitude from domain.crs)")
+        checks.check_value("forcing.coriolis.latitude_deg", c["latitude_deg"],
+                           checks.Spec(checks.NUMBER, -90.0, 90.0, unit="deg"))
+
+
+def _check_healing(cfg: dict) -> None:
+    law, params = cfg["healing"]["law"], cfg["healing"]["params"]
+    if law not in ("thermodynamic", "fdd"):
+        if params:
+            raise ConfigError(f"healing.params is set but healing.law = {law!r} takes no parameters "
+                              f"(the constant law uses rheology.healing_time_s)")
+        return
+    from thermo.healing import FreezingDegreeDayHealing, ThermodynamicHealing
+
+    cls = ThermodynamicHealing if law == "thermodynamic" else FreezingDegreeDayHealing
+    known = [n for n in inspect.signature(cls).parameters]
+    for k in params:
+        if k not in known:
+            raise ConfigError(f"unknown key healing.params.{k} for healing.law = {law!r}; known keys: {sorted(known)}")
+    checks.check_keywords("healing.params", params, [cls])
+    checks.call_checked("healing.params", cls, **params)
+
+
+def _check_remesh(rm: dict) -> None:
+    from ..remesh import Remesher, remesh_if_needed
+    from ..remesh.component import REMESH_OPTIONS
+    from ..remesh.trigger import TriggerParams
+
+    params = rm["params"]
+    trig = {k: v for k, v in params.items() if k in TriggerParams.__dataclass_fields__}
+    opts = {k: v for k, v in params.items() if k in REMESH_OPTIONS}
+    checks.check_keywords("remesh.params", opts, [remesh_if_needed])
+    for k, v in trig.items():
+        checks.check_value(f"remesh.params.{k}", v, checks.Spec(checks.NUMBER))
+    Remesher(1.0, rm["min_angle_deg"], **params)  # unknown keys and trigger ranges
+
+
+def _constant_air(t: dict) -> None:
+    if set(t) - {"kind", "value_c"}:
+        raise ConfigError(f"unknown key forcing.air_temperature.{sorted(set(t) - {'kind', 'value_c'})[0]}; "
+                          f"known keys: ['value_c']")
+    if "value_c" in t:
+        checks.check_value("forcing.air_temperature.value_c", t["value_c"], checks.SPECS["value_c"])
+
+
+def _scalar_expr(t: dict, key: str):
+    for k in t:
+        if k not in ("kind", "value"):
+            raise ConfigError(f"unknown key forcing.{key}.{k}; known keys: ['value']")
+    return time_space_callable(t.get("value", -20.0), f"forcing.{key}.value")
+
+
+def _check_air_kwargs(t: dict, kind: str, start_date) -> None:
+    from forcing import gridded
+    from thermo.air_temperature import synthetic_air_temperature
+
+    if kind == "synthetic":
+        funcs, filled = [synthetic_air_temperature], ("grid", "t_end_s")
+    else:
+        funcs, filled = [gridded.open_air_temperature, gridded.open_gridded], ("variables", "quantity")
+    kw = _kwargs({k: v for k, v in t.items() if k != "horizon"}, "air_temperature", funcs, filled)
+    checks.check_keywords("forcing.air_temperature", kw, funcs)
+    if kind == "synthetic" and "start_day_of_year" in kw:
+        want = start_day_of_year(start_date)
+        if abs(float(kw["start_day_of_year"]) - want) > 1e-6:
+            raise ConfigError(f"forcing.air_temperature.start_day_of_year = {kw['start_day_of_year']!r} disagrees "
+                              f"with run.start_date = {start_date!r} (day {want:g} of the year); leave it out "
+                              f"(it follows run.start_date) or change run.start_date")
 
 
 def _grid(mesh, spacing):
@@ -162,33 +341,49 @@ def _function_field(t, key):
     return resolve_hook(t["function"], f"forcing.{key}.function", t.get("params"))
 
 
-def build_wind(t: dict, grid, bbox, t_end, seed):
+def _file_kw(t: dict, key: str, funcs, crs, start_date) -> dict:
+    kw = _kwargs(_generator_table(t, key, "file"), key, funcs, ("variables", "quantity"))
+    path = kw.get("path")
+    if isinstance(path, str):
+        from pathlib import Path
+
+        from .builder import ROOT
+
+        p = Path(path)
+        if not p.is_absolute() and not p.exists() and (ROOT / p).exists():
+            kw["path"] = str(ROOT / p)
+    kw["crs"] = crs
+    kw["reference_time"] = None if start_date is None else parse_start_date(start_date).isoformat()
+    return kw
+
+
+def build_wind(t: dict, grid, bbox, t_end, seed, crs="EPSG:3413", start_date=None):
     from forcing import gridded
     from forcing import synthetic as syn
 
     kind = _kind(t, "wind", WIND_KINDS)
+    tt = _generator_table(t, "wind", kind)
     if kind == "uniform":
-        return syn.uniform_wind(grid, t_end, **_kwargs(t, "wind", [syn.uniform_wind], ("grid", "t_end_s")))
+        return syn.uniform_wind(grid, t_end, **_kwargs(tt, "wind", [syn.uniform_wind], ("grid", "t_end_s")))
     if kind == "random":
-        kw = _kwargs(t, "wind", [syn.random_wind], ("grid", "t_end_s"))
+        kw = _kwargs(tt, "wind", [syn.random_wind], ("grid", "t_end_s"))
         kw.setdefault("seed", seed)
         return syn.random_wind(grid, t_end, **kw)
     if kind == "cyclones":
-        kw = _kwargs(t, "wind", [syn.random_cyclones, syn.cyclone_wind], ("grid", "t_end_s", "bbox", "cyclones"))
+        kw = _kwargs(tt, "wind", [syn.random_cyclones, syn.cyclone_wind], ("grid", "t_end_s", "bbox", "cyclones"))
         n = kw.pop("n", 4)
         cseed = kw.pop("seed", seed)
         wkw = {k: kw.pop(k) for k in list(kw) if k in inspect.signature(syn.cyclone_wind).parameters}
         cyclones = syn.random_cyclones(bbox, t_end, n, seed=cseed, **kw)
         return syn.cyclone_wind(grid, t_end, cyclones, **wkw)
     if kind == "file":
-        kw = _kwargs(t, "wind", [gridded.open_wind, gridded.open_gridded], ("variables", "quantity"))
-        return gridded.open_wind(**kw)
+        return gridded.open_wind(**_file_kw(t, "wind", [gridded.open_wind, gridded.open_gridded], crs, start_date))
     if kind == "function":
         return _function_field(t, "wind")
     return _vector_expr(t, "wind")
 
 
-def build_ocean(t: dict, grid):
+def build_ocean(t: dict, grid, crs="EPSG:3413", start_date=None):
     from forcing import gridded
     from forcing import synthetic as syn
 
@@ -201,31 +396,66 @@ def build_ocean(t: dict, grid):
     if kind == "gyre":
         return syn.gyre_current(grid, **_kwargs(t, "ocean", [syn.gyre_current], ("grid",)))
     if kind == "file":
-        return gridded.open_ocean_current(**_kwargs(t, "ocean", [gridded.open_ocean_current, gridded.open_gridded],
-                                                     ("variables", "quantity")))
+        return gridded.open_ocean_current(**_file_kw(t, "ocean", [gridded.open_ocean_current, gridded.open_gridded],
+                                                     crs, start_date))
     if kind == "function":
         return _function_field(t, "ocean")
     return _vector_expr(t, "ocean")
 
 
-def build_air_temperature(t: dict, grid, t_end, seed):
+def build_air_temperature(t: dict, grid, t_end, seed, crs="EPSG:3413", start_date=None):
     from forcing import gridded
     from thermo.air_temperature import synthetic_air_temperature
 
     kind = _kind(t, "air_temperature", AIR_KINDS)
     if kind == "synthetic":
-        kw = _kwargs(t, "air_temperature", [synthetic_air_temperature], ("grid", "t_end_s"))
+        kw = _kwargs(_generator_table(t, "air_temperature", kind), "air_temperature", [synthetic_air_temperature],
+                     ("grid", "t_end_s"))
         kw.setdefault("seed", seed)
+        if start_date is not None:
+            kw.setdefault("start_day_of_year", start_day_of_year(start_date))
         return synthetic_air_temperature(grid, t_end, **kw)
     if kind == "constant":
-        if set(t) - {"kind", "value_c"}:
-            raise ConfigError(f"unknown key in [forcing.air_temperature]: {sorted(set(t) - {'kind', 'value_c'})}")
+        _constant_air(t)
         return float(t.get("value_c", -20.0))
     if kind == "file":
-        return gridded.open_air_temperature(**_kwargs(t, "air_temperature",
-                                                      [gridded.open_air_temperature, gridded.open_gridded],
-                                                      ("variables", "quantity")))
-    return time_space_callable(t.get("value", -20.0), "forcing.air_temperature.value")
+        return gridded.open_air_temperature(**_file_kw(t, "air_temperature",
+                                                       [gridded.open_air_temperature, gridded.open_gridded],
+                                                       crs, start_date))
+    return _scalar_expr(t, "air_temperature")
+
+
+def check_forcing_files(cfg: dict, points_xy, duration_s: float) -> None:
+    """Open every ``file`` forcing and check it before meshing: variables, units,
+    plausible values, the file's CF dates covering the whole run
+    (``run.start_date`` .. + ``run.duration``; ``time_extrapolation = "hold"`` opts
+    in to holding the first/last record) and no NaN over the domain
+    (``points_xy``: points spanning the domain polygon, in the scene CRS)."""
+    import numpy as np
+
+    fc = cfg["forcing"]
+    crs, start = cfg["domain"]["crs"], cfg["run"]["start_date"]
+    builders = {"wind": lambda t: build_wind(t, None, None, duration_s, 0, crs, start),
+                "ocean": lambda t: build_ocean(t, None, crs, start),
+                "air_temperature": lambda t: build_air_temperature(t, None, duration_s, 0, crs, start)}
+    t0 = np.datetime64(parse_start_date(start), "ns")
+    t1 = t0 + np.timedelta64(int(round(duration_s * 1e9)), "ns")
+    for key, build_field in builders.items():
+        t = fc[key]
+        if t is None or t.get("kind") != "file":
+            continue
+        field = build_field(t)
+        src = field.source
+        times = src.record_times
+        if field.time_extrapolation == "error" and times.size > 1 and (t0 < times[0] or t1 > times[-1]):
+            raise ForcingError(
+                f"forcing.{key}.path = {t.get('path')!r}: the file's records cover {str(times[0])[:16]} .. "
+                f"{str(times[-1])[:16]} but the run covers {str(t0)[:16]} .. {str(t1)[:16]} (run.start_date + "
+                f"run.duration); set run.start_date inside the file's dates (records are aligned by date), "
+                f"shorten the run, or set forcing.{key}.time_extrapolation = 'hold' to opt in to holding the "
+                f"first/last record")
+        field.prepare(0.0, duration_s, points_xy[:, 0], points_xy[:, 1])
+        src.close()
 
 
 def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
@@ -233,6 +463,7 @@ def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
     parts = {"forces": [], "thermo": None, "healing": None, "mover": None, "remesher": None}
     fc = cfg["forcing"]
     seed = cfg["run"]["seed"]
+    crs, start = cfg["domain"]["crs"], cfg["run"]["start_date"]
     law = cfg["healing"]["law"]
     if law == "none" and hasattr(rheology.params, "healing_time_s"):
         rheology.params = rheology.params.replace(healing_time_s=None)
@@ -241,9 +472,11 @@ def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
     x0, y0 = mesh.nodes.min(axis=0)
     x1, y1 = mesh.nodes.max(axis=0)
     t_end = duration_s
-    wind = build_wind(fc["wind"], grid, (x0, x1, y0, y1), t_end, seed) if fc["wind"] is not None else None
-    ocean = build_ocean(fc["ocean"], grid) if fc["ocean"] is not None else None
-    air = (build_air_temperature(fc["air_temperature"], grid, t_end, seed)
+    wind = (build_wind(fc["wind"], grid, (x0, x1, y0, y1), draw_span_s(fc["wind"], "wind", duration_s), seed,
+                       crs, start) if fc["wind"] is not None else None)
+    ocean = build_ocean(fc["ocean"], grid, crs, start) if fc["ocean"] is not None else None
+    air = (build_air_temperature(fc["air_temperature"], grid,
+                                 draw_span_s(fc["air_temperature"], "air_temperature", duration_s), seed, crs, start)
            if fc["air_temperature"] is not None else None)
     # validate coverage of every field over the run before any stepping
     from forcing.base import Forcing
@@ -256,8 +489,13 @@ def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
         from ..params import DragParams
 
         cor = fc["coriolis"] or {}
+        lat = cor.get("latitude_deg")
         parts["forces"] = standard_forces(wind=wind, current=ocean, drag=DragParams(**(fc["drag"] or {})),
-                                          coriolis_f=cor.get("f_s"), latitude_deg=cor.get("latitude_deg"))
+                                          coriolis_f=cor.get("f_s"), latitude_deg=None if lat == "crs" else lat)
+        if lat == "crs":
+            from ..forces import Coriolis
+
+            parts["forces"].append(Coriolis(crs=crs))
     if cfg["thermo"]["enabled"]:
         from thermo.model_adapters import ThermoComponent
         from thermo.zero_layer import ThermoParams, ZeroLayerThermo

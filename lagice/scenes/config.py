@@ -36,6 +36,7 @@ SCHEMA = {
         "file": (str, None), "function": (str, None), "params": (dict, {}),
         "resolution_m": (EXPR, None), "exterior_tag": (str, "coast"),
         "segments": (dict, {}), "rotate_deg": (NUM, 0.0), "renumber": (bool, False),
+        "crs": (str, "EPSG:3413"), "file_crs": (str, None),
     },
     "initial": {
         "thickness_m": (EXPR, 1.0), "concentration": (EXPR, 1.0), "damage": (EXPR, 0.0),
@@ -60,7 +61,7 @@ SCHEMA = {
     },
     "boundary": {"*": {"u": (EXPR, None), "v": (EXPR, None)}},
     "forcing": {
-        "grid_spacing_m": (NUM, 25e3), "crs": (str, "EPSG:3413"),
+        "grid_spacing_m": (NUM, 25e3),
         "wind": (dict, None), "ocean": (dict, None), "air_temperature": (dict, None),
         "coriolis": (dict, None), "drag": (dict, None),
     },
@@ -70,10 +71,17 @@ SCHEMA = {
     "remesh": {"enabled": (bool, False), "min_angle_deg": (NUM, 10.0), "params": (dict, {})},
     "run": {"duration": (EXPR, None), "seed": (int, 0), "progress": (bool, True),
             "start_date": (str, "2000-01-01 00:00:00"), "max_speed_m_s": (NUM, 10.0)},
-    "output": {"every": (EXPR, "1d"), "vtu": (bool, False), "crs_epsg": (int, 3413), "plot": ((bool, str), True),
+    "output": {"every": (EXPR, "1d"), "vtu": (bool, False), "plot": ((bool, str), True),
                "grid_resolution_m": (NUM, None), "timeseries": (dict, None)},
-    "checkpoint": {"every": (EXPR, None), "keep": (int, 3)},
+    "checkpoint": {"every": (EXPR, None), "every_wall": (EXPR, None), "keep": (int, 3)},
     "drifters": {"positions_m": (list, None), "count": (int, 0)},
+}
+
+#: keys that were removed, with what replaces them (an error says so)
+REMOVED = {
+    "forcing.crs": "the scene has one CRS: set [domain] crs (it is used for the domain, the forcing files, "
+                   "the outputs and Coriolis)",
+    "output.crs_epsg": "outputs are labelled with the scene's one CRS: set [domain] crs (e.g. 'EPSG:3413')",
 }
 
 #: rheology keys of each law (``[rheology] law``); keys of the other law are not used
@@ -143,6 +151,8 @@ def _validate_table(prefix, given, spec, source):
     res = {}
     for key, val in given.items():
         if key not in spec:
+            if f"{prefix}.{key}" in REMOVED:
+                raise ConfigError(f"{source}: {prefix}.{key} is no longer a setting: {REMOVED[prefix + '.' + key]}")
             raise ConfigError(f"{source}: unknown key {prefix}.{key}; known keys of [{prefix}]: {sorted(spec)}")
         _check_type(f"{source}: {prefix}.{key}", val, spec[key][0])
         res[key] = val
@@ -238,7 +248,8 @@ def physics_view(cfg: dict) -> dict:
     but :data:`NON_PHYSICS` (run length, output and checkpoint schedules, names).
     Forcing generators whose records depend on the run length (``random`` and
     ``cyclones`` winds, ``synthetic`` air temperature draw their schedule over the
-    whole run) keep ``run.duration`` in the view."""
+    whole run, :func:`length_dependent_forcing`) keep ``run.duration`` in the view,
+    unless their ``horizon`` is set."""
     out = {}
     for table, val in cfg.items():
         if table.startswith("_"):
@@ -247,24 +258,57 @@ def physics_view(cfg: dict) -> dict:
         if drop is None:
             continue
         out[table] = {k: v for k, v in val.items() if k not in drop} if isinstance(val, dict) else val
-    fc = cfg.get("forcing", {})
-    by_length = (((fc.get("wind") or {}).get("kind") in ("random", "cyclones"))
-                 or ((fc.get("air_temperature") or {}).get("kind") == "synthetic"))
-    if by_length:
+    if length_dependent_forcing(cfg):
         out["run"]["duration"] = cfg["run"]["duration"]
     return out
 
 
+#: forcing generators that draw their records over the whole run: ``(table, kind)``
+LENGTH_DEPENDENT = (("wind", "random"), ("wind", "cyclones"), ("air_temperature", "synthetic"))
+
+
+def length_dependent_forcing(cfg: dict) -> list[str]:
+    """The ``[forcing.*]`` tables whose records depend on ``run.duration``: random
+    generators drawing their schedule over ``[0, run.duration]`` (cyclone birth
+    times, wind and temperature sequences), unless ``horizon`` fixes the span they
+    are drawn over (then the run can be extended up to the horizon)."""
+    fc = cfg.get("forcing", {})
+    out = []
+    for table, kind in LENGTH_DEPENDENT:
+        t = fc.get(table) or {}
+        if t.get("kind") == kind and t.get("horizon") is None:
+            out.append(f"forcing.{table}")
+    return out
+
+
 def override_config(cfg: dict, overrides) -> dict:
-    """A validated configuration with ``overrides`` (``{"table.key": value}`` or
-    ``["table.key=value", ...]``) applied and validated again, e.g.
-    ``{"solver.device": "cuda"}`` when resuming a checkpoint on another device
-    (``Simulation.resume(path, overrides=...)`` passes them to the builder)."""
-    raw = copy.deepcopy({k: v for k, v in cfg.items() if not k.startswith("_")})
-    source = raw["scene"].pop("source", None)
-    out = validate(apply_overrides(raw, overrides), source or "<config>")
-    if source is not None:
-        out["scene"]["source"] = source
+    """A validated config (e.g. from a checkpoint) with ``overrides`` (``{"table.key":
+    value}`` or ``["table.key=value", ...]``) applied and validated again, e.g. a
+    longer ``run.duration`` to extend a run, or ``{"solver.device": "cuda"}`` when
+    resuming on another device; private keys (``_parent``) and the scene's name and
+    source are kept."""
+    raw = {k: copy.deepcopy(v) for k, v in cfg.items() if not k.startswith("_")}
+    scene = dict(raw.get("scene", {}))
+    source = scene.pop("source", "<checkpoint>")
+    raw["scene"] = scene
+    raw = apply_overrides(raw, overrides or {})
+    out = validate(raw, "--set")
+    out["scene"]["source"] = source
+    for k, v in cfg.items():
+        if k.startswith("_"):
+            out[k] = copy.deepcopy(v)
+    return out
+
+
+def changed_keys(a: dict, b: dict, prefix: str = "") -> list[str]:
+    """Dotted keys whose values differ between two (nested) configs."""
+    out = []
+    for k in sorted(set(a) | set(b), key=str):
+        va, vb = a.get(k), b.get(k)
+        if isinstance(va, dict) and isinstance(vb, dict):
+            out += changed_keys(va, vb, f"{prefix}{k}.")
+        elif va != vb:
+            out.append(f"{prefix}{k}")
     return out
 
 

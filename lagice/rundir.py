@@ -1,0 +1,151 @@
+"""Run folders: one run per folder, never mixed.
+
+* A new run gets a folder that cannot collide: ``runs/SCENE-YYYYmmdd-HHMMSS``
+  (:func:`new_run_dir`, suffixed ``-2``, ``-3`` ... when that exists), and the
+  link ``runs/SCENE-latest`` points to the newest one (:func:`update_latest`).
+* An explicit folder must be empty or absent (:func:`claim`), unless the user
+  asks to ``overwrite`` it (its contents are removed first, and only when it is a
+  lagice run folder) or to ``resume`` the run in it.
+* :func:`prepare` creates the folder, proves it is writable (writes the marker
+  file ``lagice_run.json``) before any mesh work, and removes the temporary files
+  a killed write left behind (checkpoints, snapshots, VTU, index files).
+"""
+from __future__ import annotations
+
+import json
+import logging
+import os
+import shutil
+import sys
+from datetime import UTC, datetime
+from pathlib import Path
+
+from .errors import ConfigError, OutputError
+
+MARKER = "lagice_run.json"
+#: what marks a folder as a lagice run folder (besides the marker)
+RUN_ENTRIES = ("snapshots", "checkpoints", "summary.json", "timeseries.nc")
+#: temporary files of the atomic writers (``*.tmp`` then ``os.replace``)
+TEMP_GLOBS = ("*.tmp", "snapshots/*.tmp", "snapshots/*.tmp.vtu", "checkpoints/*.tmp-*")
+
+log = logging.getLogger("lagice")
+
+
+def new_run_dir(scene: str, root="runs", now: datetime | None = None) -> Path:
+    """``root/SCENE-YYYYmmdd-HHMMSS`` (local time), suffixed ``-2``, ``-3``... if taken."""
+    stamp = (now or datetime.now()).strftime("%Y%m%d-%H%M%S")
+    base = Path(root) / f"{scene}-{stamp}"
+    p, k = base, 1
+    while p.exists() or p.is_symlink():
+        k += 1
+        p = base.with_name(f"{base.name}-{k}")
+    return p
+
+
+def latest_link(scene: str, root="runs") -> Path:
+    return Path(root) / f"{scene}-latest"
+
+
+def update_latest(run_dir: Path, scene: str) -> Path | None:
+    """Point ``runs/SCENE-latest`` (a relative symlink next to ``run_dir``) at ``run_dir``;
+    None when the file system has no symlinks (the run is unaffected)."""
+    run_dir = Path(run_dir)
+    link = latest_link(scene, run_dir.parent)
+    tmp = link.with_name(f".{link.name}.tmp-{os.getpid()}")
+    try:
+        tmp.unlink(missing_ok=True)
+        os.symlink(run_dir.name, tmp, target_is_directory=True)
+        os.replace(tmp, link)
+    except OSError as exc:
+        log.warning(f"could not update the link {link} -> {run_dir.name} ({exc.strerror})")
+        return None
+    return link
+
+
+def is_run_dir(path) -> bool:
+    p = Path(path)
+    return (p / MARKER).exists() or any((p / e).exists() for e in RUN_ENTRIES)
+
+
+def is_empty(path) -> bool:
+    p = Path(path)
+    return not p.exists() or (p.is_dir() and not any(p.iterdir()))
+
+
+def claim(out, overwrite: bool = False) -> Path:
+    """Make sure a new run may write into ``out``: absent or empty, or (``overwrite``)
+    a lagice run folder whose contents are removed now. ConfigError otherwise."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f"output folder {out} exists and is not a folder")
+    if is_empty(out):
+        return out
+    if not overwrite:
+        hint = "continue it with --resume, " if (out / "checkpoints").is_dir() else ""
+        raise ConfigError(f"output folder {out} is not empty (a previous run?); {hint}replace it with --overwrite, "
+                          f"or choose another --out (runs are never mixed in one folder)")
+    if not is_run_dir(out):
+        raise ConfigError(f"output folder {out} is not empty and is not a lagice run folder (no {MARKER}, "
+                          f"snapshots/ or checkpoints/); refusing to delete it with --overwrite")
+    for child in out.iterdir():
+        try:
+            if child.is_dir() and not child.is_symlink():
+                shutil.rmtree(child)
+            else:
+                child.unlink()
+        except OSError as exc:
+            raise OutputError(f"--overwrite: cannot remove {child}: {exc.strerror}") from None
+    log.info(f"cleared {out}/ (--overwrite)")
+    return out
+
+
+def prepare(out, config: dict | None = None) -> list[Path]:
+    """Create ``out``, prove it writable by writing the marker ``lagice_run.json``
+    (scene, lagice version, command, parent checkpoint of a branch), and remove stale
+    temporary files of killed writes. Raises OutputError naming the folder."""
+    out = Path(out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"cannot create the output folder {out}: {exc.strerror}") from None
+    removed = clean_stale(out)
+    marker = out / MARKER
+    if config is not None or not marker.exists():
+        from . import __version__
+
+        cfg = config or {}
+        info = {"scene": cfg.get("scene", {}).get("name"), "source": cfg.get("scene", {}).get("source"),
+                "lagice_version": __version__, "written": datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
+                "command": " ".join(sys.argv) if sys.argv and sys.argv[0] else None}
+        if cfg.get("_parent"):
+            info["parent"] = cfg["_parent"]
+        tmp = marker.with_name(f"{MARKER}.tmp")
+        try:
+            tmp.write_text(json.dumps(info, indent=1, default=str))
+            os.replace(tmp, marker)
+        except OSError as exc:
+            try:
+                tmp.unlink(missing_ok=True)
+            except OSError:
+                pass
+            raise OutputError(f"cannot write in the output folder {out}: {exc.strerror}") from None
+    return removed
+
+
+def clean_stale(out) -> list[Path]:
+    """Remove the temporary files killed writes left in the run folder ``out``."""
+    from .io.checkpoint import clean_stale_temporaries
+
+    out = Path(out)
+    removed = clean_stale_temporaries(out / "checkpoints")
+    for pattern in TEMP_GLOBS[:-1]:
+        for p in out.glob(pattern):
+            if p.is_file():
+                try:
+                    p.unlink()
+                    removed.append(p)
+                except OSError:
+                    pass
+    for p in removed:
+        log.info(f"removed a temporary file left by an interrupted write: {p}")
+    return removed
