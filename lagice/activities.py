@@ -178,7 +178,7 @@ class Progress(Activity):
     this session's steps); otherwise (a log file, a batch queue) a line every
     ``every`` of wall time with the rate in simulated days per wall hour, also over
     this session's steps only, so both are right after a resume. Silent when the
-    ``lagice`` logger is above INFO (``--log-level warning``)."""
+    ``lagice`` logger's level is set above INFO (``--log-level warning``)."""
 
     name = "progress"
     at_end = True
@@ -194,7 +194,8 @@ class Progress(Activity):
         self._bar = None
 
     def _quiet(self) -> bool:
-        return logging.getLogger("lagice").getEffectiveLevel() > logging.INFO
+        level = logging.getLogger("lagice").level  # set by `--log-level` (the API default NOTSET prints)
+        return level != logging.NOTSET and level > logging.INFO
 
     def initialize(self, sim):
         stream = self.stream or sys.stdout

@@ -246,6 +246,9 @@ def _diagnose(args) -> int:
     if len(index) < 2:
         raise LagiceError(f"{snaps}: need two snapshots to diagnose deformation (found {len(index)})")
     k = min(args.window_steps, len(index) - 1)
+    if k < args.window_steps:
+        log.warning(f"--window-steps {args.window_steps}: the run has {len(index)} snapshots; the window was "
+                    f"shortened to {k} snapshot interval(s)")
     w = load_window(snaps, index[-1 - k]["time_s"], index[-1]["time_s"])
     if w["remesh_events"]:
         print(f"  {w['remesh_events']} remesh event(s) in the window: nodes followed by node_id, "
@@ -267,6 +270,13 @@ def _diagnose(args) -> int:
                 "localisation_half_shear_area_fraction", "shear_divergence_r2"):
         if key in res:
             print(f"  {key}: {res[key]}")
+    from .diagnostics.statistics import tail_fit_quality  # goodness of fit, power law vs lognormal
+    from .diagnostics.strain import lagrangian_velocity_gradients
+
+    rates = lagrangian_velocity_gradients(xy0, xy1, tri, dt, res.get("geometry", "mid"))
+    for name, vals in (("shear", rates.shear_s), ("|divergence|", abs(rates.divergence_s))):
+        for w in tail_fit_quality(vals).warnings(f"PDF tail of {name}"):
+            log.warning(w)
     return 0
 
 

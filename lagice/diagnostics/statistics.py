@@ -271,3 +271,150 @@ def shear_divergence_r2(shear_s, divergence_s, weights=None):
     if sxx <= (tiny * np.max(np.abs(x))) ** 2 or syy <= (tiny * np.max(np.abs(y))) ** 2:
         return float("nan")
     return float(sxy * sxy / (sxx * syy))
+
+
+@dataclass(frozen=True)
+class TailFitQuality:
+    """How well a power-law tail fits (Clauset, Shalizi & Newman 2009, "Power-law
+    distributions in empirical data", SIAM Review 51, §4 and §5).
+
+    Attributes
+    ----------
+    exponent, x_min, n_tail, ks_distance :
+        The fit judged (γ of the density, threshold, tail size, KS distance D).
+    gof_p : float
+        Goodness-of-fit p-value: the fraction of synthetic samples drawn from the
+        fitted model (power law above x_min, the data below it) whose own fit has a
+        KS distance ≥ D (§4.1, semi-parametric bootstrap, x_min searched again in
+        each). p ≤ 0.1 rules the power law out.
+    n_bootstrap : int
+        Synthetic samples used (resolution of ``gof_p``: 1/n_bootstrap).
+    lognormal_mu, lognormal_sigma : float
+        Maximum-likelihood lognormal truncated at x_min (parameters of ln x).
+    loglikelihood_ratio : float
+        R = Σ ln p_powerlaw(x_i) − ln p_lognormal(x_i) over the tail (§5, Vuong's
+        test): R > 0 favours the power law, R < 0 the lognormal.
+    loglikelihood_ratio_p : float
+        Two-sided significance of the sign of R: erfc(|R| / (σ √(2n))), σ the
+        standard deviation of the pointwise differences. p ≥ 0.1: the data cannot
+        tell the two apart.
+    """
+
+    exponent: float
+    x_min: float
+    n_tail: int
+    ks_distance: float
+    gof_p: float
+    n_bootstrap: int
+    lognormal_mu: float
+    lognormal_sigma: float
+    loglikelihood_ratio: float
+    loglikelihood_ratio_p: float
+
+    def warnings(self, name: str = "tail", gof_threshold: float = 0.1, lr_threshold: float = 0.1) -> list[str]:
+        """Plain-language warnings when the power law is ruled out (``gof_p`` ≤
+        ``gof_threshold``) or a lognormal fits significantly better (R < 0 with
+        p < ``lr_threshold``); empty when the fit holds up."""
+        out = []
+        if not np.isfinite(self.exponent):
+            return [f"{name}: no power-law tail could be fitted (too few positive values)"]
+        if np.isfinite(self.gof_p) and self.gof_p <= gof_threshold:
+            out.append(f"{name}: the power-law tail (exponent {self.exponent:.2f}, x_min {self.x_min:.3g}) fits "
+                       f"poorly: goodness-of-fit p = {self.gof_p:.2f} <= {gof_threshold:g} ({self.n_bootstrap} "
+                       f"synthetic samples; KS distance {self.ks_distance:.3f})")
+        if (np.isfinite(self.loglikelihood_ratio) and self.loglikelihood_ratio < 0
+                and self.loglikelihood_ratio_p < lr_threshold):
+            out.append(f"{name}: a lognormal fits the tail better than the power law (log-likelihood ratio "
+                       f"R = {self.loglikelihood_ratio:.1f}, p = {self.loglikelihood_ratio_p:.2g}); the exponent "
+                       f"{self.exponent:.2f} describes a curved tail")
+        return out
+
+
+def _lognormal_tail_fit(log_tail, log_min):
+    """ML (μ, σ) of a lognormal truncated at x_min, and the pointwise log densities."""
+    from scipy.optimize import minimize
+    from scipy.special import log_ndtr
+
+    n = log_tail.size
+
+    def logpdf(mu, sigma):
+        z = (log_tail - mu) / sigma
+        return (-log_tail - np.log(sigma) - 0.5 * np.log(2 * np.pi) - 0.5 * z * z
+                - log_ndtr(-(log_min - mu) / sigma))
+
+    def nll(p):
+        mu, log_sigma = p
+        return -np.sum(logpdf(mu, np.exp(log_sigma))) / n
+
+    m0, s0 = float(np.mean(log_tail)), float(max(np.std(log_tail), 1e-3))
+    best = None
+    for mu0 in (m0, log_min, m0 - 2 * s0):  # the truncated likelihood can have a flat ridge: several starts
+        r = minimize(nll, (mu0, np.log(s0)), method="Nelder-Mead",
+                     options={"xatol": 1e-8, "fatol": 1e-12, "maxiter": 4000})
+        if best is None or r.fun < best.fun:
+            best = r
+    mu, sigma = float(best.x[0]), float(np.exp(best.x[1]))
+    return mu, sigma, logpdf(mu, sigma)
+
+
+def compare_lognormal(values, x_min):
+    """Vuong's likelihood-ratio test of the power-law tail against a lognormal
+    truncated at ``x_min`` (Clauset et al. 2009 §5): ``(R, p, mu, sigma)``, R > 0
+    favouring the power law; NaN when the tail has fewer than 2 values."""
+    from scipy.special import erfc
+
+    x = np.asarray(values, dtype=np.float64).ravel()
+    x = np.sort(x[np.isfinite(x) & (x >= x_min) & (x > 0)])
+    nan = float("nan")
+    if x.size < 2:
+        return nan, nan, nan, nan
+    lx, lm = np.log(x), np.log(x_min)
+    gamma = 1.0 + x.size / (np.sum(lx) - x.size * lm)
+    lp_pl = np.log(gamma - 1.0) - lm - gamma * (lx - lm)
+    mu, sigma, lp_ln = _lognormal_tail_fit(lx, lm)
+    d = lp_pl - lp_ln
+    r = float(np.sum(d))
+    s = float(np.std(d))
+    p = float(erfc(abs(r) / (s * np.sqrt(2.0 * x.size)))) if s > 0 else nan
+    return r, p, mu, sigma
+
+
+def tail_fit_quality(values, x_min=None, min_tail=50, n_bootstrap=50, seed=0,
+                     bootstrap_candidates=30) -> TailFitQuality:
+    """Goodness of fit and likelihood-ratio test of the power-law tail of ``values``
+    (Clauset et al. 2009 §4.1 and §5; the tests of the ``powerlaw`` package).
+
+    The tail is fitted as :func:`fit_power_law_tail` does (``x_min`` searched by KS
+    distance unless given). The goodness-of-fit p-value uses ``n_bootstrap``
+    synthetic samples of the same size (deterministic from ``seed``): each value is,
+    with probability n_tail/n, drawn from the fitted power law, else resampled from
+    the data below x_min; each sample is fitted the same way, its x_min searched
+    among ``bootstrap_candidates`` quantile-spaced values (the data's own fit uses
+    200). Cost: ``n_bootstrap`` tail fits, at most about 3 s for 2·10⁴ values and 50 samples.
+    The likelihood-ratio test agrees with ``powerlaw.Fit(values, xmin=x_min)
+    .distribution_compare("power_law", "lognormal")`` (tests/test_diagnostics_statistics.py).
+    """
+    x = np.asarray(values, dtype=np.float64).ravel()
+    x = x[np.isfinite(x) & (x > 0)]
+    nb = int(check_range("n_bootstrap", n_bootstrap, 0, None))
+    fit = fit_power_law_tail(x, x_min, min_tail)
+    nan = float("nan")
+    if not np.isfinite(fit.exponent):
+        return TailFitQuality(fit.exponent, fit.x_min, fit.n_tail, fit.ks_distance, nan, 0, nan, nan, nan, nan)
+    r, p_lr, mu, sigma = compare_lognormal(x, fit.x_min)
+    gof = nan
+    if nb > 0:
+        rng = np.random.default_rng(seed)
+        below = x[x < fit.x_min]
+        frac_tail = fit.n_tail / x.size
+        exceed = 0
+        for _ in range(nb):  # over bootstrap samples (n_bootstrap), each one vectorised
+            k = rng.binomial(x.size, frac_tail) if below.size else x.size
+            u = rng.random(k)
+            synth = np.concatenate([fit.x_min * (1.0 - u) ** (-1.0 / (fit.exponent - 1.0)),
+                                    rng.choice(below, x.size - k) if below.size else np.zeros(0)])
+            f = fit_power_law_tail(synth, fit.x_min if x_min is not None else None, min_tail, bootstrap_candidates)
+            if np.isfinite(f.ks_distance) and f.ks_distance >= fit.ks_distance:
+                exceed += 1
+        gof = exceed / nb
+    return TailFitQuality(fit.exponent, fit.x_min, fit.n_tail, fit.ks_distance, gof, nb, mu, sigma, r, p_lr)

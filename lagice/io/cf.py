@@ -117,4 +117,10 @@ class atomic_write_errors:
         if isinstance(exc, LagiceError) or not isinstance(exc, Exception):
             return False
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else f"{type(exc).__name__}: {exc}"
-        raise OutputError(f"cannot write {self.path}: {reason}") from exc
+        try:
+            st = os.statvfs(self.path.parent)
+            free = f"; {st.f_bavail * st.f_frsize / 1e9:.3g} GB free there"
+        except OSError:
+            free = ""
+        raise OutputError(f"cannot write {self.path}: {reason} (disk full, quota or read-only folder?{free})"
+                          ) from exc

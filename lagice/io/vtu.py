@@ -1,7 +1,8 @@
 """VTU output for ParaView: one ``snapshot_SSSSSSSS.vtu`` per snapshot with every
-snapshot field and diagnostic (the field registry's), and a ``snapshots.pvd``
-collection that lists them with their simulated times [s], so ParaView plays the
-run as a time series (also across remeshing: each file carries its own mesh)."""
+snapshot field and diagnostic (the field registry's) and its simulated time [s]
+(field data ``TimeValue``), and a ``snapshots.pvd`` collection that lists them
+with their times, so ParaView plays the run as a time series (also across
+remeshing: each file carries its own mesh)."""
 from __future__ import annotations
 
 import os
@@ -35,6 +36,18 @@ def vtu_arrays(model) -> tuple[dict, dict]:
     return point, cell
 
 
+def _add_time(path: Path, time_s: float) -> None:
+    """Insert the simulated time [s] as VTK field data ``TimeValue`` (the name ParaView
+    reads as the time of a dataset; meshio does not write field data to VTU)."""
+    text = path.read_text()
+    tag = "<UnstructuredGrid>"
+    if tag not in text:  # pragma: no cover - meshio's layout
+        raise RuntimeError(f"{path}: no {tag} element to add the time to")
+    field = (f'{tag}\n<FieldData>\n<DataArray type="Float64" Name="TimeValue" NumberOfTuples="1" '
+             f'format="ascii">{time_s!r}</DataArray>\n</FieldData>')
+    path.write_text(text.replace(tag, field, 1))
+
+
 class VTUWriter:
     """Writes ``.vtu`` files and keeps the ``.pvd`` time collection up to date."""
 
@@ -51,13 +64,12 @@ class VTUWriter:
         path = self.dir / f"snapshot_{step:08d}.vtu"
         point, cell = vtu_arrays(model)
         pts = np.column_stack([mesh.nodes, np.zeros(mesh.n_nodes)])
-        t = np.array([model.clock.time_s])
         m = meshio.Mesh(pts, [("triangle", mesh.triangles)], point_data=point,
-                        cell_data={k: [v] for k, v in cell.items()},
-                        field_data={"TimeValue": t, "TIME": t})  # TimeValue: the name ParaView reads
+                        cell_data={k: [v] for k, v in cell.items()})
         tmp = path.with_suffix(".tmp.vtu")
         with atomic_write_errors(path, tmp):
             m.write(tmp)
+            _add_time(tmp, model.clock.time_s)
             os.replace(tmp, path)
         self._collection_add(step, model.clock.time_s, path.name)
         return path

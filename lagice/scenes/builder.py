@@ -27,6 +27,7 @@ from ..state import IceState
 from . import components
 from .config import (
     RHEOLOGY_KEYS,
+    ROOT,
     load_scene,
     override_config,
     physics_view,
@@ -36,7 +37,6 @@ from .config import (
 )
 
 BUILDER = "lagice.scenes.builder:build_simulation"
-ROOT = Path(__file__).resolve().parents[2]
 
 
 # -- domain ------------------------------------------------------------------------

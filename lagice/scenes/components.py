@@ -197,6 +197,8 @@ def validate(cfg: dict, duration_s: float) -> None:
             continue
         kind = _kind(t, key, kinds)
         _generator_table(t, key, kind)
+        if kind == "rest" and set(t) != {"kind"}:
+            raise ConfigError(f"unknown key forcing.{key}.{sorted(set(t) - {'kind'})[0]}; kind 'rest' takes no keys")
         if kind == "function":
             _function_field(t, key)
         elif kind == "expression":
@@ -347,7 +349,7 @@ def _file_kw(t: dict, key: str, funcs, crs, start_date) -> dict:
     if isinstance(path, str):
         from pathlib import Path
 
-        from .builder import ROOT
+        from .config import ROOT
 
         p = Path(path)
         if not p.is_absolute() and not p.exists() and (ROOT / p).exists():

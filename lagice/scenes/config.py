@@ -100,7 +100,8 @@ NON_PHYSICS = {"scene": ("name", "description", "extends", "source"), "run": ("d
                # equal to round-off (docs/gpu.md), so a checkpoint resumes on another device
                "solver": ("device", "parallel")}
 
-SCENE_DIR = Path(__file__).resolve().parents[2] / "examples"
+ROOT = Path(__file__).resolve().parents[2]  # relative data paths of scenes are tried here too
+SCENE_DIR = ROOT / "examples"
 _MODFUNC = re.compile(r"^[A-Za-z_][\w.]*:[A-Za-z_]\w*$")
 
 

@@ -1,0 +1,606 @@
+"""The run workflow a modeller relies on (issue 13), through the CLI as a real
+subprocess writing real files: run folders never mixed, extend and branch bit for
+bit, clean stops on SIGTERM, every bad input a one-line error (exit 2) before any
+work, dates and projections that agree, CF-clean outputs with provenance."""
+import hashlib
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# a small moving-mesh run with remeshing and two drifters (60 steps, 4 mesh epochs)
+BASE = ["run.duration=6000.0", "solver.dt=100.0", "output.every=1500.0", "checkpoint.every=3000.0",
+        "domain.resolution_m=25e3", "run.progress=false", "output.plot=false",
+        'boundary.top.u="20.0*minimum(1.0, t/600.0)"', "lagrangian.enabled=true", "remesh.enabled=true",
+        "drifters.positions_m=[[50e3, 100e3], [150e3, 120e3]]", "run.max_speed_m_s=50.0",
+        "output.grid_resolution_m=30e3", "output.vtu=true"]
+# a quick fixed-mesh run (validation tests: they fail before any work)
+QUICK = ["run.duration=800.0", "solver.dt=40.0", "output.every=400.0", "domain.resolution_m=50e3",
+         "run.progress=false", "output.plot=false"]
+
+
+def run_cli(*args, sets=(), cwd=None, env=None, timeout=600, **kw):
+    cmd = [sys.executable, "-m", "lagice.cli", *map(str, args)]
+    for s in sets:
+        cmd += ["--set", s]
+    e = dict(os.environ, **(env or {}))
+    return subprocess.run(cmd, capture_output=True, text=True, cwd=cwd, env=e, timeout=timeout, **kw)
+
+
+def one_line_error(r, *fragments, strict=True):
+    """Exit 2, one ``lagice: error:`` line on stderr naming every fragment, no traceback
+    (``strict``: nothing else on stderr)."""
+    assert r.returncode == 2, (r.returncode, r.stdout[-2000:], r.stderr[-3000:])
+    assert "Traceback" not in r.stderr, r.stderr
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
+    if not strict:  # third-party libraries may warn on stderr too (numba cache writes under a size limit)
+        lines = [ln for ln in lines if ln.startswith("lagice: error: ")]
+    assert len(lines) == 1 and lines[0].startswith("lagice: error: "), r.stderr
+    for f in fragments:
+        assert f in lines[0], (f, lines[0])
+    return lines[0]
+
+
+def last_snapshot(run_dir):
+    idx = json.loads((Path(run_dir) / "snapshots" / "index.json").read_text())
+    return xr.load_dataset(Path(run_dir) / "snapshots" / idx[-1]["file"]), idx
+
+
+STATE_VARS = ("mesh_node_x", "mesh_node_y", "mesh_face_nodes", "node_id", "thickness", "concentration", "damage",
+              "cohesion", "stress_xx", "stress_yy", "stress_xy", "velocity_x", "velocity_y")
+
+
+def assert_same_state(a_dir, b_dir):
+    """The last snapshots (every variable) and the drifter tracks are equal bit for bit."""
+    a, ia = last_snapshot(a_dir)
+    b, ib = last_snapshot(b_dir)
+    assert ia[-1]["step"] == ib[-1]["step"] and ia[-1]["mesh_epoch"] == ib[-1]["mesh_epoch"]
+    assert set(a.variables) == set(b.variables) and set(STATE_VARS) <= set(a.variables)
+    for v in a.variables:
+        assert np.array_equal(a[v].values, b[v].values), f"{v} differs"
+    ta = xr.load_dataset(Path(a_dir) / "drifters.nc", decode_times=False)
+    tb = xr.load_dataset(Path(b_dir) / "drifters.nc", decode_times=False)
+    assert np.array_equal(ta["x"].values, tb["x"].values) and np.array_equal(ta["y"].values, tb["y"].values)
+
+
+@pytest.fixture(scope="module")
+def base_run(tmp_path_factory):
+    """The straight run every extend/branch/stop test compares with, bit for bit."""
+    out = tmp_path_factory.mktemp("base") / "run"
+    r = run_cli("run", "shear_box", "--out", out, sets=BASE)
+    assert r.returncode == 0, r.stderr[-3000:]
+    idx = json.loads((out / "snapshots" / "index.json").read_text())
+    assert len({e["mesh_epoch"] for e in idx}) > 1, "the base run must remesh (mesh epochs) to mean something"
+    return out
+
+
+# -- 1. run folders are never mixed ------------------------------------------------
+def test_output_folder_reuse_is_refused(tmp_path):
+    out = tmp_path / "run"
+    assert run_cli("run", "shear_box", "--out", out, sets=QUICK).returncode == 0
+    first = (out / "snapshots" / "index.json").read_text()
+    r = run_cli("run", "shear_box", "--out", out, sets=QUICK)
+    one_line_error(r, str(out), "not empty", "--overwrite", "--resume")
+    assert (out / "snapshots" / "index.json").read_text() == first, "the refused run touched the folder"
+    (out / "stray.txt").write_text("from the previous run")
+    r = run_cli("run", "shear_box", "--out", out, "--overwrite", sets=[*QUICK, "run.seed=5"])
+    assert r.returncode == 0, r.stderr
+    assert not (out / "stray.txt").exists(), "--overwrite clears the folder first"
+    ds, _ = last_snapshot(out)
+    assert json.loads(ds.attrs["lagice_config"])["run"]["seed"] == 5
+    other = tmp_path / "notes"
+    other.mkdir()
+    (other / "thesis.tex").write_text("precious")
+    r = run_cli("run", "shear_box", "--out", other, "--overwrite", sets=QUICK)
+    one_line_error(r, "not a lagice run folder", "refusing")
+    assert (other / "thesis.tex").read_text() == "precious"
+
+
+def test_default_folders_never_collide_and_latest_follows(tmp_path):
+    a = run_cli("run", "shear_box", sets=QUICK, cwd=tmp_path)
+    b = run_cli("run", "shear_box", sets=QUICK, cwd=tmp_path)
+    assert a.returncode == 0 and b.returncode == 0, a.stderr + b.stderr
+    runs = sorted(p for p in (tmp_path / "runs").iterdir() if not p.is_symlink())
+    assert len(runs) == 2 and all(p.name.startswith("shear_box-20") for p in runs)
+    link = tmp_path / "runs" / "shear_box-latest"
+    assert link.is_symlink() and link.resolve().parent == (tmp_path / "runs").resolve()
+    assert link.resolve().name in b.stdout and link.resolve().name not in a.stdout, "latest is the newest run"
+    assert (link / "snapshots" / "index.json").exists()
+
+
+# -- 2. extend and branch ------------------------------------------------------------
+@pytest.mark.slow
+def test_extend_is_bit_identical_and_bookkeeping_is_whole_run(base_run, tmp_path):
+    part = tmp_path / "part"
+    r = run_cli("run", "shear_box", "--out", part, sets=[s for s in BASE if not s.startswith("run.duration")]
+                + ["run.duration=3000.0"])
+    assert r.returncode == 0, r.stderr
+    s1 = json.loads((part / "summary.json").read_text())
+    # resuming a finished run changes nothing and says how to extend it
+    before = (part / "summary.json").read_bytes()
+    r = run_cli("resume", part)
+    assert r.returncode == 0 and "already finished" in r.stdout and "run.duration" in r.stdout, r.stdout
+    assert (part / "summary.json").read_bytes() == before
+    # a killed write left temporaries behind: they are cleaned when the run starts again
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                          text=True).stdout.strip()
+    stale = [part / "checkpoints" / f"checkpoint_0000000031.npz.tmp-{dead}", part / "snapshots" / "snapshot_x.nc.tmp"]
+    for p in stale:
+        p.write_bytes(b"half a file")
+    # a physics change is refused on resume, naming the key
+    r = run_cli("resume", part, sets=["run.duration=6000.0", "rheology.alpha=5.0"])
+    one_line_error(r, "rheology.alpha", "lagice branch")
+    r = run_cli("resume", part, sets=["run.duration=6000.0"])
+    assert r.returncode == 0, r.stderr
+    assert not any(p.exists() for p in stale), "stale temporary files were left behind"
+    assert_same_state(base_run, part)
+    s2 = json.loads((part / "summary.json").read_text())
+    assert s2["steps"] == 60 and s2["finished"] and s2["wall_s"] > s1["wall_s"], "wall time covers the whole run"
+    assert s2["timings"]["dynamics"] > s1["timings"]["dynamics"]
+
+
+@pytest.mark.slow
+def test_branch_same_physics_is_bit_identical_and_records_its_parent(base_run, tmp_path):
+    parent = base_run / "checkpoints" / "checkpoint_0000000030.npz"
+    assert parent.exists()
+    sha = hashlib.sha256(parent.read_bytes()).hexdigest()
+    same = tmp_path / "same"
+    r = run_cli("branch", parent, "--out", same, sets=["output.every=1000.0"])
+    assert r.returncode == 0, r.stderr
+    assert_same_state(base_run, same)
+    ds, idx = last_snapshot(same)
+    assert idx[0]["step"] == 30, "the branch starts with a snapshot of its parent's state"
+    assert ds.attrs["lagice_parent_checkpoint"] == str(parent.resolve())
+    assert ds.attrs["lagice_parent_checkpoint_sha256"] == sha
+    assert json.loads((same / "lagice_run.json").read_text())["parent"]["sha256"] == sha
+    info = run_cli("info", sorted((same / "checkpoints").glob("*.npz"))[-1])
+    assert info.returncode == 0 and sha in info.stdout
+    # changed physics: explicit, allowed, and it changes the trajectory
+    soft = tmp_path / "soft"
+    r = run_cli("branch", parent, "--out", soft, sets=["rheology.alpha=5.0"])
+    assert r.returncode == 0, r.stderr
+    a, _ = last_snapshot(base_run)
+    b, _ = last_snapshot(soft)
+    assert json.loads(b.attrs["lagice_config"])["rheology"]["alpha"] == 5.0
+    assert a["mesh_face_nodes"].shape != b["mesh_face_nodes"].shape or not np.array_equal(a["damage"], b["damage"])
+    r = run_cli("branch", parent, "--out", tmp_path / "geo", sets=["domain.resolution_m=10e3"])
+    one_line_error(r, "domain.resolution_m", "cannot change")
+
+
+def test_extending_length_dependent_forcing_is_refused(tmp_path):
+    """Random cyclones are drawn over the whole run: extending would change the forcing
+    already used, so it is refused with the two ways out."""
+    out = tmp_path / "wb"
+    r = run_cli("run", "winter_basin", "--out", out, sets=["run.duration=1h", "domain.resolution_m=100e3",
+                                                           "forcing.grid_spacing_m=100e3", "output.every=1h",
+                                                           "run.progress=false", "output.plot=false",
+                                                           "drifters.count=0"])
+    assert r.returncode == 0, r.stderr
+    r = run_cli("resume", out, sets=["run.duration=2h"])
+    one_line_error(r, "forcing.wind", "horizon", "lagice branch")
+
+
+# -- 3. stop cleanly -----------------------------------------------------------------
+@pytest.mark.slow
+def test_sigterm_writes_a_checkpoint_and_the_run_resumes_bit_identically(base_run, tmp_path):
+    hook = tmp_path / "slowhook.py"
+    hook.write_text(textwrap.dedent("""
+        import os, pathlib, time
+        from lagice.io.timeseries import diagnostic
+
+        @diagnostic("1", "pause (slows the run so the test can signal it mid-run)")
+        def pause(model):
+            if model.clock.iteration == 12:
+                pathlib.Path(os.environ["SENTINEL"]).touch()
+            if model.clock.iteration >= 12:
+                time.sleep(0.1)
+            return 0.0
+    """))
+    out = tmp_path / "stopped"
+    sentinel = tmp_path / "sentinel"
+    env = dict(os.environ, PYTHONPATH=f"{tmp_path}{os.pathsep}{os.environ.get('PYTHONPATH', '')}",
+               SENTINEL=str(sentinel))
+    cmd = [sys.executable, "-m", "lagice.cli", "run", "shear_box", "--out", str(out)]
+    for s in [*BASE, 'output.timeseries.every="1 steps"', 'output.timeseries.diagnostics=["slowhook:pause"]']:
+        cmd += ["--set", s]
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    t0 = time.time()
+    while not sentinel.exists():
+        assert p.poll() is None, p.communicate()
+        assert time.time() - t0 < 120
+        time.sleep(0.02)
+    p.send_signal(signal.SIGTERM)
+    stdout, stderr = p.communicate(timeout=120)
+    assert p.returncode == 0, stderr
+    assert "SIGTERM" in stdout and f"lagice resume {out}" in stdout, stdout
+    ck = sorted((out / "checkpoints").glob("checkpoint_*.npz"))
+    step = int(ck[-1].stem.split("_")[1])
+    assert 12 <= step < 60 and step != 30, "a checkpoint at the step the signal arrived"
+    assert not json.loads((out / "summary.json").read_text())["finished"]
+    r = run_cli("resume", out, env={"PYTHONPATH": env["PYTHONPATH"], "SENTINEL": str(tmp_path / "s2")})
+    assert r.returncode == 0, r.stderr
+    assert_same_state(base_run, out)
+    ts = xr.load_dataset(out / "timeseries.nc", decode_times=False)
+    assert np.array_equal(ts["time"].values, np.arange(0.0, 6001.0, 100.0)), "one time-series row per step"
+
+
+# -- 4. every bad input: one line, exit 2, before any work ---------------------------
+@pytest.mark.parametrize("setting,fragments", [
+    ('forcing.wind.n="six"', ["forcing.wind.n", "'six'", "integer"]),
+    ("forcing.wind.background_m_s=5", ["forcing.wind.background_m_s", "5", "[x, y] pair"]),
+    ("forcing.wind.max_speed_range_m_s=[30,10]", ["forcing.wind.max_speed_range_m_s", "[30, 10]", "low <= high"]),
+    ('forcing.air_temperature.mean_c="cold"', ["forcing.air_temperature.mean_c", "'cold'", "number"]),
+    ("remesh.params.foo=1", ["remesh.params.foo", "known keys"]),
+    ('remesh.params.rings="two"', ["remesh.params.rings", "'two'", "integer"]),
+    ("thermo.params.latent_heat_j_kg=-1.0", ["latent_heat_j_kg", "-1", "out of range"]),
+    ("drifters.count=-3", ["drifters.count", "-3", ">= 0"]),
+    ('forcing.crs="EPSG:3413"', ["forcing.crs", "[domain] crs"]),
+    ("output.crs_epsg=3031", ["output.crs_epsg", "[domain] crs"]),
+    ('forcing.ocean.colour="blue"', ["forcing.ocean.colour", "takes no keys"]),
+    ('forcing.wind={kind="file", path="no/such/era5.nc"}', ["no/such/era5.nc", "file not found"]),
+])
+def test_bad_setting_is_one_line_before_any_work(setting, fragments, tmp_path):
+    out = tmp_path / "run"
+    t0 = time.time()
+    r = run_cli("run", "winter_basin", "--out", out, sets=["run.duration=1h", setting])
+    one_line_error(r, *fragments)
+    assert not out.exists(), "nothing is written (and no mesh made) before the settings are checked"
+    assert time.time() - t0 < 60
+
+
+def test_info_on_a_file_that_is_not_netcdf(tmp_path):
+    bad = tmp_path / "notes.nc"
+    bad.write_text("not netCDF at all")
+    one_line_error(run_cli("info", bad), str(bad), "neither a netCDF file nor a lagice checkpoint")
+    one_line_error(run_cli("info", tmp_path), "is a folder")
+
+
+@pytest.fixture
+def read_only_dir(tmp_path):
+    d = tmp_path / "ro"
+    d.mkdir()
+    if os.geteuid() == 0:  # root ignores permissions: make the folder immutable instead
+        if subprocess.run(["chattr", "+i", str(d)], capture_output=True).returncode != 0:
+            pytest.skip("running as root without chattr: cannot make a read-only folder")
+        yield d
+        subprocess.run(["chattr", "-i", str(d)])
+    else:
+        d.chmod(0o555)
+        yield d
+        d.chmod(0o755)
+
+
+def test_read_only_output_folder_is_one_line_before_meshing(read_only_dir):
+    r = run_cli("run", "shear_box", "--out", read_only_dir, sets=QUICK)
+    one_line_error(r, "cannot write in the output folder", str(read_only_dir))
+    r = run_cli("run", "shear_box", "--out", read_only_dir / "sub", sets=QUICK)
+    one_line_error(r, "cannot create the output folder", "sub")
+
+
+def _file_size_limit(nbytes):
+    def limit():
+        import resource
+
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG
+        resource.setrlimit(resource.RLIMIT_FSIZE, (nbytes, nbytes))
+    return limit
+
+
+def test_disk_full_is_one_line_and_leaves_no_partial_file(tmp_path):
+    """A file-size limit (RLIMIT_FSIZE) stands in for a full disk: the write fails with
+    an OS error half-way through a real file."""
+    out = tmp_path / "run"
+    r = run_cli("run", "shear_box", "--out", out, sets=QUICK, preexec_fn=_file_size_limit(20_000))
+    one_line_error(r, "cannot write", "snapshot_00000000.nc", "disk full", strict=False)
+    assert not [p for p in out.rglob("*") if ".tmp" in p.name], "no temporary file is left behind"
+    # a checkpoint write that fails keeps the previous checkpoint and leaves nothing partial
+    script = textwrap.dedent("""
+        import sys, numpy as np
+        from lagice.errors import OutputError
+        from lagice.io.checkpoint import write_checkpoint
+        write_checkpoint(sys.argv[1], 1, {"a": np.arange(10.0)}, {"x": 1})
+        try:
+            write_checkpoint(sys.argv[1], 2, {"a": np.zeros(100_000)}, {"x": 1})
+        except OutputError as exc:
+            print(exc)
+    """)
+    ck = tmp_path / "ck"
+    r = subprocess.run([sys.executable, "-c", script, str(ck)], capture_output=True, text=True,
+                       preexec_fn=_file_size_limit(200_000))
+    assert r.returncode == 0, r.stderr
+    assert "cannot write" in r.stdout and "checkpoint_0000000002.npz" in r.stdout and "File too large" in r.stdout
+    assert sorted(p.name for p in ck.iterdir()) == ["checkpoint_0000000001.npz"]
+
+
+# -- 5. dates and projections ------------------------------------------------------------
+def _wind_file(path, start="2020-01-01T00:00", n=17):
+    """Uniform x/y wind on a projected grid over the shear box: record k blows at 1 + k m/s."""
+    times = np.datetime64(start, "ns") + np.arange(n) * np.timedelta64(6, "h")
+    x = np.linspace(-200e3, 400e3, 7)
+    y = np.linspace(-200e3, 400e3, 7)
+    u = (1.0 + np.arange(n))[:, None, None] * np.ones((n, y.size, x.size))
+    xr.Dataset({"u": (("time", "y", "x"), u, {"units": "m s-1"}), "v": (("time", "y", "x"), 0 * u, {"units": "m s-1"})},
+               coords={"time": times, "x": ("x", x, {"units": "m"}), "y": ("y", y, {"units": "m"})}).to_netcdf(path)
+    return path
+
+
+WIND_HOOK = """
+import numpy as np
+from lagice.forces import WindStress
+from lagice.io.timeseries import diagnostic
+
+@diagnostic("m s-1", "x wind at node 0 (from the wind stress the model applies)")
+def wind_u(model):
+    ws = [f for f in model.forces if isinstance(f, WindStress)][0]
+    tau = ws.stress(model.clock.time_s, model.mesh.nodes[:1])[0, 0]
+    return float(np.sqrt(abs(tau) / (ws.rho_air * ws.drag)))
+"""
+
+
+def test_a_run_inside_a_gridded_file_uses_the_records_of_its_date(tmp_path):
+    path = _wind_file(tmp_path / "wind.nc")
+    (tmp_path / "windhook.py").write_text(WIND_HOOK)
+    env = {"PYTHONPATH": f"{tmp_path}{os.pathsep}{os.environ.get('PYTHONPATH', '')}"}
+    wind = [f'forcing.wind={{kind="file", path="{path}", u="u", v="v"}}', "solver.dt=1800.0",
+            "run.duration=21600.0", "output.every=21600.0", "domain.resolution_m=50e3", "run.progress=false",
+            "output.plot=false", 'output.timeseries={every="1 steps", diagnostics=["windhook:wind_u"]}']
+    out = tmp_path / "run"
+    r = run_cli("run", "shear_box", "--out", out, sets=[*wind, 'run.start_date="2020-01-03 06:00:00"'], env=env)
+    assert r.returncode == 0, r.stderr
+    ts = xr.load_dataset(out / "timeseries.nc")
+    # 2020-01-03 06:00 is record 9 (1 + 9 = 10 m/s); 6 h later record 10; linear in between
+    assert str(ts["time"].values[0]).startswith("2020-01-03T06:00")
+    t_s = (ts["time"].values - ts["time"].values[0]) / np.timedelta64(1, "s")
+    np.testing.assert_allclose(ts["wind_u"].values, 10.0 + t_s / 21600.0, rtol=1e-12)
+    # a run outside the file's dates is an error naming both spans (hold is opt-in)
+    r = run_cli("run", "shear_box", "--out", tmp_path / "late", sets=[*wind, 'run.start_date="2026-01-15 00:00:00"'],
+                env=env)
+    one_line_error(r, "2020-01-01T00:00 .. 2020-01-05T00:00", "2026-01-15T00:00", "time_extrapolation = 'hold'")
+
+
+def test_lonlat_coastline_is_projected_and_degrees_as_metres_are_refused(tmp_path):
+    from pyproj import Transformer
+    from shapely.geometry import Polygon
+
+    lonlat = [[-150.0, 75.0], [-140.0, 75.0], [-140.0, 80.0], [-150.0, 80.0], [-150.0, 75.0]]
+    coast = tmp_path / "coast.geojson"
+    coast.write_text(json.dumps({"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [lonlat]}}]}))
+    scene = tmp_path / "coast.toml"
+    scene.write_text(textwrap.dedent(f"""
+        [scene]
+        name = "coast"
+        [domain]
+        kind = "file"
+        file = "{coast}"
+        resolution_m = 100e3
+        [solver]
+        dt = 40.0
+        [run]
+        duration = 80.0
+        progress = false
+        [output]
+        every = 80.0
+        plot = false
+    """))
+    r = run_cli("run", scene, "--out", tmp_path / "m")
+    one_line_error(r, "look like longitude/latitude degrees", "domain.file_crs = 'EPSG:4326'")
+    out = tmp_path / "ll"
+    r = run_cli("run", scene, "--out", out, sets=['domain.file_crs="EPSG:4326"'])
+    assert r.returncode == 0, r.stderr
+    ds, _ = last_snapshot(out)
+    xy = np.column_stack([ds["mesh_node_x"].values, ds["mesh_node_y"].values])
+    t = ds["mesh_face_nodes"].values
+    a, b, c = xy[t[:, 0]], xy[t[:, 1]], xy[t[:, 2]]
+    area = 0.5 * np.abs((b - a)[:, 0] * (c - a)[:, 1] - (c - a)[:, 0] * (b - a)[:, 1]).sum()
+    tr = Transformer.from_crs("EPSG:4326", "EPSG:3413", always_xy=True)
+    expected = Polygon([tr.transform(lo, la) for lo, la in lonlat]).area
+    assert area == pytest.approx(expected, rel=1e-9) and expected > 1e11  # ~ 240 km x 560 km, not 10 m x 5 m
+
+
+def test_one_crs_labels_the_output_and_rejects_forcing_from_elsewhere(tmp_path):
+    out = tmp_path / "south"
+    r = run_cli("run", "shear_box", "--out", out, sets=[*QUICK, 'domain.crs="EPSG:3031"'])
+    assert r.returncode == 0, r.stderr
+    ds, _ = last_snapshot(out)
+    assert ds["crs"].attrs["latitude_of_projection_origin"] == -90.0
+    assert "Antarctic" in ds["crs"].attrs["crs_wkt"]
+    # Arctic ERA5-like records cannot drive a scene whose CRS puts it at the South Pole
+    era5 = ROOT / "data_stubs" / "era5_stub_arctic.nc"
+    r = run_cli("run", "shear_box", "--out", tmp_path / "mixed",
+                sets=[*QUICK, 'domain.crs="EPSG:3031"', f'forcing.wind={{kind="file", path="{era5}"}}',
+                      'run.start_date="2020-01-02 00:00:00"'])
+    one_line_error(r, "outside the forcing grid")
+    assert not (tmp_path / "mixed").exists()
+
+
+def test_coriolis_latitude_from_the_crs_per_node():
+    from lagice.forces import Coriolis
+    from lagice.params import OMEGA_EARTH
+
+    c = Coriolis(crs="EPSG:3413")
+    nodes = np.array([[0.0, 0.0], [1.0e6, 0.0], [0.0, -2.0e6]])
+    from pyproj import Transformer
+
+    lat = Transformer.from_crs("EPSG:3413", "EPSG:4326", always_xy=True).transform(nodes[:, 0], nodes[:, 1])[1]
+    assert lat[0] == pytest.approx(90.0) and lat[2] < lat[1] < 90.0
+    np.testing.assert_allclose(c.f_at(nodes), 2 * OMEGA_EARTH * np.sin(np.deg2rad(lat)), rtol=1e-12)
+    assert c.f_at(nodes + 1.0e5)[0] < c.f_at(nodes)[0], "f follows the nodes as they move"
+
+
+# -- 6. CF and provenance ------------------------------------------------------------------
+UGRID_ROLES = ("mesh_topology is not a valid cf_role", "face_node_connectivity is not a valid cf_role")
+
+
+def _cf_errors(path):
+    from compliance_checker.runner import CheckSuite, ComplianceChecker
+
+    CheckSuite.load_all_available_checkers()
+    report = path.with_suffix(".cf.json")
+    ComplianceChecker.run_checker(str(path), ["cf:1.8"], verbose=0, criteria="normal",
+                                  output_filename=str(report), output_format="json")
+    res = json.loads(report.read_text())["cf:1.8"]
+    return [m for sec in res.get("high_priorities", []) for m in sec.get("msgs", [])]
+
+
+def test_outputs_pass_the_cf_checker_and_carry_provenance(base_run, tmp_path):
+    pytest.importorskip("compliance_checker")
+    snap = tmp_path / "snapshot.nc"
+    shutil.copy(sorted((base_run / "snapshots").glob("snapshot_*.nc"))[-1], snap)
+    errors = _cf_errors(snap)
+    assert errors and all(any(role in e for role in UGRID_ROLES) for e in errors), errors
+    for name in ("grid_00000060.nc",):
+        p = tmp_path / name
+        shutil.copy(base_run / "snapshots" / name, p)
+        assert _cf_errors(p) == []
+    traj = tmp_path / "drifters.nc"
+    shutil.copy(base_run / "drifters.nc", traj)
+    assert _cf_errors(traj) == []
+    for f in (snap, tmp_path / "grid_00000060.nc", traj):
+        ds = xr.open_dataset(f)
+        assert ds.attrs["title"] and ds.attrs["history"] and ds.attrs["lagice_version"]
+        assert json.loads(ds.attrs["lagice_config"])["scene"]["name"] == "shear_box"
+    d = xr.open_dataset(traj)
+    assert d.attrs["featureType"] == "trajectory" and d["trajectory"].attrs["cf_role"] == "trajectory_id"
+
+
+def test_vtu_carries_every_snapshot_field_and_the_pvd_its_times(base_run):
+    import meshio
+
+    idx = json.loads((base_run / "snapshots" / "index.json").read_text())
+    pvd = (base_run / "snapshots" / "snapshots.pvd").read_text()
+    for e in idx:
+        assert f'timestep="{float(e["time_s"])!r}"' in pvd and e["file"].replace(".nc", ".vtu") in pvd
+    e = idx[-1]
+    ds = xr.load_dataset(base_run / "snapshots" / e["file"])
+    m = meshio.read(base_run / "snapshots" / e["file"].replace(".nc", ".vtu"))
+    assert float(m.field_data["TimeValue"][0]) == e["time_s"]
+    data = {**m.point_data, **{k: v[0] for k, v in m.cell_data.items()}}
+    for name, var in ds.data_vars.items():
+        if "location" not in var.attrs or name in ("mesh",):
+            continue
+        base = name.rsplit("_", 1)[0] if name.startswith(("stress_", "velocity_")) else name
+        assert base in data, f"{name} missing in the VTU"
+        vals = data[base]
+        if vals.ndim == 2:
+            k = {"xx": 0, "yy": 1, "xy": 2, "x": 0, "y": 1}[name.rsplit("_", 1)[1]]
+            vals = vals[:, k]
+        np.testing.assert_array_equal(vals, np.squeeze(var.values), err_msg=name)
+
+
+def test_open_run_gives_time_series_across_mesh_epochs(base_run):
+    import lagice
+
+    run = lagice.open_run(base_run)
+    idx = json.loads((base_run / "snapshots" / "index.json").read_text())
+    assert len(run.epochs) == len({e["mesh_epoch"] for e in idx})
+    assert sum(ep.sizes["time"] for ep in run.epochs) == len(idx)
+    for ep in run.epochs:  # topology shared inside an epoch, positions per time
+        assert ep["node_x"].dims == ("time", "mesh_node") and ep.ugrid.grid.n_face == ep.sizes["mesh_face"]
+    damage = run.area_mean("damage")
+    assert damage.sizes["time"] == len(idx) and str(damage["time"].values[0]).startswith("2000-01-01T00:00")
+    for k, e in enumerate(idx):
+        ds = xr.load_dataset(base_run / "snapshots" / e["file"])
+        xy = np.column_stack([ds["mesh_node_x"].values, ds["mesh_node_y"].values])
+        t = ds["mesh_face_nodes"].values
+        a, b, c = xy[t[:, 0]], xy[t[:, 1]], xy[t[:, 2]]
+        area = 0.5 * np.abs((b - a)[:, 0] * (c - a)[:, 1] - (c - a)[:, 0] * (b - a)[:, 1])
+        assert damage.values[k] == pytest.approx(np.sum(ds["damage"].values[0] * area) / area.sum(), rel=1e-12)
+        # the regular-grid time series keeps the ice volume of every snapshot
+        g = run.grid.isel(time=k)
+        vol_grid = float((g["thickness"].fillna(0) * g["coverage"]).sum()) * 30e3 * 30e3
+        assert vol_grid == pytest.approx(float(np.sum(ds["thickness"].values[0] * area)), rel=1e-10)
+    traj = run.drifters
+    assert traj.sizes["trajectory"] == 2 and traj.sizes["obs"] == 61
+
+
+# -- 7. feedback ---------------------------------------------------------------------------
+def test_version_log_level_and_numba_notice(tmp_path, capsys):
+    import lagice
+
+    r = run_cli("--version")
+    assert r.returncode == 0 and r.stdout.strip() == f"lagice {lagice.__version__}"
+    quiet = run_cli("run", "shear_box", "--out", tmp_path / "q", "--log-level", "warning",
+                    sets=[s for s in QUICK if s != "run.progress=false"])
+    assert quiet.returncode == 0 and "running scene" not in quiet.stdout and "sim-days" not in quiet.stdout
+    r = run_cli("run", "shear_box", "--out", tmp_path / "d", "--log-level", "debug", sets=["drifters.count=-3"])
+    assert r.returncode == 2 and "Traceback" in r.stderr and "drifters.count" in r.stderr.splitlines()[-1]
+    from numba import njit
+
+    from lagice.cli import _announce_numba_compilation, setup_logging
+
+    setup_logging("info")
+    _announce_numba_compilation()
+
+    @njit
+    def fresh(x):  # not cached: numba compiles it now
+        return x + 1
+
+    assert fresh(1) == 2
+    assert "numba is compiling" in capsys.readouterr().out
+
+
+def test_progress_bar_after_resume(tmp_path):
+    import io
+
+    from lagice.activities import Progress
+    from lagice.simulation import Simulation
+
+    from helpers import scene_sim
+
+    sim = scene_sim("shear_box", tmp_path, {"run.duration": 1600.0, "solver.dt": 40.0, "checkpoint.every": 800.0,
+                                            "domain.resolution_m": 50e3})
+    sim.run(n_steps=20)
+    res = Simulation.resume(tmp_path / "checkpoints", progress=False)
+    stream = io.StringIO()
+    res.add(Progress(stream=stream, bar=True))
+    res.run()
+    text = stream.getvalue()
+    assert "20/40" in text and "40/40" in text and "100%" in text, text
+    assert "step/s" in text or "s/step" in text  # the rate (tqdm), over this session's steps
+
+
+def test_diagnose_warns_when_the_window_is_shortened(base_run, tmp_path):
+    r = run_cli("diagnose", base_run, "--window-steps", "10", "--out", tmp_path / "diag")
+    assert r.returncode == 0, r.stderr
+    assert "warning: --window-steps 10: the run has 5 snapshots; the window was shortened to 4" in r.stderr
+    res = json.loads((tmp_path / "diag" / "diagnostics.json").read_text())
+    assert res["dt_s"] == 4 * 1500.0
+
+
+def test_plot_draws_the_drifters_of_the_drifter_file(base_run, tmp_path, monkeypatch):
+    import lagice.plotting as plotting
+    from lagice.io.drifters import read_trajectories
+    from lagice.scenes.builder import plot_scene
+
+    run = tmp_path / "run"
+    shutil.copytree(base_run, run)
+    seen = {}
+    real = plotting.plot_run
+
+    def spy(snap_dir, png, summary=None, trajectories=None):
+        seen["trajectories"] = trajectories
+        return real(snap_dir, png, summary, trajectories)
+
+    monkeypatch.setattr(plotting, "plot_run", spy)
+    ds, _ = last_snapshot(run)
+    cfg = json.loads(ds.attrs["lagice_config"])
+    cfg["output"]["plot"] = True
+    png = plot_scene(cfg, run)
+    assert png.stat().st_size > 10_000
+    d = xr.load_dataset(run / "drifters.nc", decode_times=False)
+    assert len(seen["trajectories"]) == 2
+    for k, tr in enumerate(seen["trajectories"]):
+        assert np.array_equal(tr[:, 0], d["x"].values[k]) and tr.shape == (61, 2)
+    assert all(np.array_equal(a, b) for a, b in zip(seen["trajectories"], read_trajectories(run / "drifters.nc")))
