@@ -202,11 +202,15 @@ class Progress(Activity):
         use_bar = self.bar if self.bar is not None else bool(getattr(stream, "isatty", lambda: False)())
         self._bar = None
         if use_bar and not self._quiet():
+            import shutil
+
             from tqdm import tqdm
 
             self.schedule = IterationInterval(1)
+            size = shutil.get_terminal_size((100, 24))  # a pty may report 0 x 0: tqdm would then draw nothing
             self._bar = tqdm(total=sim.n_steps, initial=sim.model.clock.iteration, unit="step", file=stream,
-                             dynamic_ncols=True, mininterval=0.5, smoothing=0.1,
+                             ncols=size.columns if size.columns > 0 else 100,
+                             nrows=size.lines if size.lines > 0 else 24, mininterval=0.5, smoothing=0.1,
                              desc=str(sim.model.config.get("scene", {}).get("name", "lagice")))
         else:
             self.schedule = self._line_schedule
@@ -218,12 +222,10 @@ class Progress(Activity):
         m = sim.model
         if self._quiet():
             return
-        b = m.volume_budget()
         if self._bar is not None:
             self._bar.update(m.clock.iteration - self._bar.n)
             self._bar.set_postfix_str(f"day {m.clock.time_s / 86400.0:.2f}, remeshes "
-                                      f"{m.state.counters.get('remesh_count', 0)}, volume drift "
-                                      f"{b['relative_residual']:+.1e}", refresh=False)
+                                      f"{m.state.counters.get('remesh_count', 0)}", refresh=False)
             return
         wall = time.perf_counter() - self._t0
         done = m.clock.time_s - self._sim0
@@ -232,6 +234,7 @@ class Progress(Activity):
         left = sim.stop_time - m.clock.time_s if sim.stop_time else float("nan")
         eta = left / done * wall if done > 0 else float("nan")
         eta_s = _fmt_wall(eta) if math.isfinite(eta) else "?"
+        b = m.volume_budget()
         print(f"  day {m.clock.time_s / 86400.0:7.3f}  {100 * frac:5.1f} %  step {m.clock.iteration}/{sim.n_steps}  "
               f"{rate:8.1f} sim-days/wall-hour  ETA {eta_s}  remeshes {m.state.counters.get('remesh_count', 0)}  "
               f"volume {b['current_m3']:.4e} m3 (thermo {b['thermodynamic_m3']:+.2e}, outflow "

@@ -100,9 +100,10 @@ def claim(out, overwrite: bool = False) -> Path:
 
 
 def prepare(out, config: dict | None = None) -> list[Path]:
-    """Create ``out``, prove it writable by writing the marker ``lagice_run.json``
-    (scene, lagice version, command, parent checkpoint of a branch), and remove stale
-    temporary files of killed writes. Raises OutputError naming the folder."""
+    """Create ``out``, prove it writable (by writing the marker ``lagice_run.json``:
+    scene, lagice version, command, parent checkpoint of a branch; or, when it
+    exists, a probe file), and remove stale temporary files of killed writes.
+    Raises OutputError naming the folder."""
     out = Path(out)
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -110,7 +111,7 @@ def prepare(out, config: dict | None = None) -> list[Path]:
         raise OutputError(f"cannot create the output folder {out}: {exc.strerror}") from None
     removed = clean_stale(out)
     marker = out / MARKER
-    if config is not None or not marker.exists():
+    if not marker.exists():  # a resumed run keeps the marker of its start
         from . import __version__
 
         cfg = config or {}
@@ -128,6 +129,13 @@ def prepare(out, config: dict | None = None) -> list[Path]:
                 tmp.unlink(missing_ok=True)
             except OSError:
                 pass
+            raise OutputError(f"cannot write in the output folder {out}: {exc.strerror}") from None
+    else:
+        probe = out / f".lagice-write-probe-{os.getpid()}"
+        try:
+            probe.write_bytes(b"")
+            probe.unlink()
+        except OSError as exc:
             raise OutputError(f"cannot write in the output folder {out}: {exc.strerror}") from None
     return removed
 

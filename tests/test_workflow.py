@@ -86,6 +86,7 @@ def base_run(tmp_path_factory):
 
 
 # -- 1. run folders are never mixed ------------------------------------------------
+@pytest.mark.slow
 def test_output_folder_reuse_is_refused(tmp_path):
     out = tmp_path / "run"
     assert run_cli("run", "shear_box", "--out", out, sets=QUICK).returncode == 0
@@ -99,6 +100,14 @@ def test_output_folder_reuse_is_refused(tmp_path):
     assert not (out / "stray.txt").exists(), "--overwrite clears the folder first"
     ds, _ = last_snapshot(out)
     assert json.loads(ds.attrs["lagice_config"])["run"]["seed"] == 5
+    # --resume continues the run in the folder (same physics), or says it is done
+    r = run_cli("run", "shear_box", "--out", out, "--resume", sets=[*QUICK, "run.seed=5"])
+    assert r.returncode == 0 and "already finished" in r.stdout, r.stdout + r.stderr
+    r = run_cli("run", "shear_box", "--out", out, "--resume", sets=[*QUICK, "run.seed=6", "run.duration=1200.0"])
+    one_line_error(r, "run.seed", "lagice branch")
+    r = run_cli("run", "shear_box", "--out", out, "--resume", sets=[*QUICK, "run.seed=5", "run.duration=1200.0"])
+    assert r.returncode == 0, r.stderr
+    assert last_snapshot(out)[1][-1]["step"] == 30
     other = tmp_path / "notes"
     other.mkdir()
     (other / "thesis.tex").write_text("precious")
@@ -107,6 +116,7 @@ def test_output_folder_reuse_is_refused(tmp_path):
     assert (other / "thesis.tex").read_text() == "precious"
 
 
+@pytest.mark.slow
 def test_default_folders_never_collide_and_latest_follows(tmp_path):
     a = run_cli("run", "shear_box", sets=QUICK, cwd=tmp_path)
     b = run_cli("run", "shear_box", sets=QUICK, cwd=tmp_path)
@@ -348,6 +358,7 @@ def wind_u(model):
 """
 
 
+@pytest.mark.slow
 def test_a_run_inside_a_gridded_file_uses_the_records_of_its_date(tmp_path):
     path = _wind_file(tmp_path / "wind.nc")
     (tmp_path / "windhook.py").write_text(WIND_HOOK)
@@ -409,6 +420,29 @@ def test_lonlat_coastline_is_projected_and_degrees_as_metres_are_refused(tmp_pat
     assert area == pytest.approx(expected, rel=1e-9) and expected > 1e11  # ~ 240 km x 560 km, not 10 m x 5 m
 
 
+def test_lonlat_shapefile_is_projected_with_its_prj(tmp_path):
+    """A shapefile declares its CRS in its .prj: a lon/lat one is projected into domain.crs."""
+    import shapefile
+    from pyproj import CRS, Transformer
+    from shapely.geometry import Polygon
+
+    from lagice.scenes.builder import domain_polygon
+    from lagice.scenes.config import load_scene
+
+    ring = [[10.0, 78.0], [10.0, 80.0], [30.0, 80.0], [30.0, 78.0], [10.0, 78.0]]  # Svalbard-like box
+    with shapefile.Writer(str(tmp_path / "coast"), shapeType=shapefile.POLYGON) as w:
+        w.field("name", "C")
+        w.poly([ring])
+        w.record("box")
+    (tmp_path / "coast.prj").write_text(CRS("EPSG:4326").to_wkt("WKT1_ESRI"))
+    cfg = load_scene("winter_basin", {"domain.file": str(tmp_path / "coast.shp"), "run.duration": "1h"})
+    poly = domain_polygon(cfg)
+    tr = Transformer.from_crs("EPSG:4326", "EPSG:3413", always_xy=True)
+    expected = Polygon([tr.transform(lo, la) for lo, la in ring])
+    assert poly.symmetric_difference(expected).area < 1e-9 * expected.area and expected.area > 1e10
+
+
+@pytest.mark.slow
 def test_one_crs_labels_the_output_and_rejects_forcing_from_elsewhere(tmp_path):
     out = tmp_path / "south"
     r = run_cli("run", "shear_box", "--out", out, sets=[*QUICK, 'domain.crs="EPSG:3031"'])
@@ -571,6 +605,7 @@ def test_progress_bar_after_resume(tmp_path):
     assert "step/s" in text or "s/step" in text  # the rate (tqdm), over this session's steps
 
 
+@pytest.mark.slow
 def test_diagnose_warns_when_the_window_is_shortened(base_run, tmp_path):
     r = run_cli("diagnose", base_run, "--window-steps", "10", "--out", tmp_path / "diag")
     assert r.returncode == 0, r.stderr

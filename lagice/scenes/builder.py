@@ -110,33 +110,56 @@ def _geojson_crs(gj: dict) -> str | None:
     return None
 
 
-def _file_polygon(d: dict):
-    """The domain polygon of a GeoJSON file, in the scene CRS (``domain.crs``).
+def _read_shapefile(p: Path, key: str):
+    """The largest polygon of a shapefile (pyshp) and its CRS (the ``.prj`` WKT, or None)."""
+    import shapefile
+    from shapely.ops import unary_union
 
-    The file's CRS is ``domain.file_crs``, else the one the file declares, else the
-    scene CRS. A file in another CRS (e.g. lon/lat, ``EPSG:4326``) is projected; a
-    file read in a metric CRS whose coordinates look like degrees is an error."""
+    try:
+        with shapefile.Reader(str(p)) as r:
+            geoms = [shape(s.__geo_interface__) for s in r.shapes() if s.shapeType in (5, 15, 25)]
+    except Exception as exc:  # noqa: BLE001 - any reader failure is a bad file
+        raise ConfigError(f"{key}: cannot read the shapefile: {exc}") from exc
+    if not geoms:
+        raise ConfigError(f"{key}: the shapefile holds no polygon")
+    geom = unary_union(geoms) if len(geoms) > 1 else geoms[0]
+    prj = p.with_suffix(".prj")
+    return geom, (prj.read_text().strip() if prj.exists() else None)
+
+
+def _file_polygon(d: dict):
+    """The domain polygon of a GeoJSON file or a shapefile (``.shp``, read with pyshp),
+    in the scene CRS (``domain.crs``); the largest polygon when there are several.
+
+    The file's CRS is ``domain.file_crs``, else the one the file declares (a GeoJSON
+    ``crs`` member, a shapefile's ``.prj``), else the scene CRS. A file in another
+    CRS (e.g. lon/lat, ``EPSG:4326``) is projected; a file read in a metric CRS
+    whose coordinates look like degrees is an error."""
     from ..crs import check_not_degrees, model_crs, parse_crs, project_geometry
 
     if not d["file"]:
-        raise ConfigError("domain.file is required for a file domain (GeoJSON polygon)")
+        raise ConfigError("domain.file is required for a file domain (GeoJSON polygon or shapefile)")
     p = Path(d["file"])
     if not p.is_absolute() and not p.exists():
         p = ROOT / d["file"]
     if not p.exists():
         raise ConfigError(f"domain.file = {d['file']!r}: file not found")
-    try:
-        gj = json.loads(p.read_text())
-        geom = shape(gj["features"][0]["geometry"] if "features" in gj else gj.get("geometry", gj))
-    except Exception as exc:  # noqa: BLE001
-        raise ConfigError(f"domain.file = {d['file']!r}: cannot read a GeoJSON polygon: {exc}") from exc
+    key = f"domain.file = {d['file']!r}"
+    if p.suffix.lower() == ".shp":
+        geom, file_crs = _read_shapefile(p, key)
+    else:
+        try:
+            gj = json.loads(p.read_text())
+            geom = shape(gj["features"][0]["geometry"] if "features" in gj else gj.get("geometry", gj))
+        except Exception as exc:  # noqa: BLE001
+            raise ConfigError(f"{key}: cannot read a GeoJSON polygon: {exc}") from exc
+        file_crs = _geojson_crs(gj)
     if geom.geom_type == "MultiPolygon":
         geom = max(geom.geoms, key=lambda g: g.area)
     if geom.geom_type != "Polygon":
-        raise ConfigError(f"domain.file = {d['file']!r}: the geometry is a {geom.geom_type}; expected a Polygon")
+        raise ConfigError(f"{key}: the geometry is a {geom.geom_type}; expected a Polygon")
     target = model_crs(d["crs"], "domain.crs")
-    declared = d["file_crs"] or _geojson_crs(gj)
-    key = f"domain.file = {d['file']!r}"
+    declared = d["file_crs"] or file_crs
     if declared is None:
         check_not_degrees(geom.bounds, key, f"domain.crs = {d['crs']!r}")
         return geom
@@ -492,7 +515,7 @@ def build_simulation(cfg: dict, out_dir=None, progress: bool | None = None, over
         rundir.update_latest(out, cfg["scene"]["name"])
     else:
         out = Path(out_dir)
-        rundir.prepare(out, cfg if not (out / rundir.MARKER).exists() or cfg.get("_parent") else None)
+        rundir.prepare(out, cfg)
     model = build_model(cfg, validated=True)
     prog = cfg["run"]["progress"] if progress is None else progress
     sim = Simulation(model, dt=time_step_s(cfg), stop=cfg["run"]["duration"], progress=prog, builder=BUILDER,
