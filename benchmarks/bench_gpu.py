@@ -95,7 +95,7 @@ def build(n_elements, device, substeps, wind, out_dir, parallel=None, launch=Non
         st.tpb = int(tpb)
     dt = substeps * st.safety * explicit_substep_limit(st.dx_min, st.rheology.E0, st.rheology.params) * 0.999
     sim = Simulation(model, dt=dt, stop=10_000 * dt, progress=False)
-    sim.output("1000d", Path(out_dir) / "snapshots", crs_epsg=None)  # one snapshot, at the start
+    sim.output("1000d", Path(out_dir) / "snapshots", crs=None)  # one snapshot, at the start
     return sim, time.perf_counter() - t0
 
 
