@@ -4,15 +4,17 @@
    (``method="clip"``) against ``numba_celltree.CellTree2d.intersect_faces``
    (``method="celltree"``), old/new meshes of ~20k and ~200k elements.
 2. Sheared scene (``shear_channel``: annulus, prescribed shear, Lagrangian
-   motion + ``remesh_if_needed`` every outer step of 1 h) at ~20k and ~200k
-   elements: remesh events per simulated day, time per event split into gmsh
-   and remapping, elements touched, and the share of run time spent
-   remeshing. The velocity is prescribed, so the "total" of a dynamic run is
-   estimated as the measured kinematic run plus one ImplicitSolver step
-   (Δt = td) per outer step, timed on the same mesh: a lower bound on the
-   dynamic cost, so the printed remesh share is an upper bound.
-3. The same scene with ImplicitSolver dynamics (ice driven by the sheared
-   ocean current, 1-h steps) for 10 days at ``--dynamic-size`` (8 km, ~1.1k
+   motion + the remeshing component after every outer step of 1 h; scene builder +
+   Simulation, the path of ``lagice run``) at ~20k and ~200k elements: remesh
+   events per simulated day, time per event split into gmsh and remapping
+   (the remesher's event log), elements touched, the wall time of mesh motion and
+   remeshing (``model.timings``) and the share of run time spent remeshing. The
+   velocity is prescribed, so the "total" of a dynamic run is estimated as the
+   measured kinematic run plus one implicit step (Δt = td) per outer step, timed on
+   ``shear_channel_implicit`` at the same resolution (a lower bound on the dynamic
+   cost, so the printed remesh share is an upper bound).
+3. ``shear_channel_implicit`` (implicit Maxwell-EB dynamics, ice dragged by the
+   sheared ocean current, 1-h steps) for 10 days at ``--dynamic-size`` (8 km, ~1.1k
    elements by default): the measured share of remeshing in a real dynamic run.
 
     python benchmarks/bench_remesh.py              # 20k for 10 days, 200k for 6 days
@@ -26,13 +28,17 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scene_runs import reset_timings, scene_simulation, timed_run
 
-from lagice.lagrangian import move_mesh
 from lagice.mesh import generate_mesh, rectangle_domain
-from lagice.remesh import intersect_triangles, remesh_if_needed
-from lagice.scenes import shear_channel
+from lagice.remesh import intersect_triangles
 
 DAY = 86400.0
+
+
+def channel_overrides(size_m: float) -> dict:
+    """The annulus meshed at ``size_m`` (its polygon's vertices at the same spacing)."""
+    return {"domain.resolution_m": size_m, "domain.params.vertex_spacing_m": size_m, "output.timeseries": None}
 
 
 def bench_intersect(n_target):
@@ -54,56 +60,43 @@ def bench_intersect(n_target):
     return out
 
 
-def solver_step_time(state, n=3):  # -> (seconds per step, dt_s)
-    """Wall time of one ImplicitSolver step of Δt = td (its default, Δx/cs) on
-    ``state.mesh`` (coasts fixed). One such step per 1-h outer step is a lower
-    bound on the cost of a dynamic run, so the remesh share is an upper bound."""
-    from lagice.rheology import MaxwellEB
-    from lagice.solvers.implicit import ImplicitSolver
-
-    st = state
-    solver = ImplicitSolver(MaxwellEB(), st.mesh, bcs=[])
-    st2 = type(st)(mesh=st.mesh, velocity=st.velocity.copy(), thickness=st.thickness.copy(),
-                   concentration=st.concentration.copy(), damage=st.damage.copy(), stress=st.stress.copy(),
-                   cohesion=st.cohesion.copy())
-    st2.stress[:] = 0.0
-    dt = float(np.median(solver.td))
-    solver.step(st2, dt)
-    t0 = time.perf_counter()
-    for _ in range(n):
-        solver.step(st2, dt)
-    return (time.perf_counter() - t0) / n, dt
+def implicit_step_time(size_m, n=3):  # -> (seconds per step, dt_s)
+    """Wall time of one implicit step of Δt = td = Δx/cs on ``shear_channel_implicit``
+    at ``size_m`` (fixed mesh, superlu → cg as at Δt = td the system is well
+    conditioned). One such step per 1-h outer step is a lower bound on the cost of a
+    dynamic run, so the remesh share is an upper bound."""
+    td = size_m / 500.0  # Δx/cs
+    ov = {**channel_overrides(size_m), "solver.dt": "td", "solver.linear_solver": "cg",
+          "lagrangian.enabled": False, "remesh.enabled": False, "run.duration": (4 + n) * td}
+    sim = scene_simulation("shear_channel_implicit", ov)
+    sim.run(n_steps=1)  # compilation
+    sim.run(n_steps=3)  # the ice starts at rest: let the current set it moving
+    return timed_run(sim, n_steps=n) / n, sim.dt
 
 
 def bench_scene(size_m, days):
-    sc = shear_channel.build(size_m=size_m, speed_m_s=0.1, dt_s=3600.0)
-    st = sc.state
-    n0 = st.mesh.n_elements
-    shear_channel.step(sc)  # warm-up (numba compile, gmsh start)
-    sc.log.events.clear()
-    n_steps = int(round(days * DAY / sc.dt_s))
-    t_move = t_remesh = 0.0
-    for _ in range(n_steps):
-        t0 = time.perf_counter()
-        st.velocity = sc.velocity(st.mesh.nodes)
-        rep = move_mesh(st, sc.dt_s, sc.budget)
-        st.time_s += sc.dt_s
-        st.step += 1
-        t1 = time.perf_counter()
-        remesh_if_needed(st, sc.size_m, flagged=rep.flagged_elements, log=sc.log)
-        t2 = time.perf_counter()
-        t_move += t1 - t0
-        t_remesh += t2 - t1
-    ev = sc.log.events
-    t_solver, dt_td = solver_step_time(st)
-    summ = sc.log.summary()
+    dt = 3600.0  # the scene's outer step
+    n_steps = int(round(days * DAY / dt))
+    sim = scene_simulation("shear_channel", {**channel_overrides(size_m), "solver.velocity_params.speed_m_s": 0.1,
+                                             "solver.dt": dt, "run.duration": (n_steps + 1) * dt})
+    model = sim.model
+    n0 = model.mesh.n_elements
+    sim.run(n_steps=1)  # warm-up (numba compile, gmsh start)
+    log = model.component("remeshing").log
+    first = len(log.events)
+    reset_timings(model)
+    timed_run(sim, n_steps=n_steps)
+    ev = log.events[first:]
+    # move: prescribed velocity (the stepper) + mesh motion; remesh: trigger checks + events
+    t_move, t_remesh = model.timings["dynamics"] + model.timings["mesh_motion"], model.timings["remeshing"]
+    t_solver, dt_td = implicit_step_time(size_m)
     per_event = np.array([e.t_gmsh_s + e.t_remap_s for e in ev]) if ev else np.zeros(1)
     total_dyn = t_move + t_remesh + n_steps * t_solver
     total_td = t_move + t_remesh + days * DAY / dt_td * t_solver
     return {
-        "size_m": size_m, "n_elements_start": n0, "n_elements_end": st.mesh.n_elements, "days": days,
+        "size_m": size_m, "n_elements_start": n0, "n_elements_end": model.mesh.n_elements, "days": days,
         "n_steps": n_steps, "n_events": len(ev), "events_per_day": len(ev) / days,
-        "n_global": summ.get("n_global", 0),
+        "n_global": sum(e.kind == "global" for e in ev),
         "mean_event_s": float(np.mean([e.t_total_s for e in ev])) if ev else 0.0,
         "mean_gmsh_plus_remap_s": float(per_event.mean()),
         "max_event_s": float(max(e.t_total_s for e in ev)) if ev else 0.0,
@@ -116,26 +109,24 @@ def bench_scene(size_m, days):
         "remesh_share_implicit_every_td": t_remesh / total_td,
         "remesh_share_kinematic": t_remesh / (t_move + t_remesh),
         "remesh_share_with_implicit_solver": t_remesh / total_dyn,
-        "max_rel_change": summ.get("max_rel_change", 0.0),
+        "max_rel_change": float(max((max(abs(v) for v in e.rel_change.values()) if e.rel_change else 0.0)
+                                    for e in ev)) if ev else 0.0,
     }
 
 
 def bench_dynamic(size_m, days):
-    """The scene with ImplicitSolver dynamics (ocean-driven, dt = 1 h): the
-    measured share of remeshing in a real dynamic run."""
-    sc = shear_channel.build(size_m=size_m, speed_m_s=0.5, dt_s=3600.0, dynamics="implicit", cohesion_pa=1e3)
-    n0 = sc.state.mesh.n_elements
-    n_steps = int(round(days * DAY / sc.dt_s))
-    t0 = time.perf_counter()
-    for _ in range(n_steps):
-        shear_channel.step(sc)
-    wall = time.perf_counter() - t0
-    summ = sc.log.summary()
-    tm = sc.timings
-    return {"size_m": size_m, "n_elements_start": n0, "n_elements_end": sc.state.mesh.n_elements,
+    """``shear_channel_implicit`` (ocean-driven, dt = 1 h): the measured share of
+    remeshing in a real dynamic run."""
+    sim = scene_simulation("shear_channel_implicit", {**channel_overrides(size_m), "run.duration": f"{days:g}d"})
+    model = sim.model
+    n0 = model.mesh.n_elements
+    wall = timed_run(sim)
+    summ = model.component("remeshing").log.summary()
+    tm = model.timings
+    return {"size_m": size_m, "n_elements_start": n0, "n_elements_end": model.mesh.n_elements,
             "days": days, "n_events": summ.get("n_events", 0), "events_per_day": summ.get("n_events", 0) / days,
-            "wall_s": wall, "solver_s": tm["solver"], "move_s": tm["move"], "remesh_s": tm["remesh"],
-            "remesh_share": tm["remesh"] / sum(tm.values()),
+            "wall_s": wall, "solver_s": tm["dynamics"], "move_s": tm["mesh_motion"], "remesh_s": tm["remeshing"],
+            "remesh_share": tm["remeshing"] / sum(tm.values()),
             "mean_event_s": summ.get("t_total_s", 0.0) / max(1, summ.get("n_events", 0)),
             "elements_touched": summ.get("elements_touched", 0)}
 
@@ -151,12 +142,12 @@ def main():
     sizes = [(20_000, 10.0, 1.8e3), (200_000, 6.0, 0.57e3)]
     if args.quick:
         sizes = [(2_000, 6.0, 5.7e3)]
-    for n, days, size in sizes:
+    for n, _days, _size in sizes:
         r = bench_intersect(n)
         res["intersect"].append(r)
         print(f"supermesh {r['n_old']} x {r['n_new']} elements: clip {r['clip_s']:.3f} s, "
               f"celltree {r['celltree_s']:.3f} s ({r['clip_pairs']} / {r['celltree_pairs']} pairs)", flush=True)
-    for n, days, size in sizes:
+    for _n, days, size in sizes:
         r = bench_scene(size, days)
         res["scene"].append(r)
         print(f"shear_channel ~{r['n_elements_start']} elements, {days:g} days: {r['n_events']} events "

@@ -1,14 +1,17 @@
 """Stability map of the two solvers (issue 3).
 
 For each solver, the largest stable time step as a function of resolution Δx,
-Young modulus E0 and damage exponent α, on a small wind-driven closed basin
-(the ``wind_square`` scene on a 200 km square, 20 m/s wind ramped over 1 h,
-Coriolis, ocean drag, healing on; damage develops during the run).
+Young modulus E0 and damage exponent α, on a small wind-driven closed basin: the
+``wind_square`` scene (scene builder + Simulation, the path of ``lagice run``)
+on a 200 km square, 20 m/s wind ramped over 1 h and turned over 1 h, Coriolis,
+ocean drag, healing on, Lagrangian mesh motion (nodes move with the transport
+velocity, the sub-step mean for the explicit stepper).
 
-A run is *stable* when, over the whole run: no NaN/inf, no element inverted
-after moving the nodes by u·Δt, and the ice speed stays below twice the
-free-drift speed of the full wind (confined ice cannot be faster than free
-ice; an instability grows far past it).
+A run is *stable* when the production run finishes: Simulation's NaN/speed checker
+stops a run at the first NaN/Inf in the state or at an ice speed above
+``run.max_speed_m_s``, here twice the free-drift speed of the full wind (confined
+ice cannot be faster than free ice; an instability grows far past it), and the
+mesh-motion component refuses inverted elements.
 
 * explicit: bisection on C = Δt_s sqrt(E0/ρ) / Δx_min (sub-step Δt_s, 10
   sub-steps per outer step) — the elastic-wave (CFL) law — on undamageable
@@ -19,7 +22,8 @@ ice; an instability grows far past it).
   the grid is the limit the model ships (``--write-limits``).
 * implicit: Δt = k·td for k = 1, 4, 16, ... (td = Δx/cs): the largest stable k.
 
-Writes ``benchmarks/out/stability.json`` and ``docs/figures/stability.png``.
+Writes ``benchmarks/out/stability.json``, ``docs/figures/stability.png`` and
+``docs/figures/stability.json``.
 
     python benchmarks/stability.py --quick           # small grid, a few minutes
     python benchmarks/stability.py --write-limits    # also update lagice/data/stability_limits.json
@@ -32,21 +36,23 @@ import json
 import math
 import time
 import warnings
+from functools import cache
 from pathlib import Path
 
 import numba
 import numpy as np
+from scene_runs import scene_dx_min, scene_simulation, whole_steps
 
 from lagice.errors import SolverError
 from lagice.forces import free_drift_velocity
 from lagice.params import RHO_AIR, coriolis_from_latitude
-from lagice.scenes import wind_square
 from lagice.stability import LIMITS_PATH, StabilityWarning
 
 DOMAIN = 200e3
 WIND = 20.0
 LAT = 75.0
 RHO_I = 900.0
+CS = 500.0  # shear wave speed of the scene [m s-1]: td = Δx/cs
 
 
 def free_drift_speed():
@@ -54,46 +60,55 @@ def free_drift_speed():
     return abs(free_drift_velocity(complex(tau, 0.0), coriolis_from_latitude(LAT), RHO_I))
 
 
-def run_case(solver, res, E0, alpha, dt, duration_s, substeps=None, elastic=False):
-    """True if stable (see module doc); also returns the reason and max speed.
-    ``elastic``: cohesion 1e9 Pa (no damage), so that damage cannot mask an
-    instability by softening the ice it has shaken apart."""
-    rheo = {"young_modulus_pa": E0, "alpha": alpha}
+def overrides(res, E0, alpha, elastic=False):
+    """The wind_square scene of the stability map (everything but the time step)."""
+    ov = {"domain.width_m": DOMAIN, "domain.height_m": DOMAIN, "domain.resolution_m": res,
+          "forcing.wind.params.speed_m_s": WIND, "forcing.wind.params.ramp_h": 1.0,
+          "forcing.wind.params.turn_h": 1.0, "forcing.coriolis.latitude_deg": LAT,
+          "rheology.young_modulus_pa": E0, "rheology.alpha": alpha,
+          "run.max_speed_m_s": 2.0 * free_drift_speed(), "output.timeseries": None}
     if elastic:
-        rheo.update(cohesion_min_pa=1e9, cohesion_max_pa=1e9)
-    kw = dict(resolution_m=res, domain_m=DOMAIN, wind_speed=WIND, ramp_h=1.0, turn_h=1.0,
-              latitude_deg=LAT, rheology=rheo, dt_s=dt,
-              solver=solver, allow_unstable=True)
+        ov.update({"rheology.cohesion_min_pa": 1e9, "rheology.cohesion_max_pa": 1e9})
+    return ov
+
+
+def run_case(solver, res, E0, alpha, dt, duration_s, substeps=None, elastic=False):
+    """(stable, reason, max speed [m s-1]) of one run (see module doc). ``elastic``:
+    cohesion 1e9 Pa (no damage), so that damage cannot mask an instability by
+    softening the ice it has shaken apart."""
+    ov = overrides(res, E0, alpha, elastic)
+    n = whole_steps(duration_s, dt)
+    ov.update({"solver.name": solver, "solver.dt": dt, "run.duration": n * dt})
     if solver == "explicit":
-        kw["substeps"] = substeps
+        ov.update({"solver.substeps": substeps, "solver.allow_unstable": True})
     else:
-        kw["linear_solver"] = "cg"
-    sc = wind_square.build(**kw)
-    bound = 2.0 * free_drift_speed()
-    vmax = 0.0
-    n = max(1, int(math.ceil(duration_s / dt)))
+        ov["solver.linear_solver"] = "cg"
+    sim = scene_simulation("wind_square", ov)
+    vmax = [0.0]
+
+    def track(sim):
+        m = sim.model
+        vmax[0] = max(vmax[0], float(np.abs(m.state.velocity).max()), float(np.abs(m.transport_velocity).max()))
+
+    sim.add_callback(track, every="1 steps", name="max_speed")
     try:
-        for _ in range(n):
-            sc.solver.step(sc.state, dt)
-            v = wind_square.node_velocity(sc)
-            vmax = max(vmax, float(np.abs(sc.state.velocity).max()), float(np.abs(v).max()))
-            if not np.isfinite(vmax):
-                return False, "nan", vmax
-            if vmax > bound:
-                return False, "speed above 2x free drift", vmax
-            wind_square.lagrangian_step(sc.mesh, sc.state, sc.solver, dt)
+        sim.run()
     except SolverError as exc:
-        return False, "inverted" if "invert" in str(exc) else "nan", vmax
-    return True, "stable", vmax
+        msg = str(exc)
+        why = ("speed above 2x free drift" if "above the bound" in msg else "inverted" if "invert" in msg
+               else "nan")
+        return False, why, vmax[0]
+    return True, "stable", vmax[0]
 
 
-def dx_min_of(res, E0, alpha):
-    sc = wind_square.build(resolution_m=res, domain_m=DOMAIN, rheology={"young_modulus_pa": E0, "alpha": alpha})
-    return sc.solver.dx_min
+@cache
+def dx_min_of(res):
+    """Δx_min of the scene's mesh at ``res`` (the mesh does not depend on E0 or α)."""
+    return scene_dx_min("wind_square", overrides(res, 1e9, 4.0))
 
 
 def explicit_limit(res, E0, alpha, duration_s, lo=0.3, hi=1.6, iters=6):
-    dxm = dx_min_of(res, E0, alpha)
+    dxm = dx_min_of(res)
     c = math.sqrt(E0 / RHO_I)
     sub = 10
     ok_hi = run_case("explicit", res, E0, alpha, sub * hi * dxm / c, duration_s, sub, elastic=True)[0]
@@ -111,7 +126,7 @@ def explicit_limit(res, E0, alpha, duration_s, lo=0.3, hi=1.6, iters=6):
 
 
 def implicit_limit(res, E0, alpha, duration_s, ks):
-    td = res / 500.0
+    td = res / CS
     last_ok, fail = None, None
     for k in ks:
         ok, why, vmax = run_case("implicit", res, E0, alpha, k * td, max(duration_s, 6 * k * td))
@@ -169,7 +184,10 @@ def main(argv=None):
                "implicit_dt_over_td_max": [r["implicit"]["dt_over_td_max"] for r in rows],
                "free_drift_speed_m_s": free_drift_speed(), "wall_s": time.perf_counter() - t0}
     a.json.parent.mkdir(parents=True, exist_ok=True)
-    a.json.write_text(json.dumps({"grid": grid, "implicit_k": ks, "rows": rows, "summary": summary}, indent=1))
+    data = json.dumps({"grid": grid, "implicit_k": ks, "rows": rows, "summary": summary}, indent=1)
+    a.json.write_text(data)
+    a.png.parent.mkdir(parents=True, exist_ok=True)
+    a.png.with_suffix(".json").write_text(data)  # the data of the figure, next to it
     print(json.dumps(summary, indent=1))
     plot(rows, ks, a.png)
     if a.write_limits:
@@ -180,13 +198,13 @@ def main(argv=None):
                 "law": "dt_s_max = C * dx_min / sqrt(E / rho_ice)",
                 "C": math.floor(100 * float(Cs.min())) / 100,
                 "C_range_measured": [float(Cs.min()), float(Cs.max())],
-                "grid": grid, "source": "benchmarks/stability.py",
+                "grid": grid, "source": "benchmarks/stability.py (wind_square through Simulation)",
             },
             "implicit": {
                 "law": ("dt_max = dt_over_td_max * td, td = dx/cs" if any(imp_fail)
                         else f"none found up to dt = {max(ks)} td"),
                 "dt_over_td_max": (min(k for k in imp_all if k is not None) if any(imp_fail) else None),
-                "tested_dt_over_td": ks, "source": "benchmarks/stability.py",
+                "tested_dt_over_td": ks, "source": "benchmarks/stability.py (wind_square through Simulation)",
             },
         }
         LIMITS_PATH.write_text(json.dumps(limits, indent=1) + "\n")

@@ -6,19 +6,23 @@ Two experiments:
 1. **winter basin**, 10 km, 28 days: ``examples/winter_basin.toml`` (closed)
    and ``examples/winter_basin_strait.toml`` (the same basin with an open strait),
    each run with Maxwell-EB (the scene's explicit solver) and with the EVP
-   comparison rheology (``solver.name = "evp"``) on the same mesh and forcing.
-   Deformation is Lagrangian, from the node displacements over back-to-back
+   comparison rheology (``solver.name = "evp"``, ``rheology.law = "viscous_plastic"``, no
+   healing) on the same mesh and forcing.
+   The runs are ``lagice run`` subprocesses (scene builder + Simulation, two at a
+   time). Deformation is Lagrangian, from the node displacements over back-to-back
    3-day windows after a 1-day spin-up (as RGPS; nodes are followed through
    remeshing by their ids), on the elements at least ``--coast-buffer-km`` from
    the coast (seed 000 uses 150 km in the Arctic; the basin is ~3 times smaller,
-   so the default is 100 km). Per window: β of the spatial coarse-graining, ML
-   tail exponents of the shear and |divergence| PDFs, localisation (area holding
-   half of the shear), shear–|divergence| R²; the report gives medians over the
-   windows. ``--sensitivity`` adds Maxwell-EB runs of the closed basin with
+   so the default is 100 km): :func:`lagice.diagnostics.window_statistics`, the
+   function ``lagice diagnose RUN --window-days 3 --start-day 1`` uses. Per window: β
+   of the spatial coarse-graining, ML tail exponents of the shear and |divergence|
+   PDFs, localisation (area holding half of the shear), shear–|divergence| R²; the
+   report gives medians and [min, max] over the windows. ``--sensitivity`` adds Maxwell-EB runs of the closed basin with
    another α (``SENSITIVITY``), reported apart.
-2. **uniaxial compression** (seed 004 §4–5, N = 40): the macroscopic stress of
-   every step, the damage and the node velocity averaged over blocks of N
-   steps (an elastic shear wave crossing the plate width; seed 004 §5.2).
+2. **uniaxial compression** (seed 004 §4–5, N = 40; scene builder + Simulation,
+   recorded by a callback activity): the macroscopic stress of every step, the
+   damage and the transport velocity averaged over blocks of N steps (an elastic
+   shear wave crossing the plate width; seed 004 §5.2).
    Reported: the angle between the faults and the compression axis against
    the Mohr–Coulomb prediction 45° − atan(μ)/2, the skewness of the
    macroscopic stress increments Δσ/Δt (seed 004 §5.3: ≈ −6) and β at the
@@ -50,14 +54,13 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import skew
 
-from lagice.diagnostics import spatial_scaling, summarise, velocity_gradients
+from lagice.diagnostics import spatial_scaling, velocity_gradients, window_statistics
 from lagice.diagnostics.faults import (
     angle_to_axis_deg,
     fault_orientations,
-    interior_triangles,
     mohr_coulomb_fault_angle_deg,
 )
-from lagice.io.snapshots import load_window, read_index
+from lagice.io.snapshots import read_index
 
 ROOT = Path(__file__).resolve().parents[1]
 #: basin scenes: the shipped closed basin and its variant with an open strait
@@ -93,7 +96,8 @@ SENSITIVITY = {
 RHEOLOGIES = {
     "maxwell_eb": {"label": "Maxwell-EB", "overrides": []},
     "evp": {"label": "EVP (mEVP, Hibler ellipse)",
-            "overrides": ["solver.name=evp", "solver.dt=30min", "solver.substeps=300"]},
+            "overrides": ["solver.name=evp", "rheology.law=viscous_plastic", "healing.law=none", "solver.dt=30min",
+                          "solver.substeps=300"]},
 }
 
 
@@ -120,44 +124,23 @@ def sensitivity_commands(out: Path, days: float, resolution_m: float | None):
             for name, (scene, sets, _) in SENSITIVITY.items()}
 
 
-def window_stats(run_dir: Path, start_s: float, window_s: float, buffer_m: float) -> dict:
-    """Diagnostics of one Lagrangian window, on the elements ≥ buffer_m from the coast."""
-    w = load_window(run_dir, start_s, start_s + window_s)
-    tri = w["triangles"]
-    keep = interior_triangles(*w["start_mesh"], buffer_m)[w["kept_elements"]]
-    out = {"start_day": w["start_s"] / DAY, "end_day": w["end_s"] / DAY, "n_elements": int(keep.sum()),
-           "n_elements_all": int(tri.shape[0]), "remesh_events": w["remesh_events"],
-           "n_elements_lost": w["n_elements_lost"]}
-    for name, sub in (("interior", tri[keep]), ("all", tri)):
-        s = summarise(w["xy0"], w["xy1"], sub, w["dt_s"])
-        arr = s.pop("_arrays")
-        res = {k: s[k] for k in ("beta_space", "beta_space_stderr", "beta_space_r2", "beta_space_fit_range_m",
-                                 "pdf_tail_exponent_shear", "pdf_tail_fit_range_shear_s", "pdf_tail_n_shear",
-                                 "pdf_tail_ks_shear", "pdf_tail_exponent_divergence",
-                                 "pdf_tail_fit_range_divergence_s", "pdf_tail_n_divergence",
-                                 "pdf_tail_ks_divergence", "localisation_half_shear_area_fraction",
-                                 "shear_divergence_r2", "mean_total_s", "mean_shear_s", "mean_abs_divergence_s",
-                                 "scaling_space", "pdf_shear", "pdf_divergence", "element_scale_m")}
-        if name == "interior":
-            res["_map"] = (arr["map_xy"], sub, arr["rates"].shear_s)
-        out[name] = res
-    return out
-
-
 def analyse_run(run: Path, days: float, buffer_m: float, window_days: float = 3.0, spinup_days: float = 1.0):
-    """Window statistics of one basin run and their median, min and max over the windows."""
-    starts = np.arange(spinup_days, days - window_days + 1e-9, window_days)
+    """Window statistics of one basin run (:func:`lagice.diagnostics.window_statistics`:
+    median, min and max over the windows) and the run's wall time, remeshing, outflow
+    and mean speeds."""
+    ws = window_statistics(run, window_days=window_days, coast_buffer_km=buffer_m / 1e3, start_day=spinup_days,
+                           end_day=days, metrics=tuple(TARGETS), keep_arrays=True)
+    for s in ws["skipped"]:
+        print(f"validate: {run.name}: {s['reason']}", flush=True)
     idx = read_index(run)
-    windows = [window_stats(run, t * DAY, window_days * DAY, buffer_m) for t in starts]
     summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").exists() else {}
-    return {"windows": windows, "mesh_epochs": sorted({e["mesh_epoch"] for e in idx}),
+    return {"windows": ws["windows"], "skipped_windows": ws["skipped"],
+            "mesh_epochs": sorted({e["mesh_epoch"] for e in idx}),
             "wall_s": summary.get("wall_s"), "remesh_events": idx[-1]["mesh_epoch"] - idx[0]["mesh_epoch"],
             "outflow_m3": summary.get("volume_budget", {}).get("outflow_m3"),
             "mean_speed_m_s": mean_speeds(run),
-            "median": {k: float(np.median([w["interior"][k] for w in windows])) for k in TARGETS},
-            "min": {k: float(np.min([w["interior"][k] for w in windows])) for k in TARGETS},
-            "max": {k: float(np.max([w["interior"][k] for w in windows])) for k in TARGETS},
-            "median_all_elements": {k: float(np.median([w["all"][k] for w in windows])) for k in TARGETS}}
+            "median": ws["median"], "min": ws["min"], "max": ws["max"],
+            "median_all_elements": ws["median_all_elements"]}
 
 
 def analyse_basin(out: Path, scene: str, days: float, buffer_m: float):
@@ -176,42 +159,68 @@ def mean_speeds(run_dir: Path) -> list:
 
 
 # -- uniaxial compression -------------------------------------------------------------
-def run_compression(out: Path, n_across: int, max_strain: float, seed: int = 0) -> Path:
-    """Step the compression scene, keeping per-step macro stress and block means."""
-    from lagice.scenes import compression
+class BlockRecorder:
+    """Callback after every step of the compression run: the macroscopic stress and the
+    mean damage of the step, the transport velocity averaged over blocks of ``block``
+    steps and the damage at the end of each block; a progress line every 15 s of wall time."""
 
-    sc = compression.build(n_across=n_across, seed=seed)
-    n_steps = int(np.ceil(max_strain * sc.length_m / sc.push_speed_m_s / sc.dt_s))
+    def __init__(self, sim, n_steps: int, block: int):
+        from lagice.scenes.hooks.compression import macro_stress
+
+        m = sim.model
+        self.macro_stress, self.block = macro_stress, block
+        self.area = m.mesh.areas()  # fixed mesh
+        self.stress = np.empty(n_steps)
+        self.mean_damage = np.empty(n_steps)
+        self.vel_mean = np.zeros((n_steps // block, m.mesh.n_nodes, 2))
+        self.damage_end = np.empty((n_steps // block, m.mesh.n_elements), np.float32)
+        self.t0 = time.perf_counter()
+        sim.add_callback(self, every="1 steps", name="blocks")
+        sim.add_callback(self.progress, every="wall 15s", name="compression_progress")
+
+    def __call__(self, sim):
+        m = sim.model
+        k = m.clock.iteration - 1
+        self.stress[k] = -self.macro_stress(m)  # compressive positive [Pa]
+        self.mean_damage[k] = np.average(m.state.damage, weights=self.area)
+        b = k // self.block
+        self.vel_mean[b] += m.transport_velocity
+        if (k + 1) % self.block == 0:
+            self.vel_mean[b] /= self.block
+            self.damage_end[b] = m.state.damage
+
+    def progress(self, sim):
+        m = sim.model
+        k = m.clock.iteration - 1
+        print(f"  compression step {k + 1}/{sim.n_steps}  stress {self.stress[k] / 1e3:.1f} kPa  mean damage "
+              f"{self.mean_damage[k]:.4f}  [{time.perf_counter() - self.t0:.0f} s]", flush=True)
+
+
+def run_compression(out: Path, n_across: int, max_strain: float, seed: int = 0) -> Path:
+    """Run the ``uniaxial_compression`` scene with N elements across the plate (scene builder
+    + Simulation) and keep the per-step macro stress and the block means."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from scene_runs import scene_config, scene_simulation, timed_run
+
+    cfg = scene_config("uniaxial_compression")
+    width, length = cfg["domain"]["width_m"], cfg["domain"]["height_m"]
+    push = -cfg["boundary"]["top"]["v"]
+    dx = width / n_across
+    dt = dx / cfg["rheology"]["shear_wave_speed"]  # td
     block = n_across  # elastic shear wave across the width: (L/2)/(cs Δt) = N steps
-    n_blocks = n_steps // block
-    n_steps = n_blocks * block
-    stress = np.empty(n_steps)
-    mean_damage = np.empty(n_steps)
-    vel_mean = np.zeros((n_blocks, sc.mesh.n_nodes, 2))
-    damage_end = np.empty((n_blocks, sc.mesh.n_elements), np.float32)
-    t0 = time.perf_counter()
-    last = t0
-    for k in range(n_steps):
-        sc.solver.step(sc.state, sc.dt_s)
-        stress[k] = -compression.macro_stress(sc)  # compressive positive [Pa]
-        mean_damage[k] = np.average(sc.state.damage, weights=sc.solver.area)
-        b = k // block
-        vel_mean[b] += sc.solver.mean_velocity if getattr(sc.solver, "mean_velocity", None) is not None \
-            else sc.state.velocity
-        if (k + 1) % block == 0:
-            vel_mean[b] /= block
-            damage_end[b] = sc.state.damage
-        now = time.perf_counter()
-        if now - last > 15:
-            last = now
-            print(f"  compression step {k + 1}/{n_steps}  strain {(k + 1) * sc.dt_s * sc.push_speed_m_s / sc.length_m:.2e}"
-                  f"  stress {stress[k] / 1e3:.1f} kPa  mean damage {mean_damage[k]:.4f}  [{now - t0:.0f} s]", flush=True)
+    n_steps = (int(np.ceil(max_strain * length / push / dt)) // block) * block
+    sim = scene_simulation("uniaxial_compression", {
+        "domain.resolution_m": dx, "solver.dt": "td", "run.duration": n_steps * dt, "run.seed": seed,
+        "output.timeseries": None})
+    rec = BlockRecorder(sim, n_steps, block)
+    wall = timed_run(sim)
+    m = sim.model
     path = out / f"compression_N{n_across}.npz"
-    np.savez_compressed(path, stress_pa=stress, mean_damage=mean_damage, velocity_block_mean=vel_mean,
-                        damage_block_end=damage_end, nodes=sc.mesh.nodes, triangles=sc.mesh.triangles,
-                        dt_s=sc.dt_s, block_steps=block, n_across=n_across, length_m=sc.length_m,
-                        width_m=sc.width_m, push_speed_m_s=sc.push_speed_m_s, friction=sc.solver.rheology.params.friction,
-                        wall_s=time.perf_counter() - t0, seed=seed)
+    np.savez_compressed(path, stress_pa=rec.stress, mean_damage=rec.mean_damage, velocity_block_mean=rec.vel_mean,
+                        damage_block_end=rec.damage_end, nodes=m.mesh.nodes, triangles=m.mesh.triangles,
+                        dt_s=sim.dt, block_steps=block, n_across=n_across, length_m=length,
+                        width_m=width, push_speed_m_s=push, friction=m.rheology.params.friction,
+                        wall_s=wall, seed=seed)
     return path
 
 
@@ -425,10 +434,18 @@ def _inside(k, v):
     if lo <= v <= hi:
         return "inside"
     miss = lo - v if v < lo else v - hi
-    return f"misses by {miss:.2f}" if k != "localisation_half_shear_area_fraction" else f"misses by {100 * miss:.1f} points"
+    if k == "localisation_half_shear_area_fraction":
+        return f"misses by {100 * miss:.1f} points"
+    return f"misses by {miss:.2f}"
+
+
+def _num(v):
+    return "n/a" if v is None else f"{v:.3f}"
 
 
 def _fmt(k, v):
+    if v is None or not np.isfinite(v):
+        return "n/a"
     if k == "localisation_half_shear_area_fraction":
         return f"{100 * v:.1f} %"
     return f"{v:.2f}"
@@ -457,7 +474,8 @@ def _basin_section(scene: str, b: dict, res: dict, figs: list[Path]) -> list[str
               "The same statistics on all elements (coastal shear zones included), medians over the windows:", "",
               "| metric | Maxwell-EB | EVP |", "|---|---|---|"]
     for k in TARGETS:
-        lines.append(f"| {LABELS[k]} | {_fmt(k, e['median_all_elements'][k])} | {_fmt(k, v['median_all_elements'][k])} |")
+        lines.append(f"| {LABELS[k]} | {_fmt(k, e['median_all_elements'][k])} | "
+                     f"{_fmt(k, v['median_all_elements'][k])} |")
     lines += ["", "Per window (elements away from the coast; elements of remeshed patches left out):", "",
               "| rheology | days | elements (left out) | β | tail shear | tail \\|div\\| | half-shear area | R² | "
               "⟨ε̇tot⟩ (day⁻¹) |", "|---|---|---|---|---|---|---|---|---|"]
@@ -466,7 +484,8 @@ def _basin_section(scene: str, b: dict, res: dict, figs: list[Path]) -> list[str
             i = w["interior"]
             lines.append(f"| {RHEOLOGIES[key]['label']} | {w['start_day']:.0f}–{w['end_day']:.0f} | "
                          f"{w['n_elements']} ({w['n_elements_lost']}) | {i['beta_space']:.3f} ± "
-                         f"{i['beta_space_stderr']:.3f} | {i['pdf_tail_exponent_shear']:.2f} (n={i['pdf_tail_n_shear']}) | "
+                         f"{i['beta_space_stderr']:.3f} | {i['pdf_tail_exponent_shear']:.2f} "
+                         f"(n={i['pdf_tail_n_shear']}) | "
                          f"{i['pdf_tail_exponent_divergence']:.2f} (n={i['pdf_tail_n_divergence']}) | "
                          f"{100 * i['localisation_half_shear_area_fraction']:.1f} % | "
                          f"{i['shear_divergence_r2']:.2f} | {i['mean_total_s'] * DAY:.2g} |")
@@ -506,7 +525,8 @@ def write_report(res: dict, md: Path, figs: dict):
         lines += ["## Sensitivity of Maxwell-EB to α (closed basin; not a calibration)", "",
                   "α sets how fast the Maxwell viscosity η ∝ (1 − d)^α of damaged ice falls with damage. "
                   "These runs change α alone and are reported for what they show; no value was chosen from them.",
-                  "", "| run | " + " | ".join(LABELS[k] for k in TARGETS) + " | median ⟨ε̇tot⟩ (day⁻¹) | mean speed (m s⁻¹) |",
+                  "", "| run | " + " | ".join(LABELS[k] for k in TARGETS)
+                  + " | median ⟨ε̇tot⟩ (day⁻¹) | mean speed (m s⁻¹) |",
                   "|---|" + "---|" * (len(TARGETS) + 2)]
         rows = [("α = 4 (shipped, seed 004)", base)] + [(SENSITIVITY[n][2], r) for n, r in res["sensitivity"].items()]
         for label, r in rows:
@@ -537,7 +557,8 @@ def write_report(res: dict, md: Path, figs: dict):
     lines.append(f"| skewness of Δσ/Δt, whole run | strongly negative, ≈ −6 (seed 004 §5.3) | {sk_a:.1f} | "
                  f"{'negative' if sk_a < 0 else 'NOT negative'}; {abs(sk_a - (-6)):.1f} from −6 |")
     if sk_r is not None:
-        lines.append(f"| skewness of Δσ/Δt, from the stress peak on (the regime of seed 004 Fig. 7) | ≈ −6 | {sk_r:.1f} | "
+        lines.append(f"| skewness of Δσ/Δt, from the stress peak on (the regime of seed 004 Fig. 7) | ≈ −6 | "
+                     f"{sk_r:.1f} | "
                      f"{'negative' if sk_r < 0 else 'NOT negative'}; {abs(sk_r - (-6)):.1f} from −6 |")
     lines.append(f"| β just after the macro-rupture (next block) | 0.15 ± 0.02 (seed 004 §5.2, N = 100) | "
                  f"{c['beta_after_rupture']:.3f} | "
@@ -598,7 +619,7 @@ def run_jobs(jobs: dict, out: Path, n_parallel: int):
             log.close()
             del running[name]
             if rc != 0:
-                for q, lg, _ in running.values():
+                for q, _lg, _ in running.values():
                     q.kill()
                 tail = (out / f"{name}.log").read_text()[-3000:]
                 raise SystemExit(f"validate: {name} failed (exit {rc}); log {out / (name + '.log')}:\n{tail}")
@@ -610,7 +631,8 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="4-day basins at 20 km, N = 20 compression")
     ap.add_argument("--analyse-only", action="store_true", help="re-analyse the runs in --out")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "out" / "validate")
-    ap.add_argument("--days", type=float, default=None, help="basin run length in days (default 28, the scene's own; quick 4)")
+    ap.add_argument("--days", type=float, default=None,
+                    help="basin run length in days (default 28, the scene's own; quick 4)")
     ap.add_argument("--coast-buffer-km", type=float, default=100.0)
     ap.add_argument("--n-across", type=int, default=None, help="compression N (default 40, quick 20)")
     ap.add_argument("--max-strain", type=float, default=1e-3)
@@ -652,7 +674,8 @@ def main(argv=None):
     figs["compression"] = figure_compression(comp, args.fig_dir)
     res = {"quick": args.quick, "date": time.strftime("%Y-%m-%d"), "wall_s": time.perf_counter() - t0,
            "basin_days": days, "resolution_km": (resolution or 10e3) / 1e3, "coast_buffer_km": args.coast_buffer_km,
-           "basin": basin, "sensitivity": sens, "compression": comp, "targets": {k: list(v) for k, v in TARGETS.items()},
+           "basin": basin, "sensitivity": sens, "compression": comp,
+           "targets": {k: list(v) for k, v in TARGETS.items()},
            "json": str((args.fig_dir.resolve() / "validation.json").relative_to(ROOT))
            if args.fig_dir.resolve().is_relative_to(ROOT) else str(args.fig_dir / "validation.json")}
     if args.discussion.exists():
@@ -666,7 +689,8 @@ def main(argv=None):
     print(f"validate: report {md}")
     for s in SCENES:
         for k in TARGETS:
-            print(f"  {s:7s} {k}: EB {basin[s]['maxwell_eb']['median'][k]:.3f}  EVP {basin[s]['evp']['median'][k]:.3f}  "
+            print(f"  {s:7s} {k}: EB {_num(basin[s]['maxwell_eb']['median'][k])}  "
+                  f"EVP {_num(basin[s]['evp']['median'][k])}  "
                   f"(band {TARGETS[k][0]}–{TARGETS[k][1]})")
     print(f"  compression: fault angles {comp['fault_angles_rate_deg']} (MC {comp['mohr_coulomb_angle_deg']:.1f}), "
           f"skewness {comp['skewness_increments_all']:.2f}, β after rupture {comp['beta_after_rupture']:.3f}")

@@ -11,6 +11,8 @@
     lagice info FILE                                      describe a netCDF output or checkpoint
     lagice diagnose OUTPUT [--window-steps K] [--coast-buffer-km B]
                                                           deformation statistics (JSON + PNG)
+    lagice diagnose OUTPUT --window-days D [--start-day S] [--coast-buffer-km B]
+                                                          statistics over back-to-back windows
     lagice scenes                                         list bundled scenes
 
 A new run writes to ``runs/SCENE-YYYYmmdd-HHMMSS/`` (linked as ``runs/SCENE-latest``)
@@ -233,9 +235,11 @@ def _info(args) -> int:
 
 
 def _diagnose(args) -> int:
-    from .diagnostics import diagnose_arrays
-    from .diagnostics.faults import interior_triangles
-    from .io.snapshots import load_window, read_index, snapshot_dir
+    """One window (the last ``--window-steps`` snapshots: JSON + PNG figures) or, with
+    ``--window-days``, back-to-back windows over the run (``window_statistics.json``):
+    both through :mod:`lagice.diagnostics.windows`."""
+    from .diagnostics import diagnose_arrays, window_arrays, window_statistics
+    from .io.snapshots import read_index, snapshot_dir
 
     snaps = snapshot_dir(args.output)
     if args.window_steps < 1:
@@ -245,26 +249,21 @@ def _diagnose(args) -> int:
     index = read_index(snaps)
     if len(index) < 2:
         raise LagiceError(f"{snaps}: need two snapshots to diagnose deformation (found {len(index)})")
+    out = Path(args.out or snaps.parent / "diagnostics")
+    if args.window_days is not None:
+        return _diagnose_windows(args, snaps, out, window_statistics)
     k = min(args.window_steps, len(index) - 1)
     if k < args.window_steps:
         log.warning(f"--window-steps {args.window_steps}: the run has {len(index)} snapshots; the window was "
                     f"shortened to {k} snapshot interval(s)")
-    w = load_window(snaps, index[-1 - k]["time_s"], index[-1]["time_s"])
+    xy0, xy1, tri, dt, w = window_arrays(snaps, index[-1 - k]["time_s"], index[-1]["time_s"],
+                                         args.coast_buffer_km * 1e3)
     if w["remesh_events"]:
         print(f"  {w['remesh_events']} remesh event(s) in the window: nodes followed by node_id, "
               f"{w['n_elements_lost']} remeshed elements left out")
-    xy0, xy1, tri, dt = w["xy0"], w["xy1"], w["triangles"], w["dt_s"]
-    if w["fixed_mesh"]:  # fixed mesh: use the mean velocity over the window instead
-        xy1 = xy0 + 0.5 * (w["velocity0"] + w["velocity1"]) * dt
     if args.coast_buffer_km > 0:
-        keep = interior_triangles(*w["start_mesh"], args.coast_buffer_km * 1e3)[w["kept_elements"]]
-        if keep.sum() < 10:
-            raise LagiceError(f"--coast-buffer-km = {args.coast_buffer_km}: only {int(keep.sum())} elements "
-                              f"lie that far from the boundary; use a smaller buffer")
-        print(f"  {int(keep.sum())} of {tri.shape[0]} elements are >= {args.coast_buffer_km:g} km from the boundary")
-        tri = tri[keep]
-    out = Path(args.out or snaps.parent / "diagnostics")
-    res = diagnose_arrays(xy0, xy1, tri, dt, out)
+        print(f"  {w['n_elements']} of {tri.shape[0]} elements are >= {args.coast_buffer_km:g} km from the boundary")
+    res = diagnose_arrays(xy0, xy1, tri[w["interior"]], dt, out)
     print(f"  diagnostics over a {dt / 86400:.2f}-day window -> {out.resolve()}/diagnostics.json")
     for key in ("beta_space", "pdf_tail_exponent_shear", "pdf_tail_exponent_divergence",
                 "localisation_half_shear_area_fraction", "shear_divergence_r2"):
@@ -275,9 +274,41 @@ def _diagnose(args) -> int:
 
     rates = lagrangian_velocity_gradients(xy0, xy1, tri, dt, res.get("geometry", "mid"))
     for name, vals in (("shear", rates.shear_s), ("|divergence|", abs(rates.divergence_s))):
-        for w in tail_fit_quality(vals).warnings(f"PDF tail of {name}"):
-            log.warning(w)
+        for msg in tail_fit_quality(vals).warnings(f"PDF tail of {name}"):
+            log.warning(msg)
     return 0
+
+
+def _diagnose_windows(args, snaps, out, window_statistics) -> int:
+    res = window_statistics(snaps, args.window_days, args.coast_buffer_km, args.start_day, args.end_day)
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / "window_statistics.json"
+    path.write_text(json.dumps(res, indent=1, default=_json_default))
+    print(f"  {len(res['windows'])} back-to-back windows of {args.window_days:g} days from day {args.start_day:g}, "
+          f"elements >= {args.coast_buffer_km:g} km from the boundary -> {path.resolve()}")
+    for w in res["skipped"]:
+        print(f"  days {w['start_day']:g}-{w['end_day']:g}: skipped: {w['reason']}")
+    for w in res["windows"]:
+        lost = f", {w['n_elements_lost']} remeshed left out" if w["n_elements_lost"] else ""
+        print(f"  days {w['start_day']:g}-{w['end_day']:g}: {w['n_elements']} elements{lost}, "
+              f"beta {_num(w['interior']['beta_space'])}")
+    for key, med in res["median"].items():
+        print(f"  {key}: median {_num(med)} [{_num(res['min'][key])}, {_num(res['max'][key])}]")
+    return 0
+
+
+def _num(x) -> str:
+    return "n/a" if x is None else f"{x:.4g}"
+
+
+def _json_default(x):
+    import numpy as np
+
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, (np.floating, np.integer, np.bool_)):
+        return x.item()
+    raise TypeError(f"not JSON-serialisable: {type(x).__name__}")
 
 
 def _scenes(args) -> int:
@@ -335,7 +366,13 @@ def main(argv=None) -> int:
     d.add_argument("output")
     d.add_argument("--window-steps", type=int, default=1, help="snapshots spanned by the window")
     d.add_argument("--coast-buffer-km", type=float, default=0.0,
-                   help="analyse only elements this far from the mesh boundary (seed 000: 150 km)")
+                   help="analyse only elements this far from the mesh boundary (Girard et al. 2011: 150 km)")
+    d.add_argument("--window-days", type=float, default=None,
+                   help="statistics over back-to-back windows of this many days (median, [min, max]; "
+                        "window_statistics.json) instead of one window")
+    d.add_argument("--start-day", type=float, default=1.0, help="with --window-days: first window start (spin-up)")
+    d.add_argument("--end-day", type=float, default=None, help="with --window-days: last window end (default: "
+                                                               "the last snapshot)")
     d.add_argument("--out")
     d.set_defaults(func=_diagnose)
     sc = sub.add_parser("scenes", help="list bundled scenes", parents=[common])

@@ -9,7 +9,10 @@ applies equally to model output and to RGPS-like Lagrangian data:
 - :func:`temporal_scaling`: ⟨ε̇tot⟩(T) ∝ T^−α;
 - :func:`log_binned_pdf`, :func:`fit_power_law_tail`: PDFs and ML tail exponents;
 - :func:`localisation_area_fraction`, :func:`shear_divergence_r2`;
-- :func:`summarise`, :func:`write_json`, :func:`write_figures`, :func:`diagnose_arrays`.
+- :func:`summarise`, :func:`write_json`, :func:`write_figures`, :func:`diagnose_arrays`;
+- :func:`window_statistics`: the statistics of a run over back-to-back Lagrangian
+  windows (median and [min, max] over the windows, coast buffer), as used by
+  ``lagice diagnose --window-days`` and ``benchmarks/validate.py``.
 
 See ``docs/diagnostics.md``.
 """
@@ -49,6 +52,12 @@ from lagice.diagnostics.strain import (
     triangle_geometry,
     velocity_gradients,
 )
+from lagice.diagnostics.windows import (
+    WINDOW_METRICS,
+    window_arrays,
+    window_statistics,
+    window_summary,
+)
 
 __all__ = [
     "ElementStrainRates", "divergence_rate", "lagrangian_velocity_gradients", "shear_rate",
@@ -58,4 +67,5 @@ __all__ = [
     "LogBinnedPdf", "PowerLawTail", "fit_power_law_tail", "localisation_area_fraction",
     "log_binned_pdf", "shear_divergence_r2",
     "JSON_KEYS", "diagnose_arrays", "summarise", "write_figures", "write_json",
+    "WINDOW_METRICS", "window_arrays", "window_statistics", "window_summary",
 ]

@@ -1,0 +1,172 @@
+"""Deformation statistics of a run over back-to-back Lagrangian windows (as RGPS).
+
+A run's snapshots (``RUN/snapshots``) give node positions at the snapshot times.
+:func:`window_statistics` cuts the run into back-to-back windows of
+``window_days`` from ``start_day`` on (the first days are spin-up), follows the
+nodes through each window (across remeshing by their persistent ids,
+:func:`lagice.io.snapshots.load_window`), keeps the elements whose centroid is at
+least ``coast_buffer_km`` from the mesh boundary at the start of the window
+(:func:`lagice.diagnostics.faults.interior_triangles`; Girard et al. 2011 used
+150 km from the Arctic coasts), and computes the statistics of
+:func:`lagice.diagnostics.summarise` per window (β of the spatial scaling, tail
+exponents of the shear and |divergence| PDFs, localisation, shear–|divergence|
+R², mean rates) on those elements and on all elements. It reports, per metric,
+the median over the windows and the [min, max]: a window in which the ice hardly
+moves gives degenerate values, and the median is not pulled by one such window.
+
+``lagice diagnose RUN --window-days 3 --coast-buffer-km 100 --start-day 1`` and
+``benchmarks/validate.py`` use this function. See ``docs/diagnostics.md``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from lagice.errors import ConfigError, LagiceError
+
+DAY_S = 86400.0
+
+
+class WindowError(LagiceError):
+    """A window with too few elements followed through it (remeshing replaced them)."""
+
+#: the metrics :func:`window_statistics` summarises over the windows (keys of :func:`summarise`)
+WINDOW_METRICS = ("beta_space", "pdf_tail_exponent_divergence", "pdf_tail_exponent_shear",
+                  "localisation_half_shear_area_fraction", "shear_divergence_r2", "mean_total_s")
+
+#: per-window keys kept from :func:`summarise` (JSON-serialisable)
+WINDOW_KEYS = ("beta_space", "beta_space_stderr", "beta_space_r2", "beta_space_fit_range_m",
+               "pdf_tail_exponent_shear", "pdf_tail_fit_range_shear_s", "pdf_tail_n_shear", "pdf_tail_ks_shear",
+               "pdf_tail_exponent_divergence", "pdf_tail_fit_range_divergence_s", "pdf_tail_n_divergence",
+               "pdf_tail_ks_divergence", "localisation_half_shear_area_fraction", "shear_divergence_r2",
+               "mean_total_s", "mean_shear_s", "mean_abs_divergence_s", "scaling_space", "pdf_shear",
+               "pdf_divergence", "element_scale_m")
+
+
+def window_arrays(run_dir, start_s: float, end_s: float, coast_buffer_m: float = 0.0, min_elements: int = 10):
+    """Node positions at the snapshots nearest ``start_s`` and ``end_s`` [s] and the
+    elements kept for the statistics.
+
+    Returns ``(xy0, xy1, triangles, dt_s, info)``: ``triangles`` are the elements
+    present over the whole window (remeshed patches left out), ``info`` the window of
+    :func:`lagice.io.snapshots.load_window` (without its arrays) plus ``interior``
+    (mask of the triangles at least ``coast_buffer_m`` [m] from the boundary of the
+    window's first mesh), ``n_elements`` (their number) and ``n_elements_all``.
+    A run on a fixed mesh (no node moved) is a Eulerian run: its displacement over
+    the window is taken as Δt × the mean of the velocities at both ends. Raises
+    :class:`~lagice.errors.ConfigError` naming ``coast_buffer_km`` when fewer than
+    ``min_elements`` elements are that far from the boundary."""
+    from lagice.diagnostics.faults import interior_triangles
+    from lagice.io.snapshots import load_window
+
+    if not (math.isfinite(coast_buffer_m) and coast_buffer_m >= 0):
+        raise ConfigError(f"coast_buffer_km = {coast_buffer_m / 1e3!r}: expected a distance >= 0 km")
+    w = load_window(run_dir, start_s, end_s)
+    xy0, xy1, tri, dt = w["xy0"], w["xy1"], w["triangles"], w["dt_s"]
+    if w["fixed_mesh"]:
+        xy1 = xy0 + 0.5 * (w["velocity0"] + w["velocity1"]) * dt
+    inside = interior_triangles(*w["start_mesh"], coast_buffer_m)
+    if inside.sum() < min_elements:
+        raise ConfigError(f"coast_buffer_km = {coast_buffer_m / 1e3:g}: only {int(inside.sum())} elements lie that "
+                          f"far from the boundary (at least {min_elements} needed); use a smaller buffer")
+    keep = inside[w["kept_elements"]]
+    if keep.sum() < min_elements:
+        raise WindowError(f"{run_dir}: window {w['start_s'] / DAY_S:g}-{w['end_s'] / DAY_S:g} days: only "
+                          f"{int(keep.sum())} of the {int(inside.sum())} elements >= {coast_buffer_m / 1e3:g} km "
+                          f"from the boundary can be followed through the window ({w['remesh_events']} remesh "
+                          f"event(s) replaced {w['n_elements_lost']} elements); choose other windows")
+    info = {k: v for k, v in w.items() if k not in ("xy0", "xy1", "triangles", "datasets")}
+    info.update(n_elements=int(keep.sum()), n_elements_all=int(tri.shape[0]), interior=keep)
+    return xy0, xy1, tri, dt, info
+
+
+def window_summary(run_dir, start_s: float, window_s: float, coast_buffer_m: float = 0.0,
+                   keep_arrays: bool = False) -> dict:
+    """Statistics of one Lagrangian window ``[start_s, start_s + window_s]`` [s].
+
+    Returns ``{"start_day", "end_day", "n_elements" (kept), "n_elements_all",
+    "remesh_events", "n_elements_lost", "interior": {...}, "all": {...}}`` with the
+    :data:`WINDOW_KEYS` of :func:`lagice.diagnostics.summarise` on the elements
+    ``coast_buffer_m`` [m] from the boundary (``interior``) and on all elements.
+    ``keep_arrays``: ``interior`` also holds ``"_map"`` = (element-map node
+    positions, triangles, shear rate [s-1]) for figures (not JSON-serialisable)."""
+    from lagice.diagnostics.report import summarise
+
+    xy0, xy1, tri, dt, info = window_arrays(run_dir, start_s, start_s + window_s, coast_buffer_m)
+    out = {"start_day": info["start_s"] / DAY_S, "end_day": info["end_s"] / DAY_S,
+           "n_elements": info["n_elements"], "n_elements_all": info["n_elements_all"],
+           "remesh_events": info["remesh_events"], "n_elements_lost": info["n_elements_lost"]}
+    for name, sub in (("interior", tri[info["interior"]]), ("all", tri)):
+        s = summarise(xy0, xy1, sub, dt)
+        arr = s.pop("_arrays")
+        res = {k: s[k] for k in WINDOW_KEYS}
+        if name == "interior" and keep_arrays:
+            res["_map"] = (arr["map_xy"], sub, arr["rates"].shear_s)
+        out[name] = res
+    return out
+
+
+def window_starts_days(run_dir, window_days: float, start_day: float = 1.0, end_day: float | None = None):
+    """Start days of the back-to-back windows of ``window_days`` from ``start_day`` that end
+    by ``end_day`` (default: the last snapshot)."""
+    from lagice.io.snapshots import read_index
+
+    if not (math.isfinite(window_days) and window_days > 0):
+        raise ConfigError(f"window_days = {window_days!r}: expected a window length > 0 days")
+    if not (math.isfinite(start_day) and start_day >= 0):
+        raise ConfigError(f"start_day = {start_day!r}: expected a day >= 0 (the spin-up to skip)")
+    idx = read_index(run_dir)
+    last = idx[-1]["time_s"] / DAY_S
+    end = last if end_day is None else float(end_day)
+    starts = np.arange(start_day, end - window_days + 1e-9, window_days)
+    if starts.size == 0:
+        raise ConfigError(f"window_days = {window_days:g} from start_day = {start_day:g}: no whole window fits "
+                          f"before day {end:g} (the run's snapshots span days {idx[0]['time_s'] / DAY_S:g}–{last:g})")
+    return starts
+
+
+def window_statistics(run_dir, window_days: float = 3.0, coast_buffer_km: float = 100.0, start_day: float = 1.0,
+                      end_day: float | None = None, metrics=WINDOW_METRICS, keep_arrays: bool = False) -> dict:
+    """Deformation statistics over back-to-back Lagrangian windows of a run.
+
+    Args:
+        run_dir: a run folder (with ``snapshots/``) or a snapshot folder.
+        window_days: window length [days] (RGPS: 3).
+        coast_buffer_km: statistics on the elements whose centroid is at least this
+            far from the mesh boundary [km] (``all`` keeps every element).
+        start_day: first window start [days] (the days before are spin-up).
+        end_day: last window end [days] (default: the last snapshot).
+        metrics: the per-window keys summarised over the windows.
+        keep_arrays: keep the element maps of each window (see :func:`window_summary`).
+
+    Returns ``{"window_days", "coast_buffer_km", "start_day", "windows": [per-window
+    dicts of :func:`window_summary`], "skipped": [{"start_day", "end_day", "reason"}],
+    "median", "min", "max": {metric: value over the windows, interior elements},
+    "median_all_elements": {metric: median, all elements}}``. A window in which
+    remeshing replaced (nearly) all the elements cannot be followed: it is listed
+    in ``skipped`` with the reason, not in ``windows``. A metric that is NaN in some
+    windows is summarised over the others (``None`` if NaN in all)."""
+    starts = window_starts_days(run_dir, window_days, start_day, end_day)
+    windows, skipped = [], []
+    for t in starts:
+        try:
+            windows.append(window_summary(run_dir, t * DAY_S, window_days * DAY_S, coast_buffer_km * 1e3,
+                                          keep_arrays))
+        except WindowError as exc:
+            skipped.append({"start_day": float(t), "end_day": float(t + window_days), "reason": str(exc)})
+    if not windows:
+        raise WindowError(f"{run_dir}: no window could be followed: " + "; ".join(s["reason"] for s in skipped))
+
+    def over(fn, part):
+        out = {}
+        for k in metrics:
+            v = np.array([np.nan if w[part][k] is None else w[part][k] for w in windows], np.float64)
+            v = v[np.isfinite(v)]
+            out[k] = float(fn(v)) if v.size else None
+        return out
+
+    return {"window_days": float(window_days), "coast_buffer_km": float(coast_buffer_km),
+            "start_day": float(start_day), "windows": windows, "skipped": skipped,
+            "median": over(np.median, "interior"), "min": over(np.min, "interior"),
+            "max": over(np.max, "interior"), "median_all_elements": over(np.median, "all")}

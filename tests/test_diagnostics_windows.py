@@ -1,0 +1,138 @@
+"""lagice.diagnostics.window_statistics: deformation statistics over back-to-back
+Lagrangian windows of a run, checked on an analytic shear field (known rates,
+known coast-buffer element count) and on a real run through the CLI
+(``lagice diagnose --window-days`` reports the same numbers as the function, and
+its last window the same as the single-window ``lagice diagnose``)."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import shapely
+
+from lagice.diagnostics import summarise, window_arrays, window_statistics
+from lagice.errors import ConfigError
+from lagice.lagrangian import MeshMotion
+from lagice.mesh import generate_mesh, rectangle_domain
+from lagice.model import Model
+from lagice.simulation import Simulation
+from lagice.solvers import PrescribedStepper
+from lagice.state import IceState
+
+DAY = 86400.0
+L = 400e3
+GAMMA = 2e-7  # s-1: simple shear u = GAMMA (y - L/2), v = 0 (about 1.7 % per day)
+
+
+def shear(t, x, y):
+    return GAMMA * (np.asarray(y) - 0.5 * L), np.zeros(np.shape(x))
+
+
+@pytest.fixture(scope="module")
+def shear_run(tmp_path_factory):
+    """7 days of simple shear of a free 400 km square, 6-h steps, daily snapshots."""
+    out = tmp_path_factory.mktemp("shear_run")
+    poly, _ = rectangle_domain(L, L)
+    mesh = generate_mesh(poly, 25e3, exterior_tag="free")  # nothing fixed: every node moves with the field
+    st = IceState.uniform(mesh, thickness_m=1.0, concentration=1.0, cohesion_pa=1e9)
+    model = Model(st, solver=PrescribedStepper(mesh=mesh, velocity=shear), mover=MeshMotion())
+    sim = Simulation(model, dt="6h", stop="7d", progress=False)
+    sim.output(every="1d", path=out / "snapshots", crs=None)
+    sim.run()
+    return out
+
+
+def test_windows_of_an_analytic_shear(shear_run):
+    buffer_km = 60.0
+    res = window_statistics(shear_run, window_days=3.0, coast_buffer_km=buffer_km, start_day=1.0)
+    w = res["windows"]
+    assert [(x["start_day"], x["end_day"]) for x in w] == [(1.0, 4.0), (4.0, 7.0)]  # back to back, day 7 is the end
+    assert res["skipped"] == []
+    for x in w:
+        for part in ("interior", "all"):
+            s = x[part]
+            # a linear velocity field with nilpotent gradient moves the nodes by exactly T·G·x:
+            # the Lagrangian rates are the field's, element by element
+            assert s["mean_shear_s"] == pytest.approx(GAMMA, rel=1e-9)
+            assert s["mean_total_s"] == pytest.approx(GAMMA, rel=1e-9)
+            assert s["mean_abs_divergence_s"] < 1e-9 * GAMMA
+            # a uniform rate is the same at every scale: β = 0; half of the shear is on half the area
+            assert abs(s["beta_space"]) < 1e-9
+            assert s["localisation_half_shear_area_fraction"] == pytest.approx(0.5, rel=1e-9)
+        # the coast buffer: elements whose centroid is >= 60 km inside the sheared square at
+        # the window start (corners moved by u·t: a parallelogram), computed from the geometry
+        t0 = x["start_day"] * DAY
+        corners = np.array([[0, 0], [L, 0], [L, L], [0, L]], float)
+        corners[:, 0] += GAMMA * (corners[:, 1] - 0.5 * L) * t0
+        boundary = shapely.Polygon(corners).exterior
+        xy0, _, tri, _, info = window_arrays(shear_run, t0, t0 + 3 * DAY)
+        c = xy0[tri].mean(axis=1)
+        dist = shapely.distance(shapely.points(c), boundary)
+        assert x["n_elements"] == int(np.sum(dist >= buffer_km * 1e3)) < x["n_elements_all"] == tri.shape[0]
+    # summaries over the windows: the median of two windows is their mean, [min, max] brackets it
+    for k, med in res["median"].items():
+        vals = [x["interior"][k] for x in w]
+        if any(v is None or not np.isfinite(v) for v in vals):
+            continue
+        assert med == pytest.approx(np.mean(vals), rel=1e-12, abs=1e-15)
+        assert res["min"][k] == min(vals) and res["max"][k] == max(vals)
+    assert res["median"]["mean_total_s"] == pytest.approx(GAMMA, rel=1e-9)
+    # a uniform shear rate has no spread: its R² against |divergence| and its PDF tail are
+    # undefined in every window (NaN), and the summary says so (None), not a number
+    assert all(np.isnan(x["interior"]["shear_divergence_r2"]) for x in w)
+    assert res["median"]["shear_divergence_r2"] is None and res["median"]["pdf_tail_exponent_shear"] is None
+
+
+def test_windows_refuse_bad_input_naming_the_value(shear_run):
+    with pytest.raises(ConfigError, match="window_days = 0"):
+        window_statistics(shear_run, window_days=0.0)
+    with pytest.raises(ConfigError, match="no whole window fits"):
+        window_statistics(shear_run, window_days=3.0, start_day=5.0)
+    with pytest.raises(ConfigError, match="coast_buffer_km = 300: only 0 elements"):
+        window_statistics(shear_run, window_days=3.0, coast_buffer_km=300.0)
+    with pytest.raises(ConfigError, match="start_day = -1"):
+        window_statistics(shear_run, window_days=3.0, start_day=-1.0)
+
+
+def _cli(*args):
+    r = subprocess.run([sys.executable, "-m", "lagice.cli", *args], capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr[-3000:]
+    return r
+
+
+@pytest.mark.slow
+def test_cli_diagnose_windows_on_a_real_run(tmp_path):
+    """shear_channel at 20 km for 4 days (prescribed shear, mesh motion, remeshing):
+    ``lagice diagnose --window-days`` writes what window_statistics computes, and its
+    last window is the single window of ``lagice diagnose --window-steps 2``."""
+    run = tmp_path / "run"
+    _cli("run", "shear_channel", "--out", str(run), "--set", "domain.resolution_m=20e3",
+         "--set", "domain.params.vertex_spacing_m=20e3", "--set", "run.duration=4d", "--set", "output.every=12h",
+         "--set", "output.plot=false", "--set", "run.progress=false")
+    r = _cli("diagnose", str(run), "--window-days", "1", "--start-day", "1", "--coast-buffer-km", "15",
+             "--out", str(tmp_path / "win"))
+    assert "3 back-to-back windows of 1 days" in r.stdout
+    got = json.loads((tmp_path / "win" / "window_statistics.json").read_text())
+    ref = window_statistics(run, window_days=1.0, coast_buffer_km=15.0, start_day=1.0)
+    assert [(w["start_day"], w["end_day"]) for w in got["windows"]] == [(1.0, 2.0), (2.0, 3.0), (3.0, 4.0)]
+    for k in ref["median"]:
+        assert got["median"][k] == pytest.approx(ref["median"][k], rel=1e-12)
+        vals = [w["interior"][k] for w in ref["windows"]]
+        assert got["median"][k] == pytest.approx(float(np.median(vals)), rel=1e-12)
+        assert got["min"][k] <= got["median"][k] <= got["max"][k]
+    # the prescribed field shears the channel: every window deforms, the interior less than the walls
+    for w in got["windows"]:
+        assert 10 <= w["n_elements"] < w["n_elements_all"]
+        assert w["interior"]["mean_shear_s"] > 0
+    one = _cli("diagnose", str(run), "--window-steps", "2", "--coast-buffer-km", "15", "--out", str(tmp_path / "one"))
+    assert "elements are >= 15 km from the boundary" in one.stdout
+    single = json.loads((tmp_path / "one" / "diagnostics.json").read_text())
+    last = got["windows"][-1]
+    assert single["n_elements"] == last["n_elements"]
+    for k in ("beta_space", "mean_shear_s", "pdf_tail_exponent_shear", "localisation_half_shear_area_fraction"):
+        assert single[k] == pytest.approx(last["interior"][k], rel=1e-12)
+    # and the same numbers straight from the arrays
+    xy0, xy1, tri, dt, info = window_arrays(run, 3 * DAY, 4 * DAY, 15e3)
+    s = summarise(xy0, xy1, tri[info["interior"]], dt)
+    assert s["beta_space"] == pytest.approx(last["interior"]["beta_space"], rel=1e-12)
