@@ -1,0 +1,392 @@
+"""``Ensemble``: run the members of a spec on dask.distributed, resume, summarise."""
+from __future__ import annotations
+
+import contextlib
+import datetime as _dt
+import json
+import math
+import os
+import shutil
+import socket
+import sys
+import time
+import uuid
+from pathlib import Path
+
+from ..errors import ConfigError, LagiceError
+from .member import member_state, run_member, write_json
+from .spec import EnsembleSpec, load_spec
+
+
+class Ensemble:
+    """An ensemble of lagice runs.
+
+    ::
+
+        ens = lagice.Ensemble.from_file("examples/ensembles/shear_box_grid.toml", out_dir="runs/sweep")
+        summary = ens.run()                 # embedded LocalCluster sized to the machine
+        summary = ens.run(client=client)    # an existing dask.distributed Client
+        grids = lagice.ensemble.open_grids("runs/sweep")
+
+    ``spec``: an :class:`~lagice.ensemble.spec.EnsembleSpec`, a TOML path, TOML
+    text or a dict (validated at once: a bad spec raises
+    :class:`~lagice.errors.ConfigError` before anything runs).
+    """
+
+    def __init__(self, spec, out_dir=None, overrides=None):
+        self.spec: EnsembleSpec = spec if isinstance(spec, EnsembleSpec) else load_spec(spec, overrides)
+        self.out_dir = Path(out_dir) if out_dir is not None else Path("runs") / self.spec.name
+        self.last_run = {}
+
+    @classmethod
+    def from_file(cls, path, out_dir=None, overrides=None) -> Ensemble:
+        return cls(load_spec(Path(path), overrides), out_dir)
+
+    @property
+    def members(self):
+        return self.spec.members
+
+    # -- bookkeeping ---------------------------------------------------------------------
+    def _task(self, m) -> dict:
+        s = self.spec
+        return {"id": m.id, "out": str(self.out_dir.resolve()), "config": m.config, "config_hash": m.config_hash,
+                "overrides": m.overrides, "common": s.common, "ensemble": s.name, "base": s.base,
+                "branch_from": str(s.branch_from.resolve()) if s.branch_from else None,
+                "branch_sha256": s.branch_sha256, "analysis": s.analysis}
+
+    def _info(self) -> dict:
+        s = self.spec
+        from .. import __version__
+        return {"name": s.name, "source": s.source, "base": s.base, "common": s.common,
+                "branch_from": str(s.branch_from.resolve()) if s.branch_from else None,
+                "branch_sha256": s.branch_sha256, "analysis": s.analysis, "lagice_version": __version__,
+                "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")}
+
+    def check_folder(self) -> dict:
+        """Compare the spec with an earlier run in the output folder (``ensemble.json``):
+        a member whose configuration changed is an error (its outputs would mix two
+        runs). Returns the earlier ``ensemble.json`` content ({} if none)."""
+        p = self.out_dir / "ensemble.json"
+        if not p.exists():
+            if self.out_dir.exists() and any(self.out_dir.iterdir()):
+                raise ConfigError(f"--out {self.out_dir}: the folder is not empty and holds no ensemble "
+                                  "(no ensemble.json); choose a new or empty folder")
+            return {}
+        old = json.loads(p.read_text())
+        for m in self.members:
+            prev = old.get("members", {}).get(m.id)
+            if prev is not None and prev["config_hash"] != m.config_hash:
+                diff = _diff(prev.get("config", {}), m.config)
+                raise ConfigError(f"{self.out_dir}: member {m.id!r} was started with another configuration "
+                                  f"({'; '.join(diff[:5]) or 'config hash differs'}); re-running resumes the "
+                                  "same ensemble only: use a new --out, or delete "
+                                  f"{self.out_dir / 'members' / m.id}")
+        return old
+
+    def _write_ensemble_json(self, old: dict) -> None:
+        members = dict(old.get("members", {}))
+        order = [m.id for m in self.members] + [k for k in members if k not in {m.id for m in self.members}]
+        for m in self.members:
+            members[m.id] = {"overrides": m.overrides, "config_hash": m.config_hash, "config": m.config}
+        info = {**self._info(), "members": {k: members[k] for k in order}, "order": order}
+        self.out_dir.mkdir(parents=True, exist_ok=True)
+        write_json(self.out_dir / "ensemble.json", info)
+        if self.spec.source not in ("<dict>", "<toml>"):
+            shutil.copyfile(self.spec.source, self.out_dir / "ensemble_spec.toml")
+
+    def plan(self, retry_failed: bool = True) -> dict:
+        """{member id: "done" | "resume" | "new" | "retry" | "skip_failed"}."""
+        out = {}
+        for m in self.members:
+            st = member_state(self.out_dir / "members" / m.id)
+            if st == "failed":
+                st = "retry" if retry_failed else "skip_failed"
+            out[m.id] = st
+        return out
+
+    # -- running ---------------------------------------------------------------------------
+    def run(self, client=None, *, workers: int | None = None, scheduler: str | None = None,
+            serial: bool = False, retry_failed: bool = True, plot: bool = True):
+        """Run the members that are not finished; return the summary (xarray Dataset).
+
+        ``client``: a ``distributed.Client`` to use; otherwise a cluster is made from
+        the spec's ``[cluster]`` table (default: a LocalCluster sized to the machine),
+        ``scheduler`` (an address) or, with ``serial=True``, members run one by one
+        in this process. Finished members (``done.json``) are skipped, interrupted
+        ones resume from their newest checkpoint, failed ones are run again unless
+        ``retry_failed=False``. Writes ``ensemble_summary.nc`` and ``ensemble_spread.png``.
+        """
+        old = self.check_folder()
+        self.out_dir.mkdir(parents=True, exist_ok=True)
+        with _FolderLock(self.out_dir / "ensemble.lock"):
+            return self._run_locked(old, client, workers, scheduler, serial, retry_failed, plot)
+
+    def _run_locked(self, old, client, workers, scheduler, serial, retry_failed, plot):
+        self._write_ensemble_json(old)
+        plan = self.plan(retry_failed)
+        todo = [m for m in self.members if plan[m.id] in ("new", "resume", "retry")]
+        counts = {k: sum(v == k for v in plan.values()) for k in ("done", "resume", "new", "retry", "skip_failed")}
+        _say(f"ensemble {self.spec.name!r}: {len(self.members)} members -> {self.out_dir}/ "
+             f"({counts['done']} done, {counts['resume']} to resume, {counts['new']} to start, "
+             f"{counts['retry']} failed to retry" + (f", {counts['skip_failed']} failed kept" if counts["skip_failed"]
+                                                      else "") + ")")
+        t0 = time.perf_counter()
+        self.last_run = {"plan": plan, "setup_s": 0.0, "cluster": None}
+        try:
+            if todo:
+                if serial:
+                    self._run_serial(todo)
+                else:
+                    self._run_dask(todo, client, workers, scheduler)
+        finally:
+            self.last_run["wall_s"] = time.perf_counter() - t0
+            summary = self.summarise(plot=plot)
+        failed = [str(m) for m, s in zip(summary["member"].values, summary["status"].values) if s != "done"]
+        _say(f"ensemble {self.spec.name!r}: {len(self.members) - len(failed)} of {len(self.members)} members done "
+             f"in {self.last_run['wall_s']:.1f} s wall; summary {self.out_dir / 'ensemble_summary.nc'}")
+        for m in failed:
+            i = list(summary["member"].values).index(m)
+            _say(f"  {m}: {summary['status'].values[i]}: {summary['error'].values[i]}")
+        return summary
+
+    def _run_serial(self, todo):
+        prog = _Progress(len(todo), slots=1)
+        for m in todo:
+            prog.started(m.id)
+            rec = run_member(self._task(m))
+            prog.finished(rec)
+
+    def _run_dask(self, todo, client, workers, scheduler):
+        from distributed import Client, as_completed
+
+        from .cluster import make_cluster, scale, uses_member_resource
+
+        own_client = own_cluster = None
+        interrupted = False
+        t_setup = time.perf_counter()
+        if client is None:
+            cfg = dict(self.spec.cluster)
+            if scheduler:
+                cfg = {"kind": "address", "address": scheduler}
+            cluster, desc = make_cluster(cfg, len(todo), workers)
+            own_cluster = cluster
+            try:
+                own_client = client = Client(cluster if cluster is not None else cfg["address"])
+            except (OSError, TimeoutError) as exc:
+                if cluster is not None:
+                    cluster.close()
+                raise LagiceError(f"cannot connect to the dask scheduler {cfg.get('address', '')}: {exc}") from exc
+            if cluster is not None:
+                scale(cluster, cfg, workers)
+            _say(f"ensemble: {desc}; dashboard {client.dashboard_link}")
+            self.last_run["cluster"] = desc
+        try:
+            if own_cluster is not None:  # our LocalCluster / jobqueue workers all declare the member resource
+                resource, slots = True, max(1, len(getattr(own_cluster, "workers", {})) or 1)
+            else:  # an existing cluster: use the resource only if every worker declares it
+                try:
+                    client.wait_for_workers(1, timeout=120)
+                except TimeoutError:
+                    raise LagiceError(f"no dask worker joined the scheduler {client.scheduler.address} "
+                                      "in 120 s") from None
+                resource, slots = uses_member_resource(client)
+            self.last_run["setup_s"] = time.perf_counter() - t_setup
+            token = uuid.uuid4().hex[:8]
+            futures = {}
+            for m in todo:
+                kw = {"resources": {"member": 1}} if resource else {}
+                f = client.submit(run_member, self._task(m), key=f"lagice-member-{m.id}-{token}", pure=False, **kw)
+                futures[f] = m.id
+            prog = _Progress(len(todo), slots=max(1, slots), client=client)
+            interrupted = True  # until the loop ends normally: Ctrl-C / SIGTERM stop the workers promptly
+            for f in as_completed(futures):
+                mid = futures[f]
+                if f.status != "finished":  # the worker died, or the task was cancelled
+                    try:
+                        exc = f.exception()
+                    except BaseException as e:  # noqa: BLE001 - CancelledError
+                        exc = e
+                    rec = {"member": mid, "status": "failed", "error": f"{type(exc).__name__}: {exc}",
+                           "overrides": self.spec.member(mid).overrides, "wall_s": math.nan}
+                    mdir = self.out_dir / "members" / mid
+                    mdir.mkdir(parents=True, exist_ok=True)
+                    write_json(mdir / "failed.json", rec)
+                else:
+                    rec = f.result()
+                prog.finished(rec)
+            interrupted = False
+        finally:
+            if interrupted and own_cluster is not None:
+                _kill_local_workers(own_cluster)
+            if own_client is not None:
+                own_client.close()
+            if own_cluster is not None:
+                own_cluster.close()
+
+    # -- summary ----------------------------------------------------------------------------
+    def records(self) -> list[dict]:
+        """Every member's record from its folder (done, failed or not_run), in member order."""
+        from .member import member_diagnostics
+        out = []
+        keys = list(dict.fromkeys(k for m in self.members for k in m.overrides))
+        for m in self.members:
+            mdir = self.out_dir / "members" / m.id
+            rec = None
+            for name in ("done.json", "failed.json"):
+                if (mdir / name).exists():
+                    rec = json.loads((mdir / name).read_text())
+                    break
+            if rec is None:
+                rec = {"member": m.id, "status": "not_run", "overrides": m.overrides,
+                       "error": "not finished (interrupted or not started)"}
+            rec["values"] = {k: _lookup(m.config, k) for k in keys}
+            if rec["status"] == "done" and rec.get("analysis") != self.spec.analysis:
+                rec["diagnostics"] = member_diagnostics(mdir, self.spec.analysis)  # analysis settings changed
+                rec["analysis"] = self.spec.analysis
+                write_json(mdir / "done.json", rec)
+            out.append(rec)
+        return out
+
+    def summarise(self, plot: bool = True):
+        """Write ``ensemble_summary.nc`` (and the spread PNG) from the member folders."""
+        from .summary import plot_spread, summary_dataset, write_summary
+
+        ds = summary_dataset(self.records(), self._info())
+        write_summary(ds, self.out_dir / "ensemble_summary.nc")
+        if plot:
+            try:
+                png = plot_spread(self.out_dir, ds)
+                if png is not None:
+                    _say(f"ensemble: spread plot {png}")
+            except Exception as exc:  # noqa: BLE001 - a plot failure must not hide the summary
+                _say(f"ensemble: warning: no spread plot ({type(exc).__name__}: {exc})")
+        return ds
+
+
+class _FolderLock:
+    """``DIR/ensemble.lock`` (host, pid) while an ensemble runs in DIR: a second
+    ``lagice ensemble`` on the same folder is refused instead of mixing runs. A
+    lock left by a process that no longer exists on this host is replaced."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        self.held = False
+
+    def __enter__(self):
+        me = {"host": socket.gethostname(), "pid": os.getpid()}
+        for _ in range(2):
+            try:
+                fd = os.open(self.path, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+            except FileExistsError:
+                try:
+                    other = json.loads(self.path.read_text())
+                except (OSError, json.JSONDecodeError):
+                    other = {}
+                if other.get("host") == me["host"] and not _alive(other.get("pid")):
+                    self.path.unlink(missing_ok=True)  # stale: its process is gone
+                    continue
+                raise LagiceError(f"{self.path.parent}: another lagice ensemble is running in this folder "
+                                  f"(pid {other.get('pid')} on {other.get('host')}); wait for it, or delete "
+                                  f"{self.path} if that run is gone") from None
+            with os.fdopen(fd, "w") as f:
+                json.dump(me, f)
+            self.held = True
+            return self
+        raise LagiceError(f"{self.path}: cannot take the ensemble lock")
+
+    def __exit__(self, *exc):
+        if self.held:
+            self.path.unlink(missing_ok=True)
+        return False
+
+
+def _kill_local_workers(cluster) -> None:
+    """Stop the worker processes of our LocalCluster at once (Ctrl-C, SIGTERM): a
+    graceful close would wait for the members in flight. Their checkpoints,
+    snapshots and markers are written atomically, so a re-run resumes them."""
+    import signal
+
+    for w in list(getattr(cluster, "workers", {}).values()):
+        pid = getattr(w, "pid", None)
+        if isinstance(pid, int) and pid > 0:
+            with contextlib.suppress(ProcessLookupError, PermissionError):
+                os.kill(pid, signal.SIGKILL)
+
+
+def _alive(pid) -> bool:
+    if not isinstance(pid, int) or pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+class _Progress:
+    """Progress across members: done / running / failed / waiting and an ETA."""
+
+    def __init__(self, n: int, slots: int, client=None):
+        self.n, self.slots, self.client = n, slots, client
+        self.done = self.failed = 0
+        self.t0 = time.perf_counter()
+
+    def started(self, mid):
+        _say(f"  [{self.done + self.failed + 1}/{self.n}] {mid}: started")
+
+    def finished(self, rec):
+        if rec.get("status") == "done":
+            self.done += 1
+            what = f"done in {rec.get('wall_s', math.nan):.1f} s"
+            if rec.get("resumed_from"):
+                what += f" (resumed from {Path(rec['resumed_from']).name})"
+        else:
+            self.failed += 1
+            what = f"FAILED after {rec.get('wall_s', math.nan):.1f} s: {rec.get('error')}"
+        k = self.done + self.failed
+        left = self.n - k
+        if self.client is not None:
+            from .cluster import uses_member_resource
+            with contextlib.suppress(Exception):  # progress only: keep the last count
+                self.slots = max(1, uses_member_resource(self.client)[1])
+        running = min(self.slots, left)
+        el = time.perf_counter() - self.t0
+        eta = el / k * left if k else math.nan
+        _say(f"  [{k}/{self.n}] {rec['member']}: {what} | done {self.done}, failed {self.failed}, "
+             f"running {running}, waiting {left - running} | elapsed {_hms(el)}, ETA {_hms(eta)}")
+
+
+def _hms(s: float) -> str:
+    if not math.isfinite(s):
+        return "--:--:--"
+    s = round(s)
+    return f"{s // 3600:d}:{s // 60 % 60:02d}:{s % 60:02d}"
+
+
+def _say(msg: str) -> None:
+    print(f"lagice {msg}" if not msg.startswith(" ") else msg, flush=True, file=sys.stdout)
+
+
+def _lookup(cfg: dict, dotted: str):
+    node = cfg
+    for p in dotted.split("."):
+        if not isinstance(node, dict):
+            return None
+        node = node.get(p)
+    return node
+
+
+def _diff(a: dict, b: dict, prefix: str = "") -> list[str]:
+    out = []
+    for k in sorted(set(a) | set(b)):
+        if k.startswith("_"):
+            continue
+        key = f"{prefix}{k}"
+        va, vb = a.get(k), b.get(k)
+        if isinstance(va, dict) and isinstance(vb, dict):
+            out += _diff(va, vb, key + ".")
+        elif va != vb:
+            out.append(f"{key}: {va!r} -> {vb!r}")
+    return out
