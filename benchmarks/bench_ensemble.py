@@ -37,6 +37,7 @@ import argparse
 import json
 import os
 import platform
+import re
 import shutil
 import subprocess
 import sys
@@ -95,7 +96,7 @@ def phase(name, args, env, out: Path, k: int, max_wait_s: float, idle_load: floa
     idle, waited = wait_idle(max_wait_s, idle_load)
     la0 = loadavg()
     c0 = os.times()
-    wall, _ = run_cli(args, env)
+    wall, screen = run_cli(args, env)
     c1 = os.times()
     la1 = loadavg()
     recs = member_records(out)
@@ -111,6 +112,8 @@ def phase(name, args, env, out: Path, k: int, max_wait_s: float, idle_load: floa
            "critical_path_s": max(busy.values()), "sum_member_wall_s": sum(r["wall_s"] for r in recs.values()),
            "sum_member_cpu_s": sum(r["cpu_s"] for r in recs.values())}
     res["outside_members_s"] = wall - res["critical_path_s"]
+    ready = re.search(r"ready in ([0-9.]+) s", screen)
+    res["cluster_start_s"] = float(ready.group(1)) if ready else 0.0
     res["cpu_share"] = res["sum_member_cpu_s"] / res["sum_member_wall_s"]
     print(f"  run {k} {name:<8} {wall:7.1f} s wall, members {res['sum_member_wall_s']:6.1f} s wall / "
           f"{res['sum_member_cpu_s']:6.1f} s CPU, load average before {la0} after {la1}"
@@ -162,7 +165,7 @@ def main(argv=None) -> int:
            "python": platform.python_version(), "numba_threads_per_process": 1,
            "serial_wall_s": ser["wall_s"], "ensemble_wall_s": ens["wall_s"], "speedup": ser["wall_s"] / ens["wall_s"],
            "ideal_speedup": min(args.workers, n, cores),
-           "ensemble_overhead_s": ens["outside_members_s"], "ensemble_overhead_per_member_s": ens["outside_members_s"] / n,
+           "ensemble_overhead_s": ens["outside_members_s"], "cluster_start_s": ens["cluster_start_s"], "ensemble_overhead_per_member_s": ens["outside_members_s"] / n,
            "serial_outside_members_s": ser["wall_s"] - ser["sum_member_wall_s"],
            "member_wall_ratio_ensemble_serial": ens["sum_member_wall_s"] / ser["sum_member_wall_s"],
            "member_cpu_ratio_ensemble_serial": ens["sum_member_cpu_s"] / ser["sum_member_cpu_s"],
@@ -186,6 +189,7 @@ def main(argv=None) -> int:
           f"{ens['sum_member_wall_s']:.1f} / {ens['sum_member_cpu_s']:.1f} |")
     print(f"| busiest worker, summed member wall (s) | {ser['sum_member_wall_s']:.1f} | {ens['critical_path_s']:.1f} |")
     print(f"| outside the members (s) | {res['serial_outside_members_s']:.1f} | {ens['outside_members_s']:.1f} |")
+    print(f"| of which cluster start (s) | - | {ens['cluster_start_s']:.1f} |")
     print(f"| overhead per member (s) | {res['serial_outside_members_s'] / n:.2f} | "
           f"{res['ensemble_overhead_per_member_s']:.2f} |")
     print(f"| load average before (1, 5, 15 min) | {ser['loadavg_before']} | {ens['loadavg_before']} |")

@@ -178,7 +178,8 @@ class Ensemble:
                 raise LagiceError(f"cannot connect to the dask scheduler {cfg.get('address', '')}: {exc}") from exc
             if cluster is not None:
                 scale(cluster, cfg, workers)
-            _say(f"ensemble: {desc}; dashboard {client.dashboard_link}")
+            _say(f"ensemble: {desc}; ready in {time.perf_counter() - t_setup:.1f} s; "
+                 f"dashboard {client.dashboard_link}")
             self.last_run["cluster"] = desc
         try:
             if own_cluster is not None:  # our LocalCluster / jobqueue workers all declare the member resource
