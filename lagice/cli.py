@@ -343,7 +343,7 @@ def main(argv=None) -> int:
     sc = sub.add_parser("scenes", help="list bundled scenes", parents=[common])
     sc.set_defaults(func=_scenes)
     from .ensemble.command import add_subcommand as _add_ensemble  # ensembles (lagice/ensemble, issue 14)
-    _add_ensemble(sub)
+    _add_ensemble(sub, parents=[common])
     args = ap.parse_args(argv)
     level = getattr(args, "log_level", "info")
     try:

@@ -12,6 +12,7 @@ import hashlib
 import io
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -26,8 +27,8 @@ from lagice.ensemble import Ensemble, load_spec, open_grids, spread
 from lagice.ensemble.cluster import local_cluster_kwargs, machine_cores, make_cluster, uses_member_resource
 from lagice.errors import ConfigError
 from lagice.io.checkpoint import read_checkpoint
+from lagice.scenes.builder import build_simulation
 from lagice.scenes.config import load_scene
-from lagice.scenes.toml_scene import build_simulation
 
 COMMON = {"domain.resolution_m": 40e3, "run.duration": "1h", "output.every": "20min",
           "checkpoint.every": "20min", "output.plot": False, "output.grid_resolution_m": 50e3}
@@ -96,12 +97,16 @@ def test_members_on_local_cluster_are_bit_identical_to_serial_runs(ensemble_run,
         assert info["worker"].startswith("tcp://")          # it really ran on a dask worker
         assert info["numba_threads"] == ensemble_run["threads"] == max(1, machine_cores() // 2)
         assert info["overrides"] == MEMBERS[mid]
-        # provenance in the output files
-        attrs = xr.open_dataset(last_snapshot(mdir)).attrs
-        assert attrs["ensemble_member"] == mid
-        assert json.loads(attrs["ensemble_member_overrides"]) == MEMBERS[mid]
-        grid = max((mdir / "snapshots").glob("grid_*.nc"))
-        assert xr.open_dataset(grid).attrs["ensemble_member"] == mid
+        # provenance in every output file (lagice.io.cf.provenance), the run-folder marker and the checkpoints
+        files = sorted((mdir / "snapshots").glob("*.nc"))
+        assert any(f.name.startswith("grid_") for f in files) and any(f.name.startswith("snapshot_") for f in files)
+        for f in files:
+            with xr.open_dataset(f, decode_times=False) as ds:
+                assert ds.attrs["lagice_ensemble"] == "tiny" and ds.attrs["lagice_ensemble_member"] == mid, f
+                assert json.loads(ds.attrs["lagice_ensemble_member_overrides"]) == MEMBERS[mid]
+        assert json.loads((mdir / "lagice_run.json").read_text())["ensemble"]["member"] == mid
+        _, meta = read_checkpoint(max((mdir / "checkpoints").glob("*.npz")))
+        assert meta["config"]["_ensemble"] == {"ensemble": "tiny", "member": mid, "overrides": MEMBERS[mid]}
 
 
 @pytest.mark.slow
@@ -201,9 +206,17 @@ def test_rerun_completes_only_what_is_missing(ensemble_run, tmp_path):
     assert str(s["resumed_from"].sel(member="b").values).endswith("checkpoint_0000000060.npz")
     # a changed member configuration is refused before anything runs
     changed = spec_dict(members={**MEMBERS, "a": {"rheology.friction": 0.65}})
-    with pytest.raises(ConfigError, match="member 'a' was started with another configuration.*friction"):
+    with pytest.raises(ConfigError, match=r"member 'a' was started with other physics \(rheology.friction: 0.6 -> "
+                                          r"0.65\).*may only change run.duration"):
         Ensemble(changed, out).run(serial=True)
     assert (out / "members" / "a" / "done.json").stat().st_mtime_ns == a_done
+    # a longer run.duration extends every member from its last checkpoint (lagice resume's rules)
+    longer = Ensemble(spec_dict(common={**COMMON, "run.duration": "80min"}), out)
+    assert longer.plan() == {"a": "resume", "b": "resume", "c": "resume", "bad": "retry"}
+    s = longer.run(serial=True, plot=False, retry_failed=False)
+    assert list(s["status"].values) == ["done", "done", "done", "failed"]
+    assert list(s["steps"].sel(member=list(GOOD)).values) == [120, 120, 120]
+    assert all(str(s["resumed_from"].sel(member=m).values).endswith("checkpoint_0000000090.npz") for m in GOOD)
 
 
 def _toml(d: dict) -> str:
@@ -250,7 +263,7 @@ def test_branch_members_start_from_the_checkpoint(parent_checkpoint, tmp_path):
     sha = hashlib.sha256(ck.read_bytes()).hexdigest()
     info = json.loads((same / "member.json").read_text())
     assert info["parent_checkpoint_sha256"] == sha and Path(info["parent_checkpoint"]) == ck.resolve()
-    assert first.attrs["parent_checkpoint_sha256"] == sha
+    assert first.attrs["lagice_parent_checkpoint_sha256"] == sha and first.attrs["lagice_ensemble_member"] == "same"
     assert summary.attrs["ensemble_parent_checkpoint_sha256"] == sha
     weak_ck = max((tmp_path / "out" / "members" / "weak" / "checkpoints").glob("*.npz"))
     _, wmeta = read_checkpoint(weak_ck)
@@ -284,16 +297,23 @@ def test_grid_spec_expands_to_the_cartesian_product():
 
 
 def test_seed_spec_members_are_reproducible_and_perturbed():
-    def make(n):
-        return load_spec({"ensemble": {"base": "winter_basin"},
-                          "seeds": {"n": n, "seed": 11, "keys": ["run.seed", "forcing.wind.seed"],
-                                    "perturb": {"rheology.cohesion_max_pa": {"relative": 0.05}}}})
-    small, big = make(3), make(200)
-    assert [m.overrides for m in small.members] == [m.overrides for m in big.members[:3]]  # k does not depend on n
-    seeds = [m.config["run"]["seed"] for m in big.members]
+    from lagice.ensemble.spec import seed_members
+
+    rule = {"n": 3, "seed": 11, "keys": ["run.seed", "forcing.wind.seed"],
+            "perturb": {"rheology.cohesion_max_pa": {"relative": 0.05}}}
+    small = load_spec({"ensemble": {"base": "winter_basin"}, "seeds": rule})   # every member config validated
+    assert [m.id for m in small.members] == ["s000", "s001", "s002"]
+    for m in small.members:
+        assert m.config["run"]["seed"] == m.overrides["run.seed"]
+        assert m.config["forcing"]["wind"]["seed"] == m.overrides["forcing.wind.seed"]
+        assert m.config["rheology"]["cohesion_max_pa"] == m.overrides["rheology.cohesion_max_pa"]
+    # 200 members (overrides only: the same rule, without building 200 configs)
+    big = seed_members({**rule, "n": 200}, "<test>", {}, load_spec({"ensemble": {"base": "winter_basin"},
+                                                                   "seeds": {"n": 1}}).base, None)
+    assert [own for _, own in big[:3]] == [m.overrides for m in small.members]       # member k does not depend on n
+    seeds = [own["run.seed"] for _, own in big]
     assert len(set(seeds)) == 200 and all(0 <= s < 2**31 - 1 for s in seeds)
-    assert all(m.config["forcing"]["wind"]["seed"] == m.overrides["forcing.wind.seed"] for m in big.members)
-    vals = np.array([m.config["rheology"]["cohesion_max_pa"] for m in big.members])
+    vals = np.array([own["rheology.cohesion_max_pa"] for _, own in big])
     assert np.mean(vals) == pytest.approx(20e3, rel=0.02)                    # winter_basin: 20 kPa
     assert np.std(vals) == pytest.approx(0.05 * 20e3, rel=0.15)
 
@@ -309,6 +329,12 @@ BAD_SPECS = [
     ('[ensemble]\nbase = "shear_box"\n[[member]]\nset = {"rheolgy.alpha" = 3.0}\n', r"unknown table \[rheolgy\]"),
     ('[ensemble]\nbase = "shear_box"\n[grid]\n"run.duration" = ["1h", "2x"]\n',
      "member 'duration=2x'.*run.duration = '2x'"),
+    # forcing generator keywords are checked for every member too (lagice.scenes.builder.validate_config)
+    ('[ensemble]\nbase = "winter_basin"\n[grid]\n"forcing.wind.n" = [4, "six"]\n',
+     r"member 'n=six' \(forcing.wind.n=six\): forcing.wind.n = 'six': expected an integer"),
+    ('[ensemble]\nbase = "winter_basin"\n[[member]]\n[[member]]\n'
+     'set = {"forcing.wind.max_speed_range_m_s" = [30, 10]}\n',
+     r"member 'm001'.*forcing.wind.max_speed_range_m_s = \[30, 10\]: expected \[low, high\] with low <= high"),
     ('[ensemble]\nbase = "shear_box"\n[grid]\n"run.seed" = [1]\n[seeds]\nn = 2\n', "exactly one of"),
     ('[ensemble]\nbase = "shear_box"\n[seeds]\nn = 0\n', "seeds.n = 0"),
     ('[ensemble]\nbase = "shear_box"\n[seeds]\nn = 2\nperturb = {"solver.name" = {relative = 0.1}}\n',
@@ -331,9 +357,9 @@ def test_invalid_spec_fails_before_anything_starts(text, message, tmp_path):
 
 def test_invalid_branch_overrides_are_refused(parent_checkpoint, tmp_path):
     ck = parent_checkpoint[0]
-    for sets, message in (({"domain.resolution_m": 20e3}, "domain.resolution_m: a member branched"),
-                          ({"solver.dt": 20.0}, "solver.dt: a member branched"),
-                          ({"run.duration": "30min"}, "checkpoint time 2400 s")):
+    for sets, message in (({"domain.resolution_m": 20e3}, "member 'x'.*domain.resolution_m: a branch starts from"),
+                          ({"solver.dt": 20.0}, "member 'x'.*solver.dt: a branch starts from"),
+                          ({"run.duration": "30min"}, "member 'x'.*checkpoint is at t = 2400 s")):
         spec = {"ensemble": {"branch_from": str(ck)}, "member": [{"id": "x", "set": sets}]}
         with pytest.raises(ConfigError, match=message):
             Ensemble(spec, tmp_path / "out")
@@ -408,31 +434,42 @@ def test_sigterm_stops_cleanly_and_the_same_command_resumes(tmp_path):
     spec = tmp_path / "long.toml"
     spec.write_text(_toml(spec_dict(members={"m0": {"rheology.friction": 0.6},
                                              "m1": {"rheology.friction": 0.8, "run.duration": "1h"}},
-                                    common={**COMMON, "run.duration": "4h", "checkpoint.every": "30min",
+                                    common={**COMMON, "run.duration": "2h", "checkpoint.every": "30min",
                                             "output.every": "1h"})))
     out = tmp_path / "out"
     cmd = [sys.executable, "-m", "lagice.cli", "ensemble", str(spec), "--out", str(out), "--workers", "1",
            "--no-plot"]
     env = {**os.environ, "NUMBA_NUM_THREADS": "1"}
-    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+                         start_new_session=True)
     ck = out / "members" / "m0" / "checkpoints"
     t0 = time.time()
     while not (ck.exists() and len(list(ck.glob("checkpoint_*.npz"))) >= 2) and time.time() - t0 < 60:
         time.sleep(0.05)
-    p.send_signal(signal.SIGTERM)                    # what a batch system sends at the walltime
-    stdout, stderr = p.communicate(timeout=60)
-    assert p.returncode == 130, stderr
-    assert "interrupted" in stdout and "Traceback" not in stderr
+    # what a batch system sends at the walltime, to every process of the job: the command and its workers
+    os.killpg(p.pid, signal.SIGTERM)
+    stdout, stderr = p.communicate(timeout=120)
+    # a clean stop, as `lagice run`: exit 0, the running member checkpoints where it stopped, m1 never started
+    assert p.returncode == 0, stdout + stderr
+    assert "SIGTERM received" in stdout and "resume with: lagice ensemble" in stdout
+    assert "Traceback" not in stderr and "died" not in stderr    # the workers were not killed
     with xr.open_dataset(out / "ensemble_summary.nc") as s:
-        assert list(s["status"].values) == ["not_run", "not_run"]
-    assert not (out / "ensemble.lock").exists()
+        assert list(s["status"].values) == ["stopped", "not_run"]
+        why = str(s["error"].sel(member="m0").values)
+    step = int(re.search(r"stopped at step (\d+)", why).group(1))
+    assert max(ck.glob("checkpoint_*.npz")).name == f"checkpoint_{step:010d}.npz"   # written at the stop
+    assert 0 < step < 180 and not (out / "members" / "m1").exists()
+    assert not (out / "ensemble.lock").exists() and not (out / "STOP").exists()
     r = subprocess.run(cmd, check=False, capture_output=True, text=True, env=env)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "1 to resume, 1 to start" in r.stdout
     info = json.loads((out / "members" / "m0" / "member.json").read_text())
-    assert info["status"] == "done" and "checkpoint_" in info["resumed_from"]
+    assert info["status"] == "done" and info["resumed_from"].endswith(f"checkpoint_{step:010d}.npz")
+    with xr.open_dataset(out / "ensemble_summary.nc") as s:
+        assert list(s["status"].values) == ["done", "done"] and list(s["steps"].values) == [180, 90]
 
 
+@pytest.mark.slow
 def test_a_second_ensemble_on_the_same_folder_is_refused(ensemble_run, tmp_path):
     from lagice.errors import LagiceError
 
@@ -447,3 +484,21 @@ def test_a_second_ensemble_on_the_same_folder_is_refused(ensemble_run, tmp_path)
     lock.write_text(json.dumps({"host": __import__("socket").gethostname(), "pid": int(done.stdout)}))  # stale
     s = Ensemble(spec_dict(), out).run(serial=True, retry_failed=False, plot=False)
     assert list(s["status"].values) == ["done", "done", "done", "failed"] and not lock.exists()
+
+
+def test_gmsh_start_keeps_the_sigterm_handler():
+    """gmsh's first initialisation resets SIGTERM to the default action at the C level;
+    lagice.mesh.generate puts the Python handler back (else a clean stop on SIGTERM
+    installed before the first mesh, as by `lagice ensemble` and its workers, kills)."""
+    code = textwrap.dedent("""
+        import os, signal, time
+        signal.signal(signal.SIGTERM, lambda *a: print("handler ran", flush=True))
+        from lagice.scenes.builder import build_mesh
+        from lagice.scenes.config import load_scene
+        build_mesh(load_scene("shear_box", {"domain.resolution_m": 40e3}))
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(0.2)
+        print("alive", flush=True)
+        """)
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
+    assert r.returncode == 0 and r.stdout.split() == ["handler", "ran", "alive"], (r.returncode, r.stderr[-500:])

@@ -2,7 +2,6 @@
 
 - :class:`Ensemble` — ``Ensemble.from_file(spec).run(client=None)`` returns the summary Dataset;
 - :func:`load_spec` — parse and validate a spec (every member's config) without running;
-- :func:`branch_simulation` — a run that starts from a checkpoint with changed settings;
 - :func:`open_summary`, :func:`open_grids` (lazy, ``member`` dimension), :func:`spread`.
 
 Names are imported on first use, so ``lagice.ensemble.command`` (the CLI
@@ -12,7 +11,7 @@ import importlib
 
 _WHERE = {
     "Ensemble": "core", "EnsembleSpec": "spec", "Member": "spec", "load_spec": "spec",
-    "branch_simulation": "member", "member_diagnostics": "member", "run_member": "member",
+    "member_diagnostics": "member", "run_member": "member",
     "open_grids": "summary", "open_summary": "summary", "plot_spread": "summary", "spread": "summary",
 }
 __all__ = list(_WHERE)

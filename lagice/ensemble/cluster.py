@@ -13,10 +13,11 @@
   :class:`~dask_jobqueue.PBSCluster`. ``cores`` and ``memory`` are per job;
   ``threads_per_member`` (default 1) gives ``processes = cores //
   threads_per_member`` workers per job; up to ``jobs`` (default 1) jobs are
-  submitted while members wait and released as they finish (``adapt``). Every other key is a dask-jobqueue keyword (``queue``,
-  ``account``, ``walltime``, ``job_extra_directives``, ``python``, ...). Each
-  worker gets ``NUMBA_NUM_THREADS = cores // processes`` and a ``member``
-  resource of 1, so it runs one member at a time.
+  submitted while members wait and released as they finish (``adapt``).
+  Every other key is a dask-jobqueue keyword (``queue``, ``account``,
+  ``walltime``, ``job_extra_directives``, ``python``, ...). Each worker gets
+  ``NUMBA_NUM_THREADS = cores // processes`` and a ``member`` resource of 1,
+  so it runs one member at a time.
 - ``"address"``: an existing scheduler (``address = "tcp://host:8786"``, or
   ``lagice ensemble --scheduler``). Workers started with ``--resources
   member=1`` run one member each; otherwise each worker thread takes one.

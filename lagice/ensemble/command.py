@@ -2,17 +2,20 @@
 dask and the model are imported only when the command runs)."""
 from __future__ import annotations
 
-import signal
 from pathlib import Path
 
 
-def add_subcommand(sub) -> None:
-    e = sub.add_parser("ensemble", help="run an ensemble or parameter sweep (TOML spec) on dask",
+def add_subcommand(sub, parents=()) -> None:
+    e = sub.add_parser("ensemble", parents=list(parents),
+                       help="run an ensemble or parameter sweep (TOML spec) on dask",
                        description="Run the members of an ensemble spec (docs/ensembles.md) on dask.distributed. "
-                                   "Re-running the same command resumes: finished members are skipped, "
-                                   "interrupted ones resume from their newest checkpoint.")
+                                   "Every member's configuration is checked before any member starts. Re-running "
+                                   "the same command resumes: finished members are skipped, interrupted ones "
+                                   "resume from their newest checkpoint. SIGTERM/SIGINT (or the file DIR/STOP) "
+                                   "stop the running members cleanly with a checkpoint.")
     e.add_argument("spec", help="ensemble spec (TOML)")
-    e.add_argument("--out", help="output folder (default runs/ENSEMBLE_NAME)")
+    e.add_argument("--out", help="output folder (default runs/ENSEMBLE_NAME); re-running into it resumes")
+    e.add_argument("--overwrite", action="store_true", help="remove an earlier ensemble in --out first")
     e.add_argument("--set", action="append", metavar="KEY=VALUE",
                    help="override a scene key for every member (after the spec's [set])")
     e.add_argument("--workers", type=int, help="worker processes of the local cluster (default: one per core, "
@@ -33,8 +36,10 @@ def run_command(args) -> int:
         raise ConfigError(f"--workers = {args.workers}: expected an integer >= 1")
     ens = Ensemble.from_file(Path(args.spec), args.out, overrides=args.set)
     if args.dry_run:
-        ens.check_folder()
-        plan = ens.plan(not args.skip_failed)
+        plan = {m.id: "new" for m in ens.members} if args.overwrite else None
+        if plan is None:
+            ens.check_folder()
+            plan = ens.plan(not args.skip_failed)
         print(f"lagice ensemble {ens.spec.name!r}: {len(ens.members)} members ({ens.spec.kind}), "
               f"base {ens.spec.base or ens.spec.branch_from} -> {ens.out_dir}/")
         for m, line in zip(ens.members, ens.spec.table().splitlines()):
@@ -48,19 +53,17 @@ def run_command(args) -> int:
             finally:
                 cluster.close()
         return 0
-
-    def _terminate(signum, frame):  # a batch system's SIGTERM: stop like Ctrl-C (close the cluster, summarise)
-        raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGTERM, _terminate)
+    if args.overwrite:
+        ens.clear_folder()
     try:
         summary = ens.run(workers=args.workers, scheduler=args.scheduler, serial=args.serial,
                           retry_failed=not args.skip_failed, plot=not args.no_plot)
-    except KeyboardInterrupt:
-        print(f"lagice ensemble: interrupted; the summary holds the members finished so far. Run the same "
-              f"command again to resume (finished members are skipped): lagice ensemble {args.spec} "
-              f"--out {ens.out_dir}", flush=True)
+    except KeyboardInterrupt:  # a second SIGINT/SIGTERM: stopped at once
+        print(f"lagice ensemble: interrupted at once; members in flight resume from their last periodic "
+              f"checkpoint. Run the same command again to resume: lagice ensemble {args.spec} --out {ens.out_dir}",
+              flush=True)
         return 130
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+    if ens.stopped:  # a clean stop (as `lagice run`: exit 0, with how to resume)
+        print(f"  resume with: lagice ensemble {args.spec} --out {ens.out_dir}", flush=True)
+        return 0
     return 0 if all(s == "done" for s in summary["status"].values) else 1

@@ -7,14 +7,16 @@ import json
 import math
 import os
 import shutil
+import signal
 import socket
 import sys
+import threading
 import time
 import uuid
 from pathlib import Path
 
 from ..errors import ConfigError, LagiceError
-from .member import member_state, run_member, write_json
+from .member import STOP_FILE, member_state, run_member, write_json
 from .spec import EnsembleSpec, load_spec
 
 
@@ -37,6 +39,7 @@ class Ensemble:
         self.spec: EnsembleSpec = spec if isinstance(spec, EnsembleSpec) else load_spec(spec, overrides)
         self.out_dir = Path(out_dir) if out_dir is not None else Path("runs") / self.spec.name
         self.last_run = {}
+        self.stopped = None  # why the last run stopped early (a signal, DIR/STOP), else None
 
     @classmethod
     def from_file(cls, path, out_dir=None, overrides=None) -> Ensemble:
@@ -62,10 +65,37 @@ class Ensemble:
                 "branch_sha256": s.branch_sha256, "analysis": s.analysis, "lagice_version": __version__,
                 "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")}
 
+    def clear_folder(self) -> None:
+        """Remove an earlier ensemble in the output folder (``lagice ensemble --overwrite``):
+        only a folder that holds an ensemble (``ensemble.json``) or nothing."""
+        from ..errors import OutputError
+
+        if not self.out_dir.exists() or not any(self.out_dir.iterdir()):
+            return
+        if not (self.out_dir / "ensemble.json").exists():
+            raise ConfigError(f"--out {self.out_dir}: the folder is not empty and holds no ensemble (no "
+                              "ensemble.json); refusing to delete it with --overwrite")
+        with _FolderLock(self.out_dir / "ensemble.lock"):
+            for child in self.out_dir.iterdir():
+                if child.name == "ensemble.lock":
+                    continue
+                try:
+                    if child.is_dir() and not child.is_symlink():
+                        shutil.rmtree(child)
+                    else:
+                        child.unlink()
+                except OSError as exc:
+                    raise OutputError(f"--overwrite: cannot remove {child}: {exc.strerror}") from None
+
     def check_folder(self) -> dict:
         """Compare the spec with an earlier run in the output folder (``ensemble.json``):
-        a member whose configuration changed is an error (its outputs would mix two
-        runs). Returns the earlier ``ensemble.json`` content ({} if none)."""
+        a member whose physics changed (anything a resumed run may not change, as for
+        ``lagice resume``: all but ``run.duration``, ``output.*``, ``checkpoint.*``...;
+        or another parent checkpoint) is an error: its outputs would mix two runs. A
+        longer ``run.duration`` extends the members from their last checkpoints.
+        Returns the earlier ``ensemble.json`` content ({} if none)."""
+        from ..scenes.config import changed_keys, physics_view
+
         p = self.out_dir / "ensemble.json"
         if not p.exists():
             if self.out_dir.exists() and any(self.out_dir.iterdir()):
@@ -75,12 +105,19 @@ class Ensemble:
         old = json.loads(p.read_text())
         for m in self.members:
             prev = old.get("members", {}).get(m.id)
-            if prev is not None and prev["config_hash"] != m.config_hash:
-                diff = _diff(prev.get("config", {}), m.config)
-                raise ConfigError(f"{self.out_dir}: member {m.id!r} was started with another configuration "
-                                  f"({'; '.join(diff[:5]) or 'config hash differs'}); re-running resumes the "
-                                  "same ensemble only: use a new --out, or delete "
-                                  f"{self.out_dir / 'members' / m.id}")
+            if prev is None or prev["config_hash"] == m.config_hash:
+                continue
+            was = prev.get("config", {})
+            moved = changed_keys(physics_view(was), physics_view(m.config))
+            if (was.get("_parent") or {}).get("sha256") != (m.config.get("_parent") or {}).get("sha256"):
+                moved.append("ensemble.branch_from (another parent checkpoint)")
+            if moved:
+                diff = [f"{k}: {_lookup(was, k)!r} -> {_lookup(m.config, k)!r}" if "." in k and " " not in k else k
+                        for k in moved]
+                raise ConfigError(f"{self.out_dir}: member {m.id!r} was started with other physics "
+                                  f"({'; '.join(diff[:5])}); re-running resumes the same ensemble, and may only "
+                                  "change run.duration (extend), output.* and checkpoint.*: use a new --out, or "
+                                  f"delete {self.out_dir / 'members' / m.id}")
         return old
 
     def _write_ensemble_json(self, old: dict) -> None:
@@ -98,7 +135,7 @@ class Ensemble:
         """{member id: "done" | "resume" | "new" | "retry" | "skip_failed"}."""
         out = {}
         for m in self.members:
-            st = member_state(self.out_dir / "members" / m.id)
+            st = member_state(self.out_dir / "members" / m.id, m.config_hash)
             if st == "failed":
                 st = "retry" if retry_failed else "skip_failed"
             out[m.id] = st
@@ -106,7 +143,7 @@ class Ensemble:
 
     # -- running ---------------------------------------------------------------------------
     def run(self, client=None, *, workers: int | None = None, scheduler: str | None = None,
-            serial: bool = False, retry_failed: bool = True, plot: bool = True):
+            serial: bool = False, retry_failed: bool = True, plot: bool = True, handle_signals: bool = True):
         """Run the members that are not finished; return the summary (xarray Dataset).
 
         ``client``: a ``distributed.Client`` to use; otherwise a cluster is made from
@@ -115,13 +152,24 @@ class Ensemble:
         in this process. Finished members (``done.json``) are skipped, interrupted
         ones resume from their newest checkpoint, failed ones are run again unless
         ``retry_failed=False``. Writes ``ensemble_summary.nc`` and ``ensemble_spread.png``.
+
+        Stopping: the file ``DIR/STOP`` asks every running member to stop after its
+        current step with a checkpoint (the run workflow's clean stop); members not
+        started yet are not started. ``handle_signals`` (in the main thread): the first
+        SIGTERM or SIGINT writes that file (then the summary is written and ``run``
+        returns; ``self.stopped`` names the signal); a second one interrupts at once
+        (KeyboardInterrupt: the local workers are killed, members resume from their
+        last periodic checkpoint). Re-running resumes the stopped members.
         """
         old = self.check_folder()
         self.out_dir.mkdir(parents=True, exist_ok=True)
         with _FolderLock(self.out_dir / "ensemble.lock"):
-            return self._run_locked(old, client, workers, scheduler, serial, retry_failed, plot)
+            (self.out_dir / STOP_FILE).unlink(missing_ok=True)  # an earlier stop request is over
+            with _StopOnSignal(self, enabled=handle_signals):
+                return self._run_locked(old, client, workers, scheduler, serial, retry_failed, plot)
 
     def _run_locked(self, old, client, workers, scheduler, serial, retry_failed, plot):
+        self.stopped = None
         self._write_ensemble_json(old)
         plan = self.plan(retry_failed)
         todo = [m for m in self.members if plan[m.id] in ("new", "resume", "retry")]
@@ -140,21 +188,31 @@ class Ensemble:
                     self._run_dask(todo, client, workers, scheduler)
         finally:
             self.last_run["wall_s"] = time.perf_counter() - t0
-            summary = self.summarise(plot=plot)
+            if (self.out_dir / STOP_FILE).exists():
+                self.stopped = self.stopped or f"{self.out_dir / STOP_FILE} found"
+            summary = self.summarise(plot=plot and not self.stopped)
         failed = [str(m) for m, s in zip(summary["member"].values, summary["status"].values) if s != "done"]
         _say(f"ensemble {self.spec.name!r}: {len(self.members) - len(failed)} of {len(self.members)} members done "
              f"in {self.last_run['wall_s']:.1f} s wall; summary {self.out_dir / 'ensemble_summary.nc'}")
         for m in failed:
             i = list(summary["member"].values).index(m)
             _say(f"  {m}: {summary['status'].values[i]}: {summary['error'].values[i]}")
+        if self.stopped:
+            (self.out_dir / STOP_FILE).unlink(missing_ok=True)
+            _say(f"ensemble {self.spec.name!r}: stopped ({self.stopped}); the members in flight wrote a checkpoint. "
+                 f"Run the same command again to resume (finished members are skipped)")
         return summary
 
     def _run_serial(self, todo):
         prog = _Progress(len(todo), slots=1)
         for m in todo:
+            if self.stopped or (self.out_dir / STOP_FILE).exists():
+                break
             prog.started(m.id)
-            rec = run_member(self._task(m))
+            rec = run_member(self._task(m))  # in the main thread: the member's own SIGTERM/SIGINT clean stop
             prog.finished(rec)
+            if rec["status"] == "stopped":
+                self.stopped = self.stopped or str(rec.get("error"))
 
     def _run_dask(self, todo, client, workers, scheduler):
         from distributed import Client, as_completed
@@ -191,6 +249,9 @@ class Ensemble:
                     raise LagiceError(f"no dask worker joined the scheduler {client.scheduler.address} "
                                       "in 120 s") from None
                 resource, slots = uses_member_resource(client)
+            if own_cluster is not None:  # a signal reaching our workers stops their members cleanly
+                from .member import WorkerStopPlugin
+                client.register_plugin(WorkerStopPlugin())
             self.last_run["setup_s"] = time.perf_counter() - t_setup
             token = uuid.uuid4().hex[:8]
             futures = {}
@@ -226,7 +287,8 @@ class Ensemble:
 
     # -- summary ----------------------------------------------------------------------------
     def records(self) -> list[dict]:
-        """Every member's record from its folder (done, failed or not_run), in member order."""
+        """Every member's record from its folder, in member order: done, failed, stopped
+        (a clean stop with a checkpoint) or not_run."""
         from .member import member_diagnostics
         out = []
         keys = list(dict.fromkeys(k for m in self.members for k in m.overrides))
@@ -237,6 +299,15 @@ class Ensemble:
                 if (mdir / name).exists():
                     rec = json.loads((mdir / name).read_text())
                     break
+            if rec is not None and rec["status"] == "done" and rec.get("config_hash") != m.config_hash:
+                rec = {"member": m.id, "status": "not_run", "overrides": m.overrides,
+                       "error": "finished with an earlier run.duration/output settings; run the ensemble again "
+                                "to extend it"}
+            if rec is None and (mdir / "member.json").exists():
+                info = json.loads((mdir / "member.json").read_text())
+                if info.get("status") == "stopped":
+                    rec = {k: info.get(k) for k in ("member", "status", "error", "overrides", "resumed_from",
+                                                    "wall_s", "cpu_s", "numba_threads")}
             if rec is None:
                 rec = {"member": m.id, "status": "not_run", "overrides": m.overrides,
                        "error": "not finished (interrupted or not started)"}
@@ -262,6 +333,45 @@ class Ensemble:
             except Exception as exc:  # noqa: BLE001 - a plot failure must not hide the summary
                 _say(f"ensemble: warning: no spread plot ({type(exc).__name__}: {exc})")
         return ds
+
+
+class _StopOnSignal:
+    """While an ensemble runs (main thread only): the first SIGTERM or SIGINT writes
+    ``DIR/STOP`` (members stop cleanly with a checkpoint, none starts) and sets
+    ``ensemble.stopped``; a second one raises KeyboardInterrupt (stop at once)."""
+
+    SIGNALS = ("SIGTERM", "SIGINT")
+
+    def __init__(self, ensemble, enabled: bool = True):
+        self.ens = ensemble
+        self.enabled = enabled and threading.current_thread() is threading.main_thread()
+        self._old = {}
+        self.received = 0
+
+    def _handler(self, signum, frame):
+        name = signal.Signals(signum).name
+        self.received += 1
+        if self.received > 1:
+            raise KeyboardInterrupt(f"second signal ({name})")
+        self.ens.stopped = f"{name} received"
+        with contextlib.suppress(OSError):
+            (self.ens.out_dir / STOP_FILE).write_text(f"{name} received {_dt.datetime.now().isoformat()}\n")
+        print(f"lagice ensemble: {name} received: the running members stop after their current step with a "
+              "checkpoint, no other member starts (a second signal stops at once)", flush=True)
+
+    def __enter__(self):
+        self.ens.stopped = None
+        if self.enabled:
+            for name in self.SIGNALS:
+                num = getattr(signal, name)
+                self._old[num] = signal.signal(num, self._handler)
+        return self
+
+    def __exit__(self, *exc):
+        for num, old in self._old.items():
+            signal.signal(num, old)
+        self._old = {}
+        return False
 
 
 class _FolderLock:
@@ -305,8 +415,6 @@ def _kill_local_workers(cluster) -> None:
     """Stop the worker processes of our LocalCluster at once (Ctrl-C, SIGTERM): a
     graceful close would wait for the members in flight. Their checkpoints,
     snapshots and markers are written atomically, so a re-run resumes them."""
-    import signal
-
     for w in list(getattr(cluster, "workers", {}).values()):
         pid = getattr(w, "pid", None)
         if isinstance(pid, int) and pid > 0:
@@ -331,11 +439,11 @@ class _Progress:
 
     def __init__(self, n: int, slots: int, client=None):
         self.n, self.slots, self.client = n, slots, client
-        self.done = self.failed = 0
+        self.done = self.failed = self.stopped = 0
         self.t0 = time.perf_counter()
 
     def started(self, mid):
-        _say(f"  [{self.done + self.failed + 1}/{self.n}] {mid}: started")
+        _say(f"  [{self.done + self.failed + self.stopped + 1}/{self.n}] {mid}: started")
 
     def finished(self, rec):
         if rec.get("status") == "done":
@@ -343,10 +451,13 @@ class _Progress:
             what = f"done in {rec.get('wall_s', math.nan):.1f} s"
             if rec.get("resumed_from"):
                 what += f" (resumed from {Path(rec['resumed_from']).name})"
+        elif rec.get("status") == "stopped":
+            self.stopped += 1
+            what = str(rec.get("error"))
         else:
             self.failed += 1
             what = f"FAILED after {rec.get('wall_s', math.nan):.1f} s: {rec.get('error')}"
-        k = self.done + self.failed
+        k = self.done + self.failed + self.stopped
         left = self.n - k
         if self.client is not None:
             from .cluster import uses_member_resource
@@ -354,8 +465,9 @@ class _Progress:
                 self.slots = max(1, uses_member_resource(self.client)[1])
         running = min(self.slots, left)
         el = time.perf_counter() - self.t0
-        eta = el / k * left if k else math.nan
-        _say(f"  [{k}/{self.n}] {rec['member']}: {what} | done {self.done}, failed {self.failed}, "
+        eta = el / k * left if k and not self.stopped else math.nan
+        stopped = f", stopped {self.stopped}" if self.stopped else ""
+        _say(f"  [{k}/{self.n}] {rec['member']}: {what} | done {self.done}, failed {self.failed}{stopped}, "
              f"running {running}, waiting {left - running} | elapsed {_hms(el)}, ETA {_hms(eta)}")
 
 
@@ -377,17 +489,3 @@ def _lookup(cfg: dict, dotted: str):
             return None
         node = node.get(p)
     return node
-
-
-def _diff(a: dict, b: dict, prefix: str = "") -> list[str]:
-    out = []
-    for k in sorted(set(a) | set(b)):
-        if k.startswith("_"):
-            continue
-        key = f"{prefix}{k}"
-        va, vb = a.get(k), b.get(k)
-        if isinstance(va, dict) and isinstance(vb, dict):
-            out += _diff(va, vb, key + ".")
-        elif va != vb:
-            out.append(f"{key}: {va!r} -> {vb!r}")
-    return out

@@ -1,17 +1,33 @@
-"""One ensemble member, run on a dask worker (or in-process): start, resume or branch,
-write provenance, compute its diagnostics, and leave a marker.
+"""One ensemble member, run on a dask worker (or in-process), through the run
+workflow of ``lagice run`` / ``lagice resume`` / ``lagice branch``
+(:mod:`lagice.scenes.builder`, :mod:`lagice.rundir`): a new member claims its own
+run folder and is built with ``build_simulation`` (``branch_simulation`` for a
+member that starts from a checkpoint); an interrupted one continues with
+``resume_simulation`` from its newest checkpoint (bit for bit, and extended when
+only ``run.duration`` grew). The member id and overrides travel in the config
+(``config["_ensemble"]``), so every output file of the member carries them
+(:func:`lagice.io.cf.provenance`) and so do its checkpoints.
 
-Member folder ``DIR/members/<id>/``:
+Member folder ``DIR/members/<id>/`` (a lagice run folder):
 
 =======================  ==========================================================
+``lagice_run.json``      the run-folder marker (:mod:`lagice.rundir`), with ``ensemble``
 ``member.json``          id, overrides, base, parent checkpoint (path, SHA-256),
                          config, status, host/worker, numba threads (updated at the end)
-``snapshots/``           the run's snapshots (global attributes ``ensemble_*``)
+``snapshots/``           the run's snapshots (global attributes ``lagice_ensemble*``)
 ``checkpoints/``         the run's checkpoints (resume after an interruption)
 ``summary.json``         the run summary (``lagice run``'s)
 ``done.json``            marker of a finished member: its record (summary, diagnostics)
 ``failed.json``          the error of a failed member (type, message, traceback)
 =======================  ==========================================================
+
+A member stops cleanly (checkpoint, end-of-run outputs: ``Simulation.request_stop``
+through a :class:`~lagice.activities.StopCondition`) when the ensemble folder holds
+the file ``STOP`` (:data:`STOP_FILE`: written by ``lagice ensemble`` on SIGTERM/SIGINT,
+or by hand, ``touch DIR/STOP``, on any cluster that shares the folder), or when its
+worker process received SIGTERM/SIGINT (:class:`WorkerStopPlugin`: a batch system's
+signal at the walltime, or Ctrl-C reaching the local workers): the worker's members
+stop as ``lagice run`` does, and the worker starts no other member.
 """
 from __future__ import annotations
 
@@ -19,18 +35,25 @@ import datetime as _dt
 import json
 import math
 import os
-import shutil
+import signal
 import socket
+import threading
 import time
 import traceback
 from pathlib import Path
 
 import numpy as np
+from distributed.diagnostics.plugin import WorkerPlugin
+
+from ..activities import StopCondition
 
 DIAG_KEYS = ("beta_space", "beta_space_r2", "pdf_tail_exponent_shear", "pdf_tail_exponent_divergence",
              "localisation_half_shear_area_fraction", "shear_divergence_r2", "mean_total_s", "mean_shear_s",
              "mean_abs_divergence_s")
-OWN_OUTPUTS = ("snapshots", "checkpoints", "summary.json", "done.json", "failed.json")
+#: the ensemble's own files in a member folder (removed, with the run outputs, when a member starts afresh)
+MEMBER_FILES = ("member.json", "done.json", "failed.json")
+#: a file in the ensemble folder that asks every running member to stop cleanly
+STOP_FILE = "STOP"
 
 
 def _now() -> str:
@@ -54,69 +77,76 @@ def _json_default(o):
     return str(o)
 
 
-# -- provenance in output files ---------------------------------------------------------
-class ProvenanceWriter:
-    """Wraps a run's :class:`~lagice.io.snapshots.SnapshotWriter`: every snapshot (and
-    regular-grid file) gets the member's provenance as global attributes."""
-
-    def __init__(self, writer, attrs: dict):
-        self._writer = writer
-        self.attrs = {k: v for k, v in attrs.items() if v is not None}
-
-    def write(self, state, strain_rate=None, extra=None):
-        path = self._writer.write(state, strain_rate, {**self.attrs, **(extra or {})})
-        if getattr(self._writer, "grid_resolution_m", None):
-            grid = Path(path).with_name(f"grid_{state.step:08d}.nc")
-            if grid.exists():
-                import netCDF4
-                with netCDF4.Dataset(grid, "a") as nc:
-                    nc.setncatts(self.attrs)
-        return path
-
-    def __getattr__(self, name):
-        return getattr(self._writer, name)
+# -- stopping ---------------------------------------------------------------------------------
+#: why this worker process was asked to stop (set by :class:`WorkerStopPlugin`'s signal handler)
+_WORKER_STOP = {"reason": None}
 
 
-def provenance_attrs(ensemble: str, member_id: str, overrides: dict, parent=None, parent_sha=None) -> dict:
-    return {"ensemble_name": ensemble, "ensemble_member": member_id,
-            "ensemble_member_overrides": json.dumps(overrides, sort_keys=True, default=str),
-            "parent_checkpoint": str(parent) if parent else None, "parent_checkpoint_sha256": parent_sha}
+class WorkerStopPlugin(WorkerPlugin):
+    """A dask worker plugin: the first SIGTERM or SIGINT the worker process receives
+    stops its running members cleanly (checkpoint) and keeps it from starting others,
+    instead of killing the process with the members in it; a second one acts as
+    before (the worker stops at once). Registered by ``lagice ensemble`` on the
+    clusters it starts (LocalCluster, SLURM/PBS jobs)."""
+
+    name = "lagice-ensemble-stop"
+
+    def setup(self, worker):
+        if threading.current_thread() is not threading.main_thread():  # pragma: no cover - handlers need it
+            return
+        from ..mesh.generate import gmsh_session
+
+        with gmsh_session():  # gmsh's first initialisation resets SIGTERM: do it before installing the handler
+            pass
+        for name in ("SIGTERM", "SIGINT"):
+            num = getattr(signal, name)
+            old = signal.getsignal(num)
+            if getattr(old, "__name__", "") != "_worker_signal":
+                _OLD_HANDLERS[num] = old
+                signal.signal(num, _worker_signal)
 
 
-# -- branching -------------------------------------------------------------------------
-def branch_simulation(checkpoint, overrides: dict | None = None, out_dir=None, progress: bool = False,
-                      config: dict | None = None):
-    """A new :class:`~lagice.simulation.Simulation` that starts from ``checkpoint``'s
-    state with ``overrides`` applied to its configuration, writing to ``out_dir``.
+_OLD_HANDLERS = {}
 
-    The checkpoint's config (or ``config``, already built with
-    :func:`lagice.ensemble.spec.member_config`) is rebuilt into a model, then the
-    checkpoint's mesh, fields, clock, counters and random-generator state are
-    loaded; the parent's fingerprint is not required to match (that is the
-    point of a branch). ``domain.*``, ``initial.*`` and ``solver.dt`` cannot
-    change; ``run.duration`` is the end time counted from the start of the
-    parent run. The parent path and SHA-256 are stored in ``config["_parent"]``
-    (so the branch's own checkpoints carry them) and on ``sim.parent``. The
-    branch's first snapshot (the parent state) is written at once.
-    """
-    from ..io.checkpoint import read_checkpoint
-    from ..scenes.toml_scene import build_simulation
-    from .spec import file_sha256, member_config
 
-    checkpoint = Path(checkpoint)
-    arrays, meta = read_checkpoint(checkpoint)
-    cfg = config if config is not None else member_config(None, dict(overrides or {}), meta)
-    parent = {"checkpoint": str(checkpoint.resolve()), "sha256": file_sha256(checkpoint),
-              "step": int(meta["step"]), "time_s": float(meta["time_s"])}
-    cfg = dict(cfg)
-    cfg["_parent"] = parent
-    out = Path(out_dir) if out_dir is not None else Path("runs") / f"{cfg['scene']['name']}_branch"
-    cfg["_out_dir"] = str(out)
-    sim = build_simulation(cfg, out, progress=progress)
-    sim.model.load_state(arrays, meta)
-    sim.volume0 = sim.model.state.counters.get("volume0_m3")
-    sim.parent = parent
-    return sim
+def _worker_signal(signum, frame):
+    name = signal.Signals(signum).name
+    if _WORKER_STOP["reason"] is None:
+        _WORKER_STOP["reason"] = f"{name} received by the worker (pid {os.getpid()})"
+        return
+    old = _OLD_HANDLERS.pop(signum, signal.SIG_DFL)  # a second signal: as before the plugin
+    signal.signal(signum, old if old is not None else signal.SIG_DFL)
+    os.kill(os.getpid(), signum)
+
+
+def stop_reason(out_dir: Path) -> str | None:
+    """Why members should stop now (the worker was signalled, ``DIR/STOP`` exists), or None."""
+    if _WORKER_STOP["reason"] is not None:
+        return _WORKER_STOP["reason"]
+    if (Path(out_dir) / STOP_FILE).exists():
+        return f"the ensemble was asked to stop ({Path(out_dir) / STOP_FILE})"
+    return None
+
+
+class EnsembleStop(StopCondition):
+    """Checked after every step of a member: stops it (``sim.request_stop``: checkpoint,
+    end-of-run outputs, ``stop_reason``) when :func:`stop_reason` gives a reason."""
+
+    name = "ensemble_stop"
+
+    def __init__(self, out_dir):
+        super().__init__(lambda sim: False, "the ensemble was asked to stop")
+        self.out_dir = Path(out_dir)
+
+    def __call__(self, sim):
+        why = stop_reason(self.out_dir)
+        if why:
+            sim.request_stop(why)
+
+
+def member_tag(ensemble: str, member_id: str, overrides: dict) -> dict:
+    """``config["_ensemble"]``: what every output file of the member records."""
+    return {"ensemble": ensemble, "member": member_id, "overrides": dict(overrides)}
 
 
 # -- diagnostics ------------------------------------------------------------------------
@@ -195,17 +225,24 @@ def member_diagnostics(run_dir, analysis: dict) -> dict:
 
 
 # -- running one member -------------------------------------------------------------------
-def member_state(member_dir: Path) -> str:
-    """"done", "failed" (run again from its newest checkpoint, if any), "resume" (a
-    checkpoint of an interrupted attempt), or "new"."""
-    if (member_dir / "done.json").exists():
-        return "done"
+def member_state(member_dir: Path, config_hash: str | None = None) -> str:
+    """"done" (finished with this configuration), "failed" (run again: resumed from its
+    newest checkpoint, if any), "resume" (a checkpoint of an interrupted attempt, or a
+    finished member whose run grew longer: ``run.duration`` only), or "new"."""
+    done = member_dir / "done.json"
+    if done.exists():
+        if config_hash is None or json.loads(done.read_text()).get("config_hash") == config_hash:
+            return "done"
+        return "resume" if _has_checkpoints(member_dir) else "new"
     if (member_dir / "failed.json").exists():
         return "failed"
+    return "resume" if _has_checkpoints(member_dir) else "new"
+
+
+def _has_checkpoints(member_dir: Path) -> bool:
     from ..io.checkpoint import list_checkpoints
-    if list_checkpoints(member_dir / "checkpoints"):
-        return "resume"
-    return "new"
+
+    return bool(list_checkpoints(member_dir / "checkpoints"))
 
 
 def run_member(task: dict) -> dict:
@@ -217,9 +254,10 @@ def run_member(task: dict) -> dict:
     the scheduler goes away); a member's files are its own.
 
     ``task``: ``id``, ``out`` (ensemble folder), ``config`` (validated scene config),
-    ``overrides`` (the member's own), ``common``, ``ensemble`` (name), ``base``,
-    ``branch_from`` and ``branch_sha256`` (or None), ``analysis``.
-    Returns the member record (also written as ``done.json`` or ``failed.json``)."""
+    ``config_hash``, ``overrides`` (the member's own), ``common``, ``ensemble`` (name),
+    ``base``, ``branch_from`` and ``branch_sha256`` (or None), ``analysis``.
+    Returns the member record: status "done" (also written as ``done.json``),
+    "failed" (``failed.json``) or "stopped" (a clean stop on request: resumable)."""
     import dask
 
     with dask.config.set(scheduler="synchronous"):
@@ -228,38 +266,47 @@ def run_member(task: dict) -> dict:
 
 def _run_member(task: dict) -> dict:
     t_start, c_start = time.perf_counter(), time.process_time()
-    mdir = Path(task["out"]) / "members" / task["id"]
-    mdir.mkdir(parents=True, exist_ok=True)
+    out = Path(task["out"])
+    mdir = out / "members" / task["id"]
     rec = {"member": task["id"], "status": "running", "error": None, "started": _now(),
            "host": socket.gethostname(), "pid": os.getpid(), "worker": _worker_address(),
-           "numba_threads": _numba_threads(), "resumed_from": None, "overrides": task["overrides"]}
+           "numba_threads": _numba_threads(), "resumed_from": None, "overrides": task["overrides"],
+           "config_hash": task["config_hash"]}
+    why = stop_reason(out)
+    if why:  # the ensemble or this worker is stopping: do not start
+        return {**rec, "status": "stopped", "error": f"not started: {why}"}
+    state = member_state(mdir, task["config_hash"])
+    if state == "done":  # finished by an earlier run: nothing to do
+        return json.loads((mdir / "done.json").read_text())
+    for name in ("done.json", "failed.json"):  # the record of an earlier attempt (or a shorter run)
+        (mdir / name).unlink(missing_ok=True)
+    from .. import __version__
+
     info = {"member": task["id"], "ensemble": task["ensemble"], "overrides": task["overrides"],
             "common_overrides": task["common"], "base": task["base"],
             "parent_checkpoint": task.get("branch_from"), "parent_checkpoint_sha256": task.get("branch_sha256"),
-            "config_hash": task["config_hash"], "config": task["config"], **rec}
-    from .. import __version__
-    info["lagice_version"] = __version__
+            "config": task["config"], "lagice_version": __version__, **rec}
+    sim = None
     try:
-        if (mdir / "done.json").exists():  # finished by an earlier run: nothing to do
-            return json.loads((mdir / "done.json").read_text())
-        (mdir / "failed.json").unlink(missing_ok=True)
-        sim, resumed = _start_or_resume(task, mdir)
+        sim, resumed = _start_or_resume(task, mdir, state)
         rec["resumed_from"] = info["resumed_from"] = str(resumed) if resumed else None
         write_json(mdir / "member.json", info)
-        from ..scenes.toml_scene import finish
+        from ..scenes.builder import finish
+
+        sim.add(EnsembleStop(out))
         res = finish(sim)
-        st = sim.model.state
-        bad = [name for name in ("thickness", "concentration", "damage", "stress", "velocity")
-               if not np.all(np.isfinite(getattr(st, name)))]
-        if bad:
-            from ..errors import SolverError
-            raise SolverError(f"non-finite values at the end of the run (t = {st.time_s:g} s) in: {', '.join(bad)}")
         summary = res["summary"]
         rec["summary"] = {k: summary[k] for k in ("time_s", "steps", "wall_s", "remesh_count", "ice_volume_m3",
-                                                  "volume_budget", "timings") if k in summary}
-        rec["diagnostics"] = member_diagnostics(mdir, task["analysis"])
-        rec["analysis"] = {k: v for k, v in task["analysis"].items()}
-        rec["status"] = "done"
+                                                  "volume_budget", "timings", "stop_reason", "checkpoint")
+                          if k in summary}
+        if summary.get("stop_reason"):
+            rec["status"] = "stopped"
+            rec["error"] = (f"stopped at step {summary['steps']} (day {summary['time_s'] / 86400:.3f}): "
+                            f"{summary['stop_reason']}; checkpoint {summary.get('checkpoint')}")
+        else:
+            rec["diagnostics"] = member_diagnostics(mdir, task["analysis"])
+            rec["analysis"] = dict(task["analysis"])
+            rec["status"] = "done"
     except Exception as exc:  # noqa: BLE001 - a member's error is its result, not the ensemble's
         rec["status"] = "failed"
         rec["error"] = f"{type(exc).__name__}: {exc}"
@@ -268,46 +315,37 @@ def _run_member(task: dict) -> dict:
     rec["wall_s"] = time.perf_counter() - t_start
     rec["cpu_s"] = time.process_time() - c_start  # < wall_s when the member waited for a core
     info.update({k: rec[k] for k in ("status", "error", "finished", "wall_s", "cpu_s")})
+    mdir.mkdir(parents=True, exist_ok=True)
     write_json(mdir / "member.json", info)
-    write_json(mdir / ("done.json" if rec["status"] == "done" else "failed.json"), rec)
+    if rec["status"] in ("done", "failed"):
+        write_json(mdir / ("done.json" if rec["status"] == "done" else "failed.json"), rec)
     return rec
 
 
-def _start_or_resume(task: dict, mdir: Path):
-    """(simulation, checkpoint it resumed from or None)."""
+def _start_or_resume(task: dict, mdir: Path, state: str):
+    """(simulation, checkpoint it resumed from or None), through the run workflow:
+    ``resume_simulation`` (newest usable checkpoint of the member folder; refused
+    when the physics changed), else a fresh start in the member folder, claimed as
+    ``lagice run --out`` does (an earlier attempt's outputs are replaced):
+    ``branch_simulation`` from the ensemble's checkpoint or ``build_simulation``."""
+    from .. import rundir
     from ..errors import RestartError
-    from ..io.checkpoint import list_checkpoints
-    from ..simulation import Simulation
+    from ..scenes.builder import branch_simulation, build_simulation, resume_simulation
 
-    attrs = provenance_attrs(task["ensemble"], task["id"], task["overrides"], task.get("branch_from"),
-                             task.get("branch_sha256"))
-    resumed = None
-    sim = None
-    if list_checkpoints(mdir / "checkpoints"):
+    cfg = json.loads(json.dumps(task["config"]))  # a private copy
+    cfg["_ensemble"] = member_tag(task["ensemble"], task["id"], task["overrides"])
+    if state in ("resume", "failed") and _has_checkpoints(mdir):
         try:
-            sim = Simulation.resume(mdir / "checkpoints", out_dir=mdir, progress=False)
-            resumed = sim.resumed_from
+            sim = resume_simulation(mdir, config=cfg, progress=False)
+            return sim, sim.resumed_from
         except RestartError as exc:
             print(f"lagice ensemble: member {task['id']}: cannot resume ({exc}); starting it again", flush=True)
-            sim = None
-    if sim is None:
-        for name in OWN_OUTPUTS:  # a fresh start: nothing of an earlier attempt may mix in
-            p = mdir / name
-            if p.is_dir():
-                shutil.rmtree(p)
-            else:
-                p.unlink(missing_ok=True)
-        cfg = json.loads(json.dumps(task["config"]))  # a private copy
-        if task.get("branch_from"):
-            sim = branch_simulation(task["branch_from"], out_dir=mdir, config=cfg)
-            sim.writer = ProvenanceWriter(sim.writer, attrs)
-            sim.writer.write(sim.model.state)  # the branch's first snapshot: the parent state
-            return sim, None
-        from ..scenes.toml_scene import build_simulation
-        cfg["_out_dir"] = str(mdir)
-        sim = build_simulation(cfg, mdir, progress=False)
-    sim.writer = ProvenanceWriter(sim.writer, attrs)
-    return sim, resumed
+    for name in MEMBER_FILES:  # a fresh start: nothing of an earlier attempt may mix in
+        (mdir / name).unlink(missing_ok=True)
+    rundir.claim(mdir, overwrite=True)  # refuses a folder that is not a lagice run folder
+    if task.get("branch_from"):
+        return branch_simulation(task["branch_from"], mdir, config=cfg, progress=False), None
+    return build_simulation(cfg, mdir, progress=False), None
 
 
 def _worker_address() -> str:

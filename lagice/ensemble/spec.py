@@ -51,7 +51,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ConfigError
+from ..errors import ConfigError, LagiceError
 from ..schedule import parse_duration
 
 TABLES = ("ensemble", "set", "member", "grid", "seeds", "cluster", "analysis")
@@ -63,8 +63,6 @@ DISTRIBUTIONS = ("normal", "uniform")
 ANALYSIS_DEFAULTS = {"window": None, "windows": 1, "coast_buffer_km": 0.0}
 CLUSTER_KINDS = ("local", "slurm", "pbs", "address")
 _ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._=+,-]{0,119}$")
-#: keys a branched member may not change: the state (mesh, fields) and the clock come from the checkpoint
-BRANCH_FIXED = ("domain.", "initial.", "solver.dt")
 
 
 @dataclass
@@ -114,14 +112,6 @@ class EnsembleSpec:
 def config_hash(cfg: dict) -> str:
     clean = {k: v for k, v in cfg.items() if not k.startswith("_")}
     return hashlib.sha256(json.dumps(clean, sort_keys=True, default=str).encode()).hexdigest()[:16]
-
-
-def file_sha256(path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for chunk in iter(lambda: f.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
 
 
 def _fmt(v) -> str:
@@ -178,7 +168,7 @@ def parse_spec(raw: dict, source: str = "<dict>", root: Path | None = None, over
     common.update(_cli_overrides(overrides))
 
     # base configuration: a scene, or the config stored in a checkpoint
-    base, branch, branch_sha, ck_meta = ens.get("base"), ens.get("branch_from"), None, None
+    base, branch, branch_sha, parent = ens.get("base"), ens.get("branch_from"), None, None
     if (base is None) == (branch is None):
         raise ConfigError(f"{source}: give exactly one of ensemble.base (a scene name or .toml path) or "
                           "ensemble.branch_from (a checkpoint file every member starts from)")
@@ -189,14 +179,18 @@ def parse_spec(raw: dict, source: str = "<dict>", root: Path | None = None, over
     else:
         if not isinstance(branch, str):
             raise ConfigError(f"{source}: ensemble.branch_from = {branch!r}: expected a checkpoint file path")
-        branch = Path(branch) if Path(branch).is_absolute() else (root / branch)
-        from ..io.checkpoint import read_checkpoint
+        branch = (Path(branch) if Path(branch).is_absolute() else (root / branch)).resolve()
+        from ..io.checkpoint import file_sha256, read_checkpoint
         if not branch.is_file():
             raise ConfigError(f"{source}: ensemble.branch_from = {str(branch)!r}: checkpoint file not found")
-        _, ck_meta = read_checkpoint(branch)
+        try:
+            _, meta = read_checkpoint(branch)
+        except LagiceError as exc:
+            raise ConfigError(f"{source}: ensemble.branch_from = {str(branch)!r}: {exc}") from None
         branch_sha = file_sha256(branch)
+        parent = (branch, meta, branch_sha)
 
-    members_raw = _expand_members(raw, source, common, base, ck_meta)
+    members_raw = _expand_members(raw, source, common, base, parent)
     members, seen = [], {}
     for mid, own in members_raw:
         if mid in seen:
@@ -207,8 +201,8 @@ def parse_spec(raw: dict, source: str = "<dict>", root: Path | None = None, over
             raise ConfigError(f"{source}: member id {mid!r}: expected 1-120 letters, digits and ._=+,- "
                               "starting with a letter or digit (it names a folder)")
         try:
-            cfg = member_config(base, {**common, **own}, ck_meta)
-        except ConfigError as exc:
+            cfg = member_config(base, {**common, **own}, parent)
+        except LagiceError as exc:
             raise ConfigError(f"{source}: member {mid!r} ({_overrides_text(own)}): {exc}") from None
         members.append(Member(mid, own, cfg))
     if not members:
@@ -275,7 +269,7 @@ def flatten(d: dict, where: str, source: str, stop=None) -> dict:
 
 
 # -- members ---------------------------------------------------------------------------
-def _expand_members(raw, source, common, base, ck_meta):
+def _expand_members(raw, source, common, base, parent):
     kinds = [k for k in ("member", "grid", "seeds") if k in raw]
     if len(kinds) != 1:
         raise ConfigError(f"{source}: give the members as exactly one of [[member]] (a list of overrides), "
@@ -286,7 +280,7 @@ def _expand_members(raw, source, common, base, ck_meta):
         return _list_members(raw["member"], source)
     if kind == "grid":
         return grid_members(flatten(_table(raw, "grid", source), "grid", source), source)
-    return seed_members(_table(raw, "seeds", source), source, common, base, ck_meta)
+    return seed_members(_table(raw, "seeds", source), source, common, base, parent)
 
 
 def _list_members(items, source):
@@ -339,7 +333,7 @@ def _id_value(v) -> str:
     return re.sub(r"[^A-Za-z0-9.+-]", "-", s)
 
 
-def seed_members(t: dict, source: str, common: dict, base, ck_meta):
+def seed_members(t: dict, source: str, common: dict, base, parent):
     """[(id, overrides)] of ``n`` members: member k draws from ``default_rng([seed, k])``,
     first one integer in [0, 2**31 - 1) per entry of ``keys`` (in order), then one
     perturbation per entry of ``perturb`` (in order). Member k does not depend on n."""
@@ -363,7 +357,7 @@ def seed_members(t: dict, source: str, common: dict, base, ck_meta):
                           "(e.g. [\"run.seed\", \"forcing.wind.seed\"])")
     if not keys and not perturb:
         raise ConfigError(f"{source}: [seeds] needs keys (seeded keys) or perturb (perturbed keys)")
-    base_cfg = member_config(base, common, ck_meta) if perturb else None
+    base_cfg = member_config(base, common, parent) if perturb else None
     rules = {}
     for key, rule in perturb.items():
         if not isinstance(rule, dict):
@@ -408,32 +402,23 @@ def _get(cfg: dict, dotted: str):
 
 
 # -- configs ---------------------------------------------------------------------------
-def member_config(base, overrides: dict, ck_meta: dict | None = None) -> dict:
-    """The validated scene config of a member: ``load_scene(base, overrides)`` and the
-    engine's pre-mesh checks; for a branched member, the checkpoint's config with the
-    overrides applied (keys that fix the state or the clock may not change)."""
-    from ..scenes.config import apply_overrides, load_scene, validate
-    from ..scenes.toml_scene import validate_components
+def member_config(base, overrides: dict, parent=None) -> dict:
+    """The validated scene config of a member, with the checks ``lagice run`` and
+    ``lagice branch`` make before any work: ``load_scene(base, overrides)`` and
+    :func:`~lagice.scenes.builder.validate_config` (every table, forcing keywords and
+    gridded forcing files included); for a member branched from a checkpoint
+    (``parent`` = (path, metadata, SHA-256)),
+    :func:`~lagice.scenes.builder.branch_config` (the checkpoint's config with the
+    overrides; domain, initial state, time step and start date cannot change)."""
+    from ..scenes.builder import branch_config, validate_config
+    from ..scenes.config import load_scene
 
-    if ck_meta is None:
+    if parent is None:
         cfg = load_scene(base, overrides)
-    else:
-        parent = ck_meta["config"]
-        for key in overrides:
-            if key.startswith(BRANCH_FIXED):
-                raise ConfigError(f"{key}: a member branched from a checkpoint starts from its mesh, fields "
-                                  "and clock; domain.*, initial.* and solver.dt cannot change")
-        raw = {k: copy.deepcopy(v) for k, v in parent.items() if not k.startswith("_")}
-        raw["scene"] = {k: v for k, v in raw.get("scene", {}).items() if k != "source"}
-        cfg = validate(apply_overrides(raw, overrides), "checkpoint config")
-        cfg["scene"]["source"] = parent.get("scene", {}).get("source", "")
-        end = parse_duration(cfg["run"]["duration"], "run.duration")
-        if not end > float(ck_meta["time_s"]) * (1 + 1e-12):
-            raise ConfigError(f"run.duration = {cfg['run']['duration']!r} ({end:g} s): a branched member runs "
-                              f"from the checkpoint time {float(ck_meta['time_s']):g} s to run.duration "
-                              "(counted from the start of the parent run); give a longer duration")
-    validate_components(cfg)
-    return cfg
+        validate_config(cfg)
+        return cfg
+    path, meta, sha = parent
+    return branch_config(path, meta, overrides, sha256=sha)
 
 
 def parse_analysis(t: dict, source: str) -> dict:

@@ -65,9 +65,11 @@ def summary_dataset(records: list[dict], spec_info: dict) -> xr.Dataset:
     ds = xr.Dataset(coords={"member": ("member", np.array(ids, dtype=object),
                                        {"long_name": "ensemble member id (folder members/<id>)"})})
     ds["status"] = ("member", np.array([r.get("status", "not_run") for r in records], dtype=object),
-                    {"long_name": "member status: done, failed or not_run"})
+                    {"long_name": "member status: done, failed, stopped (a clean stop with a checkpoint: "
+                                 "re-running resumes it) or not_run"})
     ds["error"] = ("member", np.array([r.get("error") or "" for r in records], dtype=object),
-                   {"long_name": "error of a failed member (type: message), empty otherwise"})
+                   {"long_name": "error of a failed member (type: message), why a member stopped or did not "
+                                 "run, empty otherwise"})
     ds["resumed_from"] = ("member", np.array([r.get("resumed_from") or "" for r in records], dtype=object),
                           {"long_name": "checkpoint the member's last attempt resumed from, empty if none"})
     for name, (path, units, long) in SCALARS.items():
