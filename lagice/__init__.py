@@ -12,7 +12,7 @@ from .errors import (  # noqa: E402
 )
 
 __all__ = ["__version__", "LagiceError", "ConfigError", "MeshError", "ForcingError", "RestartError",
-           "SolverError", "OutputError", "Model", "Simulation", "open_run"]
+           "SolverError", "OutputError", "Model", "Simulation", "open_run", "Ensemble"]
 
 
 def __getattr__(name):  # lazy: keep `import lagice` light
@@ -25,4 +25,7 @@ def __getattr__(name):  # lazy: keep `import lagice` light
     if name == "open_run":
         from .io.run import open_run
         return open_run
+    if name == "Ensemble":  # ensembles (lagice.ensemble, dask): imported on first use
+        from .ensemble import Ensemble
+        return Ensemble
     raise AttributeError(name)

@@ -14,6 +14,8 @@
     lagice diagnose OUTPUT --window-days D [--start-day S] [--coast-buffer-km B]
                                                           statistics over back-to-back windows
     lagice scenes                                         list bundled scenes
+    lagice ensemble SPEC [--out DIR] [--workers N] [--scheduler ADDRESS]
+                                                          ensemble / parameter sweep on dask
 
 A new run writes to ``runs/SCENE-YYYYmmdd-HHMMSS/`` (linked as ``runs/SCENE-latest``)
 unless ``--out`` names a folder, which must be empty (``--overwrite`` replaces a
@@ -377,6 +379,8 @@ def main(argv=None) -> int:
     d.set_defaults(func=_diagnose)
     sc = sub.add_parser("scenes", help="list bundled scenes", parents=[common])
     sc.set_defaults(func=_scenes)
+    from .ensemble.command import add_subcommand as _add_ensemble  # ensembles (lagice/ensemble, issue 14)
+    _add_ensemble(sub, parents=[common])
     args = ap.parse_args(argv)
     level = getattr(args, "log_level", "info")
     try:

@@ -101,7 +101,7 @@ def claim(out, overwrite: bool = False) -> Path:
 
 def prepare(out, config: dict | None = None) -> list[Path]:
     """Create ``out``, prove it writable (by writing the marker ``lagice_run.json``:
-    scene, lagice version, command, parent checkpoint of a branch; or, when it
+    scene, lagice version, command, parent checkpoint of a branch, ensemble member; or, when it
     exists, a probe file), and remove stale temporary files of killed writes.
     Raises OutputError naming the folder."""
     out = Path(out)
@@ -120,6 +120,8 @@ def prepare(out, config: dict | None = None) -> list[Path]:
                 "command": " ".join(sys.argv) if sys.argv and sys.argv[0] else None}
         if cfg.get("_parent"):
             info["parent"] = cfg["_parent"]
+        if cfg.get("_ensemble"):
+            info["ensemble"] = cfg["_ensemble"]
         tmp = marker.with_name(f"{MARKER}.tmp")
         try:
             tmp.write_text(json.dumps(info, indent=1, default=str))

@@ -51,7 +51,9 @@ def provenance(title: str, config: dict | None = None, extra: dict | None = None
     """Global attributes: Conventions, title, history, source (lagice version and
     commit), the scene configuration as JSON, the parent checkpoint of a branched run
     (``lagice_parent_checkpoint``, ``lagice_parent_checkpoint_sha256``, from
-    ``config["_parent"]``), plus ``extra``."""
+    ``config["_parent"]``), the ensemble member of an ensemble run (``lagice_ensemble``,
+    ``lagice_ensemble_member``, ``lagice_ensemble_member_overrides`` as JSON, from
+    ``config["_ensemble"]``, :mod:`lagice.ensemble`), plus ``extra``."""
     from .. import __version__
 
     now = datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
@@ -70,6 +72,13 @@ def provenance(title: str, config: dict | None = None, extra: dict | None = None
             attrs["lagice_parent_checkpoint_sha256"] = str(parent["sha256"])
             attrs["history"] += (f"\n{now}: branched from checkpoint {parent['checkpoint']} (step {parent['step']}, "
                                  f"sha256 {parent['sha256']})")
+        member = config.get("_ensemble")
+        if member:
+            attrs["lagice_ensemble"] = str(member["ensemble"])
+            attrs["lagice_ensemble_member"] = str(member["member"])
+            attrs["lagice_ensemble_member_overrides"] = json.dumps(member.get("overrides", {}), sort_keys=True,
+                                                                   default=str)
+            attrs["history"] += f"\n{now}: member {member['member']!r} of the ensemble {member['ensemble']!r}"
     attrs.update(extra or {})
     return attrs
 

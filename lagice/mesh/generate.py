@@ -6,6 +6,7 @@ islands) with a target element size given as a number [m] or a callable
 """
 from __future__ import annotations
 
+import signal
 import threading
 from contextlib import contextmanager
 
@@ -20,6 +21,20 @@ from .core import COAST, Mesh, boundary_edges_of, signed_areas
 _GMSH_LOCK = threading.RLock()
 
 
+def _initialize(gmsh) -> None:
+    """``gmsh.initialize``, keeping the SIGTERM handler: gmsh's initialisation resets
+    the process's SIGTERM action to the default at the C level (Python still reports
+    its handler, which then never runs), so a clean stop on SIGTERM (``Simulation``'s
+    :class:`~lagice.activities.SignalStop`, ``lagice ensemble`` workers) would kill the
+    process instead when gmsh first starts during a run (the first remesh of a resumed
+    run). The Python handler is installed again (main thread only: elsewhere it cannot
+    be, and whoever installs one must start gmsh first, e.g. with ``gmsh_session()``)."""
+    handler = signal.getsignal(signal.SIGTERM)
+    gmsh.initialize(interruptible=False)
+    if handler is not None and threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, handler)
+
+
 @contextmanager
 def gmsh_session(model_name: str = "lagice"):
     """Initialise gmsh once per process, clear the model, serialise access."""
@@ -27,7 +42,7 @@ def gmsh_session(model_name: str = "lagice"):
 
     with _GMSH_LOCK:
         if not gmsh.isInitialized():
-            gmsh.initialize(interruptible=False)
+            _initialize(gmsh)
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.Verbosity", 1)
         gmsh.option.setNumber("General.NumThreads", 1)

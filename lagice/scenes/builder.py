@@ -588,20 +588,18 @@ def resume_simulation(checkpoint, overrides=None, progress: bool | None = None, 
     return sim
 
 
-def branch_simulation(checkpoint, out_dir=None, overrides=None, progress: bool | None = None,
-                      overwrite: bool = False) -> Simulation:
-    """A new run in ``out_dir`` (a new folder by default) that starts from the state of
-    ``checkpoint`` with ``overrides`` (forcing, rheology, remeshing... may change; the
-    fingerprint then differs: branching is explicit). Keys of :data:`BRANCH_FIXED` cannot
-    change. Its outputs record the parent checkpoint (path and SHA-256: global
-    attributes ``lagice_parent_checkpoint*``, ``lagice_run.json``, checkpoints)."""
-    from .. import rundir
+def branch_config(checkpoint, meta: dict, overrides=None, sha256: str | None = None) -> dict:
+    """The validated configuration of a branch from ``checkpoint`` (whose metadata is
+    ``meta``) with ``overrides``: every check of :func:`branch_simulation` that needs
+    no mesh (keys of :data:`BRANCH_FIXED` unchanged, a run end after the checkpoint
+    time, :func:`validate_config`), and ``_parent`` = the checkpoint's path, SHA-256
+    (``sha256`` when already known), step, time, scene and fingerprint. Raises
+    :class:`~lagice.errors.RestartError` or :class:`~lagice.errors.ConfigError`.
+    Used to check every member of an ensemble before any starts."""
     from ..errors import RestartError
     from ..io.checkpoint import file_sha256
-    from ..simulation import load_checkpoint
     from .config import changed_keys, override_config
 
-    path, arrays, meta = load_checkpoint(checkpoint)
     old = meta["config"]
     cfg = override_config(old, overrides)
     for key in changed_keys({k: v for k, v in old.items() if not k.startswith("_")},
@@ -612,11 +610,38 @@ def branch_simulation(checkpoint, out_dir=None, overrides=None, progress: bool |
     if meta["clock"]["time_s"] >= parse_duration(cfg["run"]["duration"], "run.duration") * (1 - 1e-12):
         raise RestartError(f"the checkpoint is at t = {meta['clock']['time_s']:g} s; the branch's run.duration "
                            f"= {cfg['run']['duration']!r} leaves nothing to run: set a longer run.duration")
-    path = path.resolve()
-    cfg["_parent"] = {"checkpoint": str(path), "sha256": file_sha256(path), "step": int(meta["step"]),
+    path = Path(checkpoint).resolve()
+    cfg["_parent"] = {"checkpoint": str(path), "sha256": sha256 or file_sha256(path), "step": int(meta["step"]),
                       "time_s": float(meta["clock"]["time_s"]), "scene": old["scene"]["name"],
                       "fingerprint": meta.get("scene_fingerprint")}
     validate_config(cfg)
+    return cfg
+
+
+def branch_simulation(checkpoint, out_dir=None, overrides=None, progress: bool | None = None,
+                      overwrite: bool = False, config: dict | None = None) -> Simulation:
+    """A new run in ``out_dir`` (a new folder by default) that starts from the state of
+    ``checkpoint`` with ``overrides`` (forcing, rheology, remeshing... may change; the
+    fingerprint then differs: branching is explicit). Keys of :data:`BRANCH_FIXED` cannot
+    change. Its outputs record the parent checkpoint (path and SHA-256: global
+    attributes ``lagice_parent_checkpoint*``, ``lagice_run.json``, checkpoints).
+    ``config``: the branch's configuration made earlier by :func:`branch_config` (instead
+    of ``overrides``); the checkpoint file must still have the SHA-256 recorded in it."""
+    from .. import rundir
+    from ..errors import RestartError
+    from ..io.checkpoint import file_sha256
+    from ..simulation import load_checkpoint
+
+    path, arrays, meta = load_checkpoint(checkpoint)
+    path = path.resolve()
+    if config is None:
+        cfg = branch_config(path, meta, overrides)
+    else:
+        cfg = config
+        parent = cfg.get("_parent") or {}
+        if parent.get("checkpoint") != str(path) or parent.get("sha256") != file_sha256(path):
+            raise RestartError(f"checkpoint {path} is not the parent this branch configuration was made for "
+                               f"({parent.get('checkpoint')}, sha256 {parent.get('sha256')}): the file changed?")
     if out_dir is not None:
         rundir.claim(out_dir, overwrite)
     sim = build_simulation(cfg, out_dir, progress)
