@@ -196,3 +196,18 @@ def test_every_bundled_scene_runs_checkpoints_and_resumes_bit_identically(name, 
     assert fa.keys() == fb.keys()
     for k in fa:
         assert np.array_equal(fa[k], fb[k]), f"{name}: checkpoint array {k} differs after resume"
+
+
+def test_damage_time_step_reaches_the_healing_component(tmp_path):
+    """solver.dt = "td" (Δt = Δx/cs) is one outer step for every component: the
+    thermodynamic healing law gets the same Δt as the simulation (it used to read
+    solver.dt as a duration and fail on "td")."""
+    from lagice.scenes.builder import build_simulation
+    from lagice.scenes.config import load_scene
+
+    cfg = load_scene("winter_basin", {"domain.resolution_m": 60e3, "solver.dt": "td", "run.duration": "1h",
+                                      "healing.law": "thermodynamic", "output.plot": False})
+    sim = build_simulation(cfg, tmp_path / "run")
+    expected = 60e3 / cfg["rheology"]["shear_wave_speed"]
+    assert sim.dt == pytest.approx(expected, rel=1e-12)
+    assert sim.model.healing.dt_s == pytest.approx(expected, rel=1e-12)

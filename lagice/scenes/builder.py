@@ -25,6 +25,7 @@ from ..simulation import Simulation
 from ..solvers import SOLVER_RHEOLOGY, SOLVERS, VelocityBC
 from ..state import IceState
 from . import components
+from .components import time_step_s  # noqa: F401 - part of the builder API
 from .config import (
     RHEOLOGY_KEYS,
     ROOT,
@@ -212,21 +213,6 @@ def build_mesh(cfg: dict):
 
 
 # -- checks before any mesh work ---------------------------------------------------
-def time_step_s(cfg: dict) -> float:
-    """The outer step [s]: ``solver.dt`` as a duration, or ``"td"`` for the damage time
-    scale of the nominal element size, Δt = Δx/cs (Dansereau et al. 2016)."""
-    dt = cfg["solver"]["dt"]
-    if dt is None:
-        raise ConfigError("solver.dt is required (e.g. '10min', seconds, or 'td' for Δx/cs)")
-    if dt == "td":
-        res = cfg["domain"]["resolution_m"]
-        if not isinstance(res, (int, float)):
-            raise ConfigError("solver.dt = 'td' needs a numeric domain.resolution_m (Δt = Δx/cs)")
-        check_range("domain.resolution_m", res, 0.0, None, low_open=True, unit="m")
-        check_range("rheology.shear_wave_speed", cfg["rheology"]["shear_wave_speed"], 0.0, None, low_open=True,
-                    unit="m s-1")
-        return float(res) / float(cfg["rheology"]["shear_wave_speed"])
-    return parse_duration(dt, "solver.dt")
 
 
 def build_rheology(cfg: dict):

@@ -47,7 +47,8 @@ import inspect
 
 import numpy as np
 
-from ..errors import ConfigError, ForcingError
+from ..errors import ConfigError, ForcingError, check_range
+from ..schedule import parse_duration
 from . import checks
 from .config import resolve_hook, time_space_callable
 
@@ -55,6 +56,23 @@ WIND_KINDS = ("uniform", "random", "cyclones", "file", "expression", "function")
 OCEAN_KINDS = ("rest", "uniform", "gyre", "file", "expression", "function")
 AIR_KINDS = ("synthetic", "constant", "file", "expression")
 HEAL_LAWS = ("none", "constant", "thermodynamic", "fdd")
+
+
+def time_step_s(cfg: dict) -> float:
+    """The outer step [s]: ``solver.dt`` as a duration, or ``"td"`` for the damage time
+    scale of the nominal element size, Δt = Δx/cs (Dansereau et al. 2016)."""
+    dt = cfg["solver"]["dt"]
+    if dt is None:
+        raise ConfigError("solver.dt is required (e.g. '10min', seconds, or 'td' for Δx/cs)")
+    if dt == "td":
+        res = cfg["domain"]["resolution_m"]
+        if not isinstance(res, (int, float)):
+            raise ConfigError("solver.dt = 'td' needs a numeric domain.resolution_m (Δt = Δx/cs)")
+        check_range("domain.resolution_m", res, 0.0, None, low_open=True, unit="m")
+        check_range("rheology.shear_wave_speed", cfg["rheology"]["shear_wave_speed"], 0.0, None, low_open=True,
+                    unit="m s-1")
+        return float(res) / float(cfg["rheology"]["shear_wave_speed"])
+    return parse_duration(dt, "solver.dt")
 
 
 def _kind(table: dict, key: str, kinds) -> str:
@@ -122,8 +140,6 @@ _LENGTH_KINDS = (("wind", "random"), ("wind", "cyclones"), ("air_temperature", "
 
 def draw_span_s(t: dict, key: str, duration_s: float) -> float:
     """The span [s] random forcing is drawn over: ``horizon`` if set, else the run."""
-    from ..schedule import parse_duration
-
     if t.get("horizon") is None:
         return duration_s
     h = parse_duration(t["horizon"], f"forcing.{key}.horizon")
@@ -512,9 +528,7 @@ def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
             h = cls(**cfg["healing"]["params"])
         except TypeError as exc:
             raise ConfigError(f"[healing.params] for law {law!r}: {exc}") from None
-        from ..schedule import parse_duration
-
-        parts["healing"] = HealingComponent(h, air, dt_s=parse_duration(cfg["solver"]["dt"], "solver.dt"))
+        parts["healing"] = HealingComponent(h, air, dt_s=time_step_s(cfg))
     if cfg["lagrangian"]["enabled"]:
         from ..lagrangian import MeshMotion
 
