@@ -1,4 +1,4 @@
-"""External forcing for lagice: wind, ocean current, air temperature (DESIGN.md §6).
+"""External forcing for lagice: wind, ocean current, air temperature (docs/design.md §6).
 
 See ``docs/forcing_thermo.md`` for the expected use.
 """

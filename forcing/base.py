@@ -1,4 +1,4 @@
-"""The field interface shared by every external forcing (DESIGN.md §6).
+"""The field interface shared by every external forcing (docs/design.md §6).
 
 A *field* is something that can be evaluated at a model time ``t`` (seconds
 since the run's reference time) and at the **current** positions ``x, y`` of

@@ -1,4 +1,4 @@
-"""Gridded forcing files: netCDF with a CF time axis (DESIGN.md §6).
+"""Gridded forcing files: netCDF with a CF time axis (docs/design.md §6).
 
 A file holds records on either
 

@@ -1,4 +1,4 @@
-"""Record-based forcing: time and space interpolation (DESIGN.md §6).
+"""Record-based forcing: time and space interpolation (docs/design.md §6).
 
 Forcing data come as *records*: complete 2-D fields on a fixed grid, one per
 record time (every 6 h by default, any strictly increasing times allowed).

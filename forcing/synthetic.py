@@ -1,4 +1,4 @@
-"""Synthetic forcing generators (DESIGN.md §6).
+"""Synthetic forcing generators (docs/design.md §6).
 
 Every generator returns a :class:`forcing.records.RecordField` whose records
 sit on a :class:`forcing.records.RegularGrid` (build one covering the domain's

@@ -1,9 +1,9 @@
-"""External forces on the ice per unit area (DESIGN.md §3): wind stress, ocean
+"""External forces on the ice per unit area (docs/design.md §3): wind stress, ocean
 drag and Coriolis, usable by both time steppers.
 
 Momentum per unit area:  ρi h du/dt = ∇·(hσ) + τa + τw − ρi h f k×u
 
-* wind stress     τa = ρa Ca |Ua| Ua                          (seed 000; DESIGN §3)
+* wind stress     τa = ρa Ca |Ua| Ua                          (Girard et al. 2011; docs/design.md §3)
 * ocean drag      τw = ρw Cw |Uw − u| Rθ (Uw − u)             (Rθ: rotation by the
   turning angle θ, counter-clockwise positive)
 * Coriolis        −ρi h f k×u,  k×u = (−v, u)
@@ -107,7 +107,7 @@ class ExplicitTerms:
 
 
 class WindStress:
-    """Air drag τa = ρa Ca |Ua| Ua [N m-2] (seed 000; DESIGN §3).
+    """Air drag τa = ρa Ca |Ua| Ua [N m-2] (Girard et al. 2011; docs/design.md §3).
 
     Args:
         wind: 10 m wind [m s-1], callable ``f(t, x, y)`` or constant ``(u, v)``.
@@ -269,7 +269,7 @@ def explicit_terms(forces, t: float, nodes: np.ndarray) -> ExplicitTerms:
 def free_drift_velocity(wind_stress, f: float, mass_per_area: float, rho_water: float = RHO_WATER,
                         drag: float = 5.5e-3, turning_angle_deg: float = 0.0) -> complex:
     """Steady free-drift velocity u + iv [m s-1] with the ocean at rest:
-    τa − ρw Cw |u| e^{iθ} u − i ρi h f u = 0 (complex form of DESIGN §3).
+    τa − ρw Cw |u| e^{iθ} u − i ρi h f u = 0 (complex form of docs/design.md §3).
 
     Solved for the speed s = |u| from s |ρw Cw s e^{iθ} + i ρi h f| = |τa|
     (monotone in s), then u = τa / (ρw Cw s e^{iθ} + i ρi h f).

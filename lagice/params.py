@@ -1,6 +1,6 @@
 """Physical parameters: one table with defaults, units and sources.
 
-Values and sources follow ``DESIGN.md`` §9 and seed 004 Table 1.
+Values and sources follow ``docs/design.md`` §9 and Dansereau et al. 2016 Table 1.
 """
 from __future__ import annotations
 
@@ -10,15 +10,15 @@ from dataclasses import dataclass, fields, replace
 from .errors import ConfigError, check_range
 
 #: Gravity-free physical constants shared by the forcing/thermo packages.
-RHO_ICE = 900.0  # kg m-3, seed 004 Table 1
-RHO_AIR = 1.3  # kg m-3, seed 000
-RHO_WATER = 1025.0  # kg m-3, seed 000
+RHO_ICE = 900.0  # kg m-3, Dansereau et al. 2016 Table 1
+RHO_AIR = 1.3  # kg m-3, Girard et al. 2011
+RHO_WATER = 1025.0  # kg m-3, Girard et al. 2011
 OMEGA_EARTH = 7.2921e-5  # rad s-1
 
 
 @dataclass(frozen=True)
 class MaxwellEBParams:
-    """Maxwell-Elasto-Brittle rheology parameters (seed 004 Table 1).
+    """Maxwell-Elasto-Brittle rheology parameters (Dansereau et al. 2016 Table 1).
 
     Attributes (units in brackets):
         poisson: ν [-], 0 <= ν < 0.5
@@ -65,14 +65,14 @@ class MaxwellEBParams:
 
     @property
     def E0(self) -> float:
-        """Undamaged Young modulus [Pa]: E0 = 2 cs² (1+ν) ρ (seed 004 Table 1)."""
+        """Undamaged Young modulus [Pa]: E0 = 2 cs² (1+ν) ρ (Dansereau et al. 2016 Table 1)."""
         if self.young_modulus_pa is not None:
             return float(self.young_modulus_pa)
         return 2.0 * self.shear_wave_speed**2 * (1.0 + self.poisson) * self.rho_ice
 
     @property
     def q(self) -> float:
-        """Slope of the Mohr-Coulomb envelope, seed 004 eq. 3."""
+        """Slope of the Mohr-Coulomb envelope, Dansereau et al. 2016 eq. 3."""
         return (math.sqrt(self.friction**2 + 1.0) + self.friction) ** 2
 
     def replace(self, **changes) -> MaxwellEBParams:
@@ -85,7 +85,7 @@ class MaxwellEBParams:
 
 @dataclass(frozen=True)
 class DragParams:
-    """Air/ocean drag and Coriolis parameters (seed 000; DESIGN.md §9)."""
+    """Air/ocean drag and Coriolis parameters (Girard et al. 2011; docs/design.md §9)."""
 
     rho_air: float = RHO_AIR
     air_drag: float = 1.2e-3

@@ -1,4 +1,4 @@
-"""Spatial coarse-graining and temporal scaling on fields with analytic answers (seed 001 §3.5).
+"""Spatial coarse-graining and temporal scaling on fields with analytic answers (Girard 2010 §3.5).
 
 Slip-line fields. The x-velocity jumps by Δu across horizontal lines
 y = (k + 1/2) s (k = 0..8) in an 81 km × 81 km domain (s = 9 km); on the mesh

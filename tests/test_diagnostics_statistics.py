@@ -1,4 +1,4 @@
-"""PDF tails, localisation and shear–divergence correlation on cases with known answers (seed 000)."""
+"""PDF tails, localisation and shear–divergence correlation on cases with known answers (Girard et al. 2011)."""
 
 import numpy as np
 import pytest

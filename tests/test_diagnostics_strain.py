@@ -1,4 +1,5 @@
-"""Strain-rate invariants on irregular triangular meshes (issue 7, seed 000 eq. 10, seed 001 eq. 2.1-2.2)."""
+"""Strain-rate invariants on irregular triangular meshes (issue 7; Girard et al. 2011 eq. 10,
+Girard 2010 eq. 2.1-2.2)."""
 
 import numpy as np
 import pytest

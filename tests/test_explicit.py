@@ -1,6 +1,6 @@
 """Explicit solver (issue 3): kernels against the rheology, patch test, Maxwell
 relaxation, boundary conditions, agreement with the implicit solver on the
-seed 004 compression test, stability refusal/warning."""
+Dansereau et al. 2016 compression test, stability refusal/warning."""
 import warnings
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""How much a remesh blurs a one-element-wide damage band (DESIGN.md §5, seed 003 eqs. 1-3).
+"""How much a remesh blurs a one-element-wide damage band (docs/design.md §5, Åström & Benn 2019 eqs. 1-3).
 
 A straight band of damage d_b (one element wide, along y) in undamaged ice
 is sheared parallel to itself (u = 0, v = v(x, y)), so in the Lagrangian
@@ -8,7 +8,7 @@ on lines across the band (x direction):
 
 * width: the square root of the second moment of d across the band;
 * effective stiffness E/E0 of a box around the band: series (harmonic)
-  average of (1 − d) along each line (seed 003 eq. 1), averaged over lines.
+  average of (1 − d) along each line (Åström & Benn 2019 eq. 1), averaged over lines.
 
 The numbers are reported in docs/remeshing.md; the bounds below are what a
 first-order conservative (P0) remap gives (one event: the band widens to at

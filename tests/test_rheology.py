@@ -26,7 +26,7 @@ def rotate(s1, s2, theta):
     return np.stack([sxx, syy, sxy], axis=-1)
 
 
-def test_seed004_q_and_strength_ratio():
+def test_dansereau2016_q_and_strength_ratio():
     q, sc, st = envelope(37.5e3, 0.7)
     assert q == pytest.approx(3.69, abs=0.005)
     assert st / sc == pytest.approx(0.27, abs=0.005)
@@ -65,7 +65,7 @@ def test_uniaxial_strengths():
     assert dcrit(np.array([[-1e9, -1e9, 0.0]]), C, 0.7)[0] == 1.0
 
 
-def test_damage_update_with_dt_equal_td_is_seed004_recursion(rng):
+def test_damage_update_with_dt_equal_td_is_dansereau2016_recursion(rng):
     rheo = MaxwellEB(healing_time_s=None)
     m = 500
     C = rng.uniform(25e3, 50e3, m)
@@ -77,7 +77,7 @@ def test_damage_update_with_dt_equal_td_is_seed004_recursion(rng):
     s = sig.copy()
     td = np.full(m, 20.0)
     rheo.damage_update(s, d, C, 20.0, td, np.zeros(m))
-    # seed 004: d_seed^{n+1} = dcrit d_seed^n with d_seed = 1 - d
+    # Dansereau et al. 2016: d_seed^{n+1} = dcrit d_seed^n with d_seed = 1 - d
     assert np.allclose(1 - d, dc * (1 - d0), rtol=1e-14)
     assert np.allclose(s, sig * dc[:, None], rtol=1e-14)
     # after the update, every stress is inside or on the envelope

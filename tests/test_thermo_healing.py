@@ -42,7 +42,7 @@ def test_apply_floors_at_zero_and_returns_decrease():
 
 
 def test_fdd_healing_follows_sqrt_of_freezing_degree_days():
-    """Seed 001 eq. 5.8: d_seed = 1 − d grows like √(t (Tf − Ta)); eq. 5.11 is its Euler step."""
+    """Girard 2010 eq. 5.8: d_seed = 1 − d grows like √(t (Tf − Ta)); eq. 5.11 is its Euler step."""
     beta = 1e3 * DAY
     f = FreezingDegreeDayHealing(beta_s_k=beta)
     ta = -21.8

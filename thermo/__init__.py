@@ -1,4 +1,4 @@
-"""Thermodynamics and healing for lagice (DESIGN.md §3).
+"""Thermodynamics and healing for lagice (docs/design.md §3).
 
 A scene that does not need them builds none: :func:`build` returns ``None``
 for a component that is switched off, and the model skips it (no work).

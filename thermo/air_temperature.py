@@ -1,4 +1,4 @@
-"""Synthetic 2 m air temperature (DESIGN.md §3 and §6).
+"""Synthetic 2 m air temperature (docs/design.md §3 and §6).
 
 Seasonal cycle plus synoptic variability, deterministic from a seed, as
 records every 6 h through the forcing machinery

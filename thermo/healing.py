@@ -1,20 +1,20 @@
-"""Healing of damage (DESIGN.md §3; seed 001 §5.2.3; seed 004).
+"""Healing of damage (docs/design.md §3; Girard 2010 §5.2.3; Dansereau et al. 2016).
 
 Damage convention of lagice: ``d = 0`` undamaged, ``d = 1`` fully damaged
-(seed 001 and seed 004 use ``d_seed = 1 − d``).  The damage update calls
+(Girard 2010 and Dansereau et al. 2016 use ``d_seed = 1 − d``).  The damage update calls
 
     rate = healing.rate(air_temperature_c, damage)      # [s-1], >= 0
     healing.apply(damage, air_temperature_c, dt_s)      # d ← max(0, d − rate·dt)
 
 Three laws:
 
-* :class:`ConstantHealing` — ``H = 1/th`` (seed 004, th = 1e5 s); independent
+* :class:`ConstantHealing` — ``H = 1/th`` (Dansereau et al. 2016, th = 1e5 s); independent
   of temperature.
 * :class:`ThermodynamicHealing` — neXtSIM form
   ``H = max(0, Tf − Ta) / (ΔT0 · th0)`` (th = th0·ΔT0/ΔT; th0 = 20 days,
   ΔT0 = 20 K): no healing at or above freezing, proportionally faster when
   colder.
-* :class:`FreezingDegreeDayHealing` — seed 001 eqs. 5.8–5.11: healing of
+* :class:`FreezingDegreeDayHealing` — Girard 2010 eqs. 5.8–5.11: healing of
   ``d_seed = 1 − d`` like ice growth, ``d_seed = k √(t (Tf − Ta))``, i.e.
   ``∂d_seed/∂t = 1/(th d_seed)`` with ``th = β/(Tf − Ta)``.  In lagice's
   convention ``rate = (Tf − Ta) / (β (1 − d))``.  :meth:`apply` integrates it
@@ -61,7 +61,7 @@ class Healing:
 
 
 class ConstantHealing(Healing):
-    """Constant-rate healing ``H = 1/th`` [s-1] (seed 004; th = 1e5 s).
+    """Constant-rate healing ``H = 1/th`` [s-1] (Dansereau et al. 2016; th = 1e5 s).
 
     Temperature is ignored (accepted for a uniform interface).
     """
@@ -84,7 +84,7 @@ class ThermodynamicHealing(Healing):
 
     Parameters
     ----------
-    th0_s : reference healing time at ΔT = ΔT0 [s] (20 days; DESIGN.md §3: 15–25 days)
+    th0_s : reference healing time at ΔT = ΔT0 [s] (20 days; docs/design.md §3: 15–25 days)
     delta_t0_k : reference temperature difference ΔT0 [K] (20)
     freezing_point_c : Tf [°C] (−1.8)
     """
@@ -101,11 +101,11 @@ class ThermodynamicHealing(Healing):
 
 
 class FreezingDegreeDayHealing(Healing):
-    """Seed 001 √(freezing-degree-days) healing (eqs. 5.8–5.11), lagice convention.
+    """Girard 2010 √(freezing-degree-days) healing (eqs. 5.8–5.11), lagice convention.
 
     Parameters
     ----------
-    beta_s_k : β, healing parameter [s K] (th = β/(Tf − Ta)); seed 001
+    beta_s_k : β, healing parameter [s K] (th = β/(Tf − Ta)); Girard 2010
         Fig. 5.4 uses β = 1e3 day K
     freezing_point_c : Tf [°C] (−1.8)
     """
@@ -116,7 +116,7 @@ class FreezingDegreeDayHealing(Healing):
                                             unit="degC")
 
     def rate(self, air_temperature_c, damage=None):
-        """``(Tf − Ta)⁺ / (β (1 − d))`` [s-1] (seed 001 eq. 5.10); needs ``damage``
+        """``(Tf − Ta)⁺ / (β (1 − d))`` [s-1] (Girard 2010 eq. 5.10); needs ``damage``
         (infinite where d = 1 and it is freezing: use :meth:`apply`)."""
         if damage is None:
             raise ConfigError("FreezingDegreeDayHealing.rate needs the damage (rate ∝ 1/(1 − d))")

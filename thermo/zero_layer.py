@@ -1,6 +1,6 @@
-"""Zero-layer (Semtner 1976) thermodynamics on element arrays (DESIGN.md §3).
+"""Zero-layer (Semtner 1976) thermodynamics on element arrays (docs/design.md §3).
 
-Simple on purpose (seed 001 §5.2.3 asks only for something growth-like):
+Simple on purpose (Girard 2010 §5.2.3 asks only for something growth-like):
 the ice has no heat capacity, its surface is at the air temperature ``Ta``
 and its base at the freezing point ``Tf``, so the conductive flux through
 ice of thickness ``hi = h/A`` and snow ``hsi = hs/A`` in series is
@@ -55,7 +55,7 @@ class ThermoParams:
     ----------
     conductivity_ice_w_m_k : ki, ice thermal conductivity [W m-1 K-1] (2.0, Semtner 1976)
     conductivity_snow_w_m_k : ks, snow thermal conductivity [W m-1 K-1] (0.31, Maykut & Untersteiner 1971)
-    rho_ice_kg_m3 : ρi, ice density [kg m-3] (900, seed 004 Table 1)
+    rho_ice_kg_m3 : ρi, ice density [kg m-3] (900, Dansereau et al. 2016 Table 1)
     latent_heat_j_kg : Lf, latent heat of fusion [J kg-1] (3.34e5)
     freezing_point_c : Tf, sea-water freezing point [°C] (−1.8)
     open_water_heat_transfer_w_m2_k : kow, linearised open-water heat loss
@@ -254,7 +254,7 @@ class ZeroLayerThermo:
 
 
 class VolumeBudget:
-    """Global ice-volume budget [m³] (DESIGN.md §3, Lagrangian mass update).
+    """Global ice-volume budget [m³] (docs/design.md §3, Lagrangian mass update).
 
     ``V(t) − V(0) = Σ thermodynamic change − Σ outflow`` where the
     thermodynamic change is booked by :meth:`ZeroLayerThermo.step` and the

@@ -1,11 +1,11 @@
-"""Deformation diagnostics that tell physics from noise (DESIGN §8, GitHub issue 7).
+"""Deformation diagnostics that tell physics from noise (docs/design.md §8, GitHub issue 7).
 
 Works on plain arrays (node positions in m, CCW triangles, window in s) so it
 applies equally to model output and to RGPS-like Lagrangian data:
 
 - :func:`velocity_gradients`, :func:`lagrangian_velocity_gradients`:
   per-triangle gradients and invariants (divergence, shear, total; s-1);
-- :func:`coarse_grain`, :func:`spatial_scaling`: ⟨ε̇tot⟩(L) ∝ L^−β (seed 001 §3.5);
+- :func:`coarse_grain`, :func:`spatial_scaling`: ⟨ε̇tot⟩(L) ∝ L^−β (Girard 2010 §3.5);
 - :func:`temporal_scaling`: ⟨ε̇tot⟩(T) ∝ T^−α;
 - :func:`log_binned_pdf`, :func:`fit_power_law_tail`: PDFs and ML tail exponents;
 - :func:`localisation_area_fraction`, :func:`shear_divergence_r2`;

@@ -16,12 +16,12 @@ the strip still fits in it.
 
 :func:`mohr_coulomb_fault_angle_deg` gives the Coulomb prediction for the angle
 between a shear fault and the most compressive principal stress,
-``θ = 45° − φ/2`` with ``φ = atan μ`` (seed 001 §1.3: μ internal friction
-coefficient; seed 004 uses μ = 0.7, hence θ = 27.5° and conjugate faults
-55° apart; observed conjugate leads intersect at 20–50°, seed 001 ch. 1).
+``θ = 45° − φ/2`` with ``φ = atan μ`` (Girard 2010 §1.3: μ internal friction
+coefficient; Dansereau et al. 2016 uses μ = 0.7, hence θ = 27.5° and conjugate faults
+55° apart; observed conjugate leads intersect at 20–50°, Girard 2010 ch. 1).
 
 :func:`distance_to_boundary` and :func:`interior_triangles` build the
-"away from the coast" masks of seed 000 (statistics from elements more than
+"away from the coast" masks of Girard et al. 2011 (statistics from elements more than
 150 km from coasts).
 """
 from dataclasses import dataclass
@@ -199,7 +199,7 @@ def distance_to_boundary(nodes_xy_m, triangles, points_xy_m):
 
 def interior_triangles(nodes_xy_m, triangles, buffer_m):
     """Boolean mask of triangles whose centroid lies at least ``buffer_m`` (m)
-    from the mesh boundary (seed 000: 150 km from coastlines and straits)."""
+    from the mesh boundary (Girard et al. 2011: 150 km from coastlines and straits)."""
     nodes = as_points("nodes_xy_m", nodes_xy_m)
     tri = as_triangles(triangles, nodes.shape[0])
     b = float(buffer_m)

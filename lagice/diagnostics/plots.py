@@ -1,6 +1,6 @@
 """PNG figures of the diagnostics (matplotlib, Agg canvas; no global backend change).
 
-Figures follow seed 000: scaling (Fig. 5), PDFs with tail fits (Fig. 4), and
+Figures follow Girard et al. 2011: scaling (Fig. 5), PDFs with tail fits (Fig. 4), and
 maps of the deformation rate on the triangles (Fig. 3).
 """
 
@@ -83,7 +83,7 @@ def plot_pdfs(pdfs, tails, path):
 
 
 def plot_map(nodes_xy, triangles, values_s, path, title="log10 total deformation rate (s-1)", decades=4.0):
-    """Map of log10 of an element field (s-1) on the triangles (seed 000 Fig. 3).
+    """Map of log10 of an element field (s-1) on the triangles (Girard et al. 2011 Fig. 3).
 
     The colour range spans ``decades`` decades below the 99.5th percentile of
     the positive values; smaller values (zeros and round-off of Lagrangian

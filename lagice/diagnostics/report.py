@@ -72,8 +72,8 @@ def summarise(nodes_xy0, nodes_xy1, triangles, dt_s, *, geometry="mid", box_size
 
     Element-scale rates come from :func:`lagrangian_velocity_gradients`
     (velocity = displacement / dt_s, gradient on the ``geometry``). PDFs,
-    localisation and R² use the element-scale rates (seed 000 uses the 10 km
-    RGPS cell scale); β uses the coarse-graining of seed 001 §3.5; α needs a
+    localisation and R² use the element-scale rates (Girard et al. 2011 uses the 10 km
+    RGPS cell scale); β uses the coarse-graining of Girard 2010 §3.5; α needs a
     position time series.
 
     Parameters

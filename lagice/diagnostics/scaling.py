@@ -1,7 +1,7 @@
 """Spatial and temporal scaling of the mean total deformation rate.
 
-Spatial coarse-graining follows seed 001 §3.5 ("changement d'échelle", after
-Marsan et al. 2004, used for seed 000 Fig. 5):
+Spatial coarse-graining follows Girard 2010 §3.5 ("changement d'échelle", after
+Marsan et al. 2004, used for Girard et al. 2011 Fig. 5):
 
 1. element-scale velocity gradients G_e (s-1) and areas A_e (m²);
 2. for a box width W, cover the bounding box of the mesh with a regular grid
@@ -22,7 +22,7 @@ field whose gradients all have the same sign the mean over all boxes is
 conserved across scales (β = 0); β > 0 measures cancellation between
 deformation events of different sense/orientation at larger scales.
 
-Temporal scaling (seed 001 §2.2 eq. 2.5, ⟨ε̇⟩ ∝ T^−α): element rates over
+Temporal scaling (Girard 2010 §2.2 eq. 2.5, ⟨ε̇⟩ ∝ T^−α): element rates over
 windows of K steps of a position time series on fixed connectivity.
 """
 
@@ -116,7 +116,7 @@ def fit_power_law(x, y, fit_range=None):
 
 @dataclass(frozen=True)
 class CoarseGraining:
-    """Box-averaged deformation rates at several box widths (seed 001 §3.5).
+    """Box-averaged deformation rates at several box widths (Girard 2010 §3.5).
 
     Attributes
     ----------
@@ -154,7 +154,7 @@ def default_box_sizes(rates, factor=2.0, n_min_boxes=4):
     Starts at ``2 · sqrt(median element area)``, multiplies by ``factor``, and
     stops when fewer than ``n_min_boxes`` boxes would fit in the bounding box
     of the centroids (the largest widths are dominated by finite-size effects,
-    seed 000 §Scaling).
+    Girard et al. 2011 §Scaling).
     """
     h = np.sqrt(np.median(rates.area_m2))
     ext = np.ptp(rates.centroid_xy_m, axis=0)
@@ -256,7 +256,7 @@ class SpatialScaling:
 
 def spatial_scaling(rates, box_sizes_m=None, min_coverage=0.75, fit_range_m=None,
                     include_element_scale=True, origin_xy_m=None):
-    """⟨ε̇tot⟩(L) by coarse-graining and the exponent β of ⟨ε̇tot⟩ ∝ L^−β (seed 001 §3.5).
+    """⟨ε̇tot⟩(L) by coarse-graining and the exponent β of ⟨ε̇tot⟩ ∝ L^−β (Girard 2010 §3.5).
 
     Parameters
     ----------
@@ -268,7 +268,7 @@ def spatial_scaling(rates, box_sizes_m=None, min_coverage=0.75, fit_range_m=None
         Inclusive range of scales L (m) used in the fit; default all points.
     include_element_scale : bool
         Prepend the element scale (L = mean sqrt(A_e), ⟨ε̇tot⟩ = mean over
-        elements), "the smallest scale" of seed 001 §3.5.
+        elements), "the smallest scale" of Girard 2010 §3.5.
 
     Returns
     -------
@@ -303,7 +303,7 @@ class TemporalScaling:
 
 def temporal_scaling(nodes_xy_series, triangles, dt_s, window_steps=None, geometry="mid",
                      overlapping=False, fit_range_s=None):
-    """⟨ε̇tot⟩(T) ∝ T^−α from a time series of node positions (seed 001 eq. 2.5).
+    """⟨ε̇tot⟩(T) ∝ T^−α from a time series of node positions (Girard 2010 eq. 2.5).
 
     For each window of ``K`` steps (T = K·dt_s) the Lagrangian element rates
     are computed from the positions at the window ends (see

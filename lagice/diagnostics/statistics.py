@@ -1,7 +1,7 @@
 """One-point statistics of element strain rates: PDFs, tails, localisation, correlation.
 
-Seed 000 §"Damage localization" and §"Strain-rate distributions" (Figs. 3–4);
-seed 001 §2.5 (localisation: share of the area holding half of the shear,
+Girard et al. 2011 §"Damage localization" and §"Strain-rate distributions" (Figs. 3–4);
+Girard 2010 §2.5 (localisation: share of the area holding half of the shear,
 RGPS ≈ 6 % at 10 km; PDF tails p(ε̇) ∝ ε̇^−γ, RGPS γ ≈ 2.2 for shear and 2.5
 for |divergence| at 10 km / 3 days; shear–divergence R² = 0.83 for RGPS).
 """
@@ -40,7 +40,7 @@ class LogBinnedPdf:
 
 
 def log_binned_pdf(values, bins_per_decade=10, min_value=None, max_value=None):
-    """Log-binned PDF of the positive part of ``values`` (seed 000 Fig. 4).
+    """Log-binned PDF of the positive part of ``values`` (Girard et al. 2011 Fig. 4).
 
     Parameters
     ----------
@@ -190,7 +190,7 @@ def fit_power_law_tail(values, x_min=None, min_tail=50, max_candidates=200):
 
 
 def localisation_area_fraction(shear_s, area_m2, fraction_of_shear=0.5):
-    """Fraction of the area holding a given share of the total shear (seed 000, seed 001 §2.5).
+    """Fraction of the area holding a given share of the total shear (Girard et al. 2011, Girard 2010 §2.5).
 
     Elements are sorted by shear rate (descending); the shear "amount"
     ``ε̇II · A`` is accumulated, and the returned value is the area fraction at
@@ -238,10 +238,10 @@ def localisation_area_fraction(shear_s, area_m2, fraction_of_shear=0.5):
 
 
 def shear_divergence_r2(shear_s, divergence_s, weights=None):
-    """R² between |divergence| and shear per element (seed 000: RGPS 0.83, EB 0.77, VP 0.58).
+    """R² between |divergence| and shear per element (Girard et al. 2011: RGPS 0.83, EB 0.77, VP 0.58).
 
     Squared Pearson correlation coefficient between ε̇II and |ε̇I| (absolute
-    value: opening and closing both accompany slip on rough faults, seed 000),
+    value: opening and closing both accompany slip on rough faults, Girard et al. 2011),
     equal to the R² of the least-squares line |ε̇I| = a ε̇II + b.
 
     Parameters

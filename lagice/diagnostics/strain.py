@@ -1,6 +1,6 @@
 """Per-triangle velocity gradients and strain-rate invariants.
 
-Conventions (seed 000 eqs. 10 and 15; seed 001 eqs. 2.1–2.3 and 3.15–3.16):
+Conventions (Girard et al. 2011 eqs. 10 and 15; Girard 2010 eqs. 2.1–2.3 and 3.15–3.16):
 
     ε̇xx = ∂u/∂x,   ε̇yy = ∂v/∂y,   ε̇xy = (∂u/∂y + ∂v/∂x) / 2
     divergence   ε̇I   = ε̇xx + ε̇yy                                   (s-1)
@@ -14,7 +14,7 @@ Conventions (seed 000 eqs. 10 and 15; seed 001 eqs. 2.1–2.3 and 3.15–3.16):
 
 On a P1 triangle the velocity is linear, so its gradient is constant and equals
 the line integral ``(1/A) ∮ u n ds`` around the triangle used for RGPS cells
-(seed 001 §2.2). Gradients are therefore exact (to round-off) for any affine
+(Girard 2010 §2.2). Gradients are therefore exact (to round-off) for any affine
 velocity field on any mesh.
 
 Lagrangian (RGPS-like) rates use node displacements over a window Δt:
@@ -82,7 +82,7 @@ class ElementStrainRates:
 def divergence_rate(gradient_s):
     """Divergence ε̇I = ∂u/∂x + ∂v/∂y (s-1) of gradients of shape (..., 2, 2).
 
-    Seed 000 eq. 10, seed 001 eq. 2.1.
+    Girard et al. 2011 eq. 10, Girard 2010 eq. 2.1.
     """
     g = np.asarray(gradient_s, dtype=np.float64)
     return g[..., 0, 0] + g[..., 1, 1]
@@ -91,15 +91,15 @@ def divergence_rate(gradient_s):
 def shear_rate(gradient_s):
     """Maximum shear rate ε̇II (s-1) of gradients of shape (..., 2, 2).
 
-    ε̇II = sqrt((∂u/∂x − ∂v/∂y)² + (∂u/∂y + ∂v/∂x)²) (seed 001 eq. 2.2,
-    seed 000 eq. 10 with ε̇xy = (∂u/∂y + ∂v/∂x)/2).
+    ε̇II = sqrt((∂u/∂x − ∂v/∂y)² + (∂u/∂y + ∂v/∂x)²) (Girard 2010 eq. 2.2,
+    Girard et al. 2011 eq. 10 with ε̇xy = (∂u/∂y + ∂v/∂x)/2).
     """
     g = np.asarray(gradient_s, dtype=np.float64)
     return np.hypot(g[..., 0, 0] - g[..., 1, 1], g[..., 0, 1] + g[..., 1, 0])
 
 
 def total_deformation_rate(gradient_s):
-    """Total deformation rate ε̇tot = sqrt(ε̇I² + ε̇II²) (s-1) (seed 000 §RGPS)."""
+    """Total deformation rate ε̇tot = sqrt(ε̇I² + ε̇II²) (s-1) (Girard et al. 2011 §RGPS)."""
     return np.hypot(divergence_rate(gradient_s), shear_rate(gradient_s))
 
 
@@ -187,7 +187,7 @@ def lagrangian_velocity_gradients(nodes_xy0, nodes_xy1, triangles, dt_s, geometr
 
     The node velocity is ``(nodes_xy1 − nodes_xy0) / dt_s`` and its P1 gradient
     is evaluated on the triangle geometry at the window start, end or middle
-    (seed 001 §2.2 and §3.5: gradients of the displacement rate over an
+    (Girard 2010 §2.2 and §3.5: gradients of the displacement rate over an
     interval; see the module docstring for the accuracy of each choice).
 
     Parameters

@@ -1,4 +1,4 @@
-"""Local remeshing with gmsh (DESIGN.md §5).
+"""Local remeshing with gmsh (docs/design.md §5).
 
 A *patch* is a set of elements: the bad elements plus ``rings`` rings of
 neighbours (elements sharing a node), grown further where the patch would

@@ -1,4 +1,4 @@
-"""Conservative remapping of element fields over a supermesh (DESIGN.md §5).
+"""Conservative remapping of element fields over a supermesh (docs/design.md §5).
 
 Old and new triangles are intersected (candidate pairs from a numba
 uniform bucket grid, intersection areas from a numba Sutherland–Hodgman

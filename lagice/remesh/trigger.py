@@ -1,4 +1,4 @@
-"""Remesh trigger (DESIGN.md §5): which elements are too distorted.
+"""Remesh trigger (docs/design.md §5): which elements are too distorted.
 
 An element is *bad* when any of these holds:
 

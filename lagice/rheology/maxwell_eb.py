@@ -1,15 +1,15 @@
 """Maxwell-Elasto-Brittle rheology as functions of state (no mesh, no solver).
 
-Conventions (DESIGN.md §2-3): stress is tension positive, stored per element as
+Conventions (docs/design.md §2-3): stress is tension positive, stored per element as
 (σxx, σyy, σxy) [Pa]; damage d ∈ [0, 1), 0 undamaged, 1 fully damaged
-(seed 004 uses d_seed = 1 − d).
+(Dansereau et al. 2016 uses d_seed = 1 − d).
 
-* stiffness   E = E0 (1−d) exp(−c*(1−A))                 (seed 004 eqs. 12, 17)
-* relaxation  λ = λ0 [(1−d) exp(−c*(1−A))]^(α−1)         (seed 004 eq. 12)
-* constitutive law  dσ/dt + σ/λ = E K:ε̇                   (seed 004 eq. 1)
-* Mohr–Coulomb envelope with tensile cut-off, d_crit        (seed 004 eqs. 2-8)
+* stiffness   E = E0 (1−d) exp(−c*(1−A))                 (Dansereau et al. 2016 eqs. 12, 17)
+* relaxation  λ = λ0 [(1−d) exp(−c*(1−A))]^(α−1)         (Dansereau et al. 2016 eq. 12)
+* constitutive law  dσ/dt + σ/λ = E K:ε̇                   (Dansereau et al. 2016 eq. 1)
+* Mohr–Coulomb envelope with tensile cut-off, d_crit        (Dansereau et al. 2016 eqs. 2-8)
 * damage  dd/dt = (1−d_crit)(1−d)/td − H_heal, stress scaled onto the envelope
-                                                             (seed 004 eqs. 9-11)
+                                                             (Dansereau et al. 2016 eqs. 9-11)
 """
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ from ..params import MaxwellEBParams
 
 
 def plane_stress_matrix(poisson: float) -> np.ndarray:
-    """K of DESIGN.md §3 acting on (ε̇xx, ε̇yy, ε̇xy) (tensor shear component)."""
+    """K of docs/design.md §3 acting on (ε̇xx, ε̇yy, ε̇xy) (tensor shear component)."""
     nu = poisson
     return np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 1.0 - nu]]) / (1.0 - nu * nu)
 
@@ -40,7 +40,7 @@ def relaxation_time(lambda0, damage, concentration, c_star, alpha):
 
 
 def envelope(cohesion, friction):
-    """(q, σc, σT) of seed 004 eqs. 3, 4, 6: slope, uniaxial compressive strength
+    """(q, σc, σT) of Dansereau et al. 2016 eqs. 3, 4, 6: slope, uniaxial compressive strength
     [Pa] and tensile strength [Pa, positive]."""
     s = math.sqrt(friction * friction + 1.0)
     q = (s + friction) ** 2
@@ -57,7 +57,7 @@ def _principal(sxx, syy, sxy):
 
 @njit(cache=True, inline="always")
 def _dcrit(sxx, syy, sxy, cohesion, q, denom):
-    """d_crit of seed 004 eq. 8 in tension-positive form (DESIGN.md §3)."""
+    """d_crit of Dansereau et al. 2016 eq. 8 in tension-positive form (docs/design.md §3)."""
     s1, s2 = _principal(sxx, syy, sxy)
     sigma_c = 2.0 * cohesion / denom
     sigma_t = sigma_c / q
@@ -80,7 +80,7 @@ def principal_stresses(sigma: np.ndarray):
 
 def dcrit(sigma: np.ndarray, cohesion, friction: float) -> np.ndarray:
     """d_crit ∈ (0, 1] for (m, 3) stresses: 1 inside the envelope, the factor that
-    scales σ back onto it outside (seed 004 eq. 8)."""
+    scales σ back onto it outside (Dansereau et al. 2016 eq. 8)."""
     sigma = np.atleast_2d(np.asarray(sigma, dtype=np.float64))
     C = np.broadcast_to(np.asarray(cohesion, np.float64), (len(sigma),))
     out = np.empty(len(sigma))
@@ -97,7 +97,7 @@ def _dcrit_kernel(sigma, cohesion, q, denom, out):
 
 @njit(cache=True, inline="always")
 def damage_step(d, dc, dt, td, heal_rate, max_damage):
-    """One element's damage update (seed 004 eqs. 9-11), shared by the kernels.
+    """One element's damage update (Dansereau et al. 2016 eqs. 9-11), shared by the kernels.
 
     Returns ``(d_new, f, capped)``: r = min(1, dt/td)(1 − dc), 1 − d ← (1 − d)(1 − r)
     where dc < 1; the stress factor f = 1 − r (1 without a damage event); then
@@ -121,11 +121,11 @@ def damage_step(d, dc, dt, td, heal_rate, max_damage):
 @njit(cache=True, parallel=True)
 def damage_update_kernel(sigma, damage, cohesion, dt, td, heal_rate, q, denom, max_damage,
                          dcrit_out):
-    """Explicit damage update with stress correction, in place (seed 004 eqs. 9-11).
+    """Explicit damage update with stress correction, in place (Dansereau et al. 2016 eqs. 9-11).
 
     Per element: r = min(1, dt/td_e)(1 − d_crit);  1 − d ← (1 − d)(1 − r);
     σ ← σ (1 − r);  then healing d ← d − dt·H_e, floored at 0 (a fully healed
-    element). With dt = td this is seed 004's d_{n+1} = d_crit d_n. Damage is
+    element). With dt = td this is Dansereau et al. (2016)'s d_{n+1} = d_crit d_n. Damage is
     capped at ``max_damage`` (< 1, keeps E > 0); the number of capped elements
     is returned so the caller can report it.
 
@@ -150,7 +150,7 @@ DAMAGE_UPDATE = (serial_copy(damage_update_kernel), damage_update_kernel)
 
 def draw_cohesion(n_elements: int, params: MaxwellEBParams, rng: np.random.Generator) -> np.ndarray:
     """Cohesion C [Pa] per element, uniform in [C_min, C_max] from a seeded generator
-    (quenched disorder, seed 004 §2.2)."""
+    (quenched disorder, Dansereau et al. 2016 §2.2)."""
     if n_elements < 0:
         raise ConfigError(f"n_elements = {n_elements} must be >= 0")
     return rng.uniform(params.cohesion_min_pa, params.cohesion_max_pa, size=n_elements)
@@ -187,7 +187,7 @@ class MaxwellEB:
         return E, lam
 
     def damage_time(self, element_size_m):
-        """td = Δx / cs [s] (seed 004 §3.1.1)."""
+        """td = Δx / cs [s] (Dansereau et al. 2016 §3.1.1)."""
         return np.asarray(element_size_m, np.float64) / self.params.shear_wave_speed
 
     def constant_heal_rate(self, n: int) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""Implicit Maxwell-EB time stepper (DESIGN.md §4.1, seed 004 §4).
+"""Implicit Maxwell-EB time stepper (docs/design.md §4.1, Dansereau et al. 2016 §4).
 
 Per step (Δt), with P1 velocity and P0 stress/damage:
 
@@ -12,7 +12,7 @@ Per step (Δt), with P1 velocity and P0 stress/damage:
    until the constitutive residual ‖σ_k − σ_{k−1}‖/‖σ_k‖ (and the same for
    velocity) is below ``tol``. Without such forces the system is linear and
    one iteration is exact (reported as 1 iteration, residual 0).
-3. Damage explicit (seed 004 eq. 11): d_crit from the new stress, damage
+3. Damage explicit (Dansereau et al. 2016 eq. 11): d_crit from the new stress, damage
    increment and stress correction, healing.
 
 Iterations, residual and timings (assembly, solve, damage) are reported in
