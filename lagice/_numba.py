@@ -9,9 +9,12 @@ chooses by size.
 """
 from __future__ import annotations
 
+import logging
 import os
+import time
 import types
 
+import numba
 from numba import njit
 
 #: problems smaller than this run the serial build (environment override
@@ -44,3 +47,71 @@ def serial_and_parallel(py_func, **njit_kw):
 def pick(kernels, n, threshold: int | None = None):
     """The serial build for ``n`` below the threshold, else the parallel one."""
     return kernels[0] if n < (PARALLEL_MIN_SIZE if threshold is None else threshold) else kernels[1]
+
+
+#: below this many elements ``parallel = "auto"`` runs the serial kernels without
+#: measuring (environment override ``LAGICE_AUTOTUNE_MIN_SIZE``): at 2000 elements
+#: a sub-step of the explicit kernels takes ~50 µs serial, the order of one
+#: fork/join of the parallel build on an idle machine (measured on the project's
+#: 2-vCPU VM, docs/benchmarks.md), so threads cannot pay there.
+AUTOTUNE_MIN_SIZE = int(os.environ.get("LAGICE_AUTOTUNE_MIN_SIZE", "2000"))
+
+#: the parallel build must beat the serial one by this factor to be chosen (a
+#: margin against timing noise on a shared machine)
+AUTOTUNE_MARGIN = 1.05
+
+
+def autotune(trial, n_elements: int, *, max_threads: int | None = None, repeats: int = 3,
+             min_size: int | None = None, what: str = "kernels") -> dict:
+    """Choose serial or parallel kernel builds and the thread count by measurement.
+
+    ``trial(parallel: bool) -> None`` runs a fixed amount of the real work (the
+    caller's kernels on copies of its arrays). Each candidate, serial (1 thread)
+    and parallel with 2..``max_threads`` numba threads (default: all numba
+    threads), is run once to warm up (loads the compiled kernels), then timed
+    ``repeats`` times; the best time of each counts. The parallel build is chosen
+    only when it is :data:`AUTOTUNE_MARGIN` faster than the serial one. Below
+    ``min_size`` elements (default :data:`AUTOTUNE_MIN_SIZE`) the serial build is
+    chosen without measuring.
+
+    Leaves numba's thread count at the chosen value (for a parallel choice) and
+    returns ``{"parallel", "threads", "method", "timings_ms", "n_elements"}``; the
+    choice is logged on the ``lagice`` logger (the run log).
+    """
+    n_max = numba.config.NUMBA_NUM_THREADS if max_threads is None else int(max_threads)
+    n_max = max(1, min(n_max, numba.config.NUMBA_NUM_THREADS))
+    min_size = AUTOTUNE_MIN_SIZE if min_size is None else int(min_size)
+    out = {"n_elements": int(n_elements), "timings_ms": {}}
+    if n_elements < min_size or n_max < 2:
+        why = (f"below {min_size} elements" if n_elements < min_size else "one numba thread available")
+        out.update(parallel=False, threads=1, method=f"rule: {why}")
+    else:
+        before = numba.get_num_threads()
+        cands = [(False, 1)] + [(True, t) for t in range(2, n_max + 1)]
+        best = {}
+        try:
+            for par, t in cands:
+                if par:
+                    numba.set_num_threads(t)
+                trial(par)  # warm-up: loads (or compiles) the build
+                ts = []
+                for _ in range(max(1, int(repeats))):
+                    t0 = time.perf_counter()
+                    trial(par)
+                    ts.append(time.perf_counter() - t0)
+                best[(par, t)] = min(ts)
+        finally:
+            numba.set_num_threads(before)
+        t_ser = best[(False, 1)]
+        (par, t), t_best = min(((k, v) for k, v in best.items() if k[0]), key=lambda kv: kv[1])
+        if t_best * AUTOTUNE_MARGIN >= t_ser:
+            par, t = False, 1
+        out.update(parallel=par, threads=t, method="measured",
+                   timings_ms={("serial" if not p else f"parallel_{n}"): 1e3 * v for (p, n), v in best.items()})
+    if out["parallel"]:
+        numba.set_num_threads(out["threads"])
+    tm = ", ".join(f"{k} {v:.2f} ms" for k, v in out["timings_ms"].items())
+    logging.getLogger("lagice").info(
+        f"{what}: {'parallel on ' + str(out['threads']) + ' threads' if out['parallel'] else 'serial'} "
+        f"for {n_elements} elements ({out['method']}{'; ' + tm if tm else ''})")
+    return out

@@ -373,6 +373,11 @@ def solver_options(cfg: dict) -> dict:
     for k in ("linear_solver", "tol", "max_iter", "substeps", "allow_unstable", "safety", "parallel"):
         if sv[k] is None or (k == "allow_unstable" and sv[k] is False):
             continue
+        if k == "parallel" and isinstance(sv[k], str):
+            if sv[k] != "auto":
+                raise ConfigError(f"solver.parallel = {sv[k]!r}: expected true, false or \"auto\" (measured "
+                                  f"at the first step)")
+            continue  # "auto" is the steppers' default (None)
         if k not in accepted:
             raise ConfigError(f"solver.{k} does not apply to solver {sv['name']!r}")
         opts[k] = sv[k]

@@ -55,7 +55,7 @@ SCHEMA = {
     "solver": {
         "name": (str, "implicit"), "dt": (EXPR, None), "substeps": (int, None),
         "linear_solver": (str, None), "tol": (NUM, None), "max_iter": (int, None),
-        "allow_unstable": (bool, False), "safety": (NUM, None), "parallel": (bool, None),
+        "allow_unstable": (bool, False), "safety": (NUM, None), "parallel": ((bool, str), None),
         "velocity": (str, None), "velocity_params": (dict, {}),
         "device": (str, "cpu"),
     },

@@ -41,7 +41,7 @@ import time
 import numpy as np
 from numba import njit, prange
 
-from .._numba import PARALLEL_MIN_SIZE, serial_copy
+from .._numba import PARALLEL_MIN_SIZE, autotune, serial_copy
 from ..errors import ConfigError
 from ..fem import STRAIN_RATE, NodeSystem, element_strain_rate, solve_node_2x2
 from ..forces import explicit_terms
@@ -50,7 +50,10 @@ from ..state import IceState
 from .base import StepInfo
 
 #: keys of ``ExplicitSolver.kernel_timings`` / ``StepInfo.kernel_timings`` [s]
-KERNELS = ("forcing", "setup", "node_velocity", "element_stress_damage")
+KERNELS = ("forcing", "setup", "substeps", "node_velocity", "element_stress_damage")
+
+#: sub-steps per autotuning trial: about this many element-sub-steps (a few ms)
+AUTOTUNE_WORK = 300_000
 
 
 def _node_velocity(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
@@ -177,6 +180,42 @@ element_stress_damage_kernel_serial = _serial(_element_stress_damage)
 PARALLEL_MIN_ELEMENTS = PARALLEL_MIN_SIZE
 
 
+@njit(cache=True, error_model="numpy")
+def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
+                      half_mf, fixed, pres0, pres1, tri, b, c, damage, conc_factor, coh, sig_c, sig_t, td,
+                      heal, e_dt, gamma, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+    """All ``n_sub`` sub-steps of one outer step in compiled code (one call per outer
+    step, no Python per sub-step): the node kernel then the element kernel, serial
+    builds; the same calls as a Python loop over the kernels, bit-identical results."""
+    n_capped = 0
+    for k in range(n_sub):
+        node_velocity_kernel_serial(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
+                                    half_mf, fixed, pres0, pres1, (k + 1) / n_sub)
+        n_capped += element_stress_damage_kernel_serial(
+            tri, b, c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt, gamma, dt_s, kxx, kxy,
+            kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+    return n_capped
+
+
+@njit(cache=True, error_model="numpy")
+def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
+                      half_mf, fixed, pres0, pres1, tri, b, c, damage, conc_factor, coh, sig_c, sig_t, td,
+                      heal, e_dt, gamma, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+    """:func:`substeps_serial` with the parallel kernel builds (one fork/join per
+    kernel and sub-step, launched from compiled code)."""
+    n_capped = 0
+    for k in range(n_sub):
+        node_velocity_kernel(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
+                             half_mf, fixed, pres0, pres1, (k + 1) / n_sub)
+        n_capped += element_stress_damage_kernel(
+            tri, b, c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt, gamma, dt_s, kxx, kxy,
+            kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+    return n_capped
+
+
+SUBSTEPS = (substeps_serial, substeps_parallel)
+
+
 class ExplicitSolver:
     """Explicit (sub-stepped, lumped-mass) Maxwell-EB time stepper.
 
@@ -193,8 +232,13 @@ class ExplicitSolver:
         safety: fraction of the measured sub-step limit used when ``substeps`` is None.
         allow_unstable: run (with a :class:`~lagice.stability.StabilityWarning`)
             when Δt_s is beyond the measured limit instead of raising ConfigError.
-        parallel: True/False, or None (default): parallel kernels from
-            ``PARALLEL_MIN_ELEMENTS`` elements up.
+        parallel: True/False, or None / ``"auto"`` (default): serial or parallel kernel
+            builds and the numba thread count chosen by measurement on this mesh at
+            the first step (:func:`lagice._numba.autotune`); the choice is logged
+            and kept in :attr:`kernel_choice`.
+        profile_kernels: time the node and element kernels separately (a Python
+            loop over the sub-steps, two kernel calls each) instead of running the
+            whole sub-step loop in one compiled call (the default; same results).
 
     After a step, ``state.velocity`` is the last sub-step's velocity (the dynamic
     state, carried in checkpoints), :attr:`transport_velocity` the mean over the
@@ -202,7 +246,10 @@ class ExplicitSolver:
     integrated: nodes and drifters move with it) and :attr:`last_strain_rate` its
     strain rate.
 
-    Per-kernel wall times [s] are accumulated in :attr:`kernel_timings` and
+    Connectivity is passed to the kernels as int32 copies (cached per mesh).
+    Per-kernel wall times [s] are accumulated in :attr:`kernel_timings` (``substeps``:
+    the whole sub-step loop; ``node_velocity``/``element_stress_damage`` only with
+    ``profile_kernels``) and
     returned per step in ``StepInfo.kernel_timings``; ``StepInfo.timings`` maps
     them onto the implicit solver's keys (assembly = forcing + setup,
     solve = node_velocity, damage = element_stress_damage).
@@ -213,7 +260,7 @@ class ExplicitSolver:
 
     def __init__(self, rheology: MaxwellEB, mesh, bcs=(), forces=(), substeps: int | None = None,
                  heal_rate=None, safety: float = 0.7, allow_unstable: bool = False,
-                 parallel: bool | None = None):
+                 parallel: bool | str | None = None, profile_kernels: bool = False):
         if not isinstance(rheology, MaxwellEB):
             raise ConfigError(f"the explicit stepper solves the Maxwell-EB rheology; got "
                               f"{type(rheology).__name__} (use solver 'evp' for viscous-plastic)")
@@ -234,6 +281,16 @@ class ExplicitSolver:
         self._transport = None
         self._strain_rate = None
         self.last_substeps = None
+        if isinstance(parallel, str):
+            if parallel != "auto":
+                raise ConfigError(f"solver.parallel = {parallel!r}; expected true, false or \"auto\"")
+            parallel = None
+        self.parallel_setting = parallel
+        self.profile_kernels = bool(profile_kernels)
+        #: the kernel build and thread count in use ({"parallel", "threads", "method", ...}),
+        #: set at the first step (None before)
+        self.kernel_choice = None
+        self._idx = (None, None)
         self.nodes = NodeSystem(mesh, bcs, parallel, geometry_hook=self._geometry_extras)
 
     # -- geometry/topology (the node system owns the caches) ----------------------------
@@ -294,6 +351,66 @@ class ExplicitSolver:
             self._checked.clear()
         self._checked.add(key)
 
+    # -- kernels ----------------------------------------------------------------------
+    def _indices(self, mesh):
+        """int32 copies of the connectivity the kernels read (ptr, elems, tri), cached
+        for ``mesh`` (half the index bytes of the int64 originals)."""
+        if self._idx[0] is not mesh:
+            ptr, elems, _ = mesh.node_elements
+            if len(elems) >= 2**31:
+                raise ConfigError(f"{mesh.n_elements} elements: too many for int32 connectivity")
+            self._idx = (mesh, (ptr.astype(np.int32), elems.astype(np.int32), mesh.triangles.astype(np.int32)))
+        return self._idx[1]
+
+    def _choose_kernels(self, args) -> None:
+        """Fix :attr:`kernel_choice` at the first step: the setting ``parallel`` if given,
+        else measured on this mesh (:func:`lagice._numba.autotune`) with the step's own
+        arrays (scratch copies: the state is not touched)."""
+        import logging
+
+        import numba
+
+        m = self.mesh.n_elements
+        if self.parallel_setting is not None:
+            par = bool(self.parallel_setting)
+            self.kernel_choice = {"parallel": par, "threads": numba.get_num_threads() if par else 1,
+                                  "method": f"solver.parallel = {str(par).lower()}", "n_elements": m,
+                                  "timings_ms": {}}
+            how = f"parallel on {self.kernel_choice['threads']} threads" if par else "serial"
+            logging.getLogger("lagice").info(f"explicit kernels: {how} for {m} elements "
+                                             f"({self.kernel_choice['method']})")
+        else:
+            scratch = tuple(a.copy() if isinstance(a, np.ndarray) and a.flags.writeable else a for a in args)
+            n_trial = int(min(100, max(2, math.ceil(AUTOTUNE_WORK / max(m, 1)))))
+
+            def trial(par):
+                SUBSTEPS[int(par)](n_trial, *scratch)
+
+            self.kernel_choice = autotune(trial, m, what="explicit kernels")
+            self.kernel_choice["trial_substeps"] = n_trial
+        self.nodes.parallel = self.kernel_choice["parallel"]
+
+    def _profiled_substeps(self, par, n_sub, args):
+        """The sub-step loop in Python with each kernel timed (``profile_kernels``)."""
+        (vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t, half_mf, fixed, pres0,
+         pres1, tri, b, c, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt, gamma, dt_s, kxx, kxy, kss, q,
+         denom, max_damage, E0, lambda0, alpha, flag) = args
+        node_k = node_velocity_kernel if par else node_velocity_kernel_serial
+        elem_k = element_stress_damage_kernel if par else element_stress_damage_kernel_serial
+        n_capped = 0
+        tn = tm = 0.0
+        for k in range(n_sub):
+            ta = time.perf_counter()
+            node_k(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t, half_mf,
+                   fixed, pres0, pres1, (k + 1) / n_sub)
+            tb = time.perf_counter()
+            n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt,
+                               gamma, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            tc = time.perf_counter()
+            tn += tb - ta
+            tm += tc - tb
+        return n_capped, tn, tm
+
     # -- one step -----------------------------------------------------------------
     def step(self, state: IceState, t_s: float, dt: float) -> StepInfo:
         if not dt > 0:
@@ -314,7 +431,6 @@ class ExplicitSolver:
         t1 = time.perf_counter()
         kt["forcing"] = t1 - t0
 
-        ptr, elems, _ = mesh.node_elements
         tri = mesh.triangles
         su = ns.setup(state.thickness, terms, p.rho_ice, dt_s, True)
         par = su.parallel
@@ -339,36 +455,34 @@ class ExplicitSolver:
         t2 = time.perf_counter()
         kt["setup"] = t2 - t1
 
-        n_capped = 0
-        tn = tm = 0.0
-        node_k = node_velocity_kernel if par else node_velocity_kernel_serial
-        elem_k = element_stress_damage_kernel if par else element_stress_damage_kernel_serial
-        b, c = ns.b, ns.c
-        for k in range(n_sub):
-            ta = time.perf_counter()
-            node_k(vel, vel_sum, sigma, ptr, elems, su.wb, su.wc, su.m_dt, su.fext, su.cda, terms.current,
-                   terms.cos_turn, terms.sin_turn, half_mf, ns.fixed, pres0, pres1, (k + 1) / n_sub)
-            tb = time.perf_counter()
-            n_capped += elem_k(
-                tri, b, c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, self.td, heal,
-                e_dt, gamma, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0,
-                p.relaxation_time_s, float(p.alpha), flag)
-            tc = time.perf_counter()
-            tn += tb - ta
-            tm += tc - tb
-        kt["node_velocity"] = tn
-        kt["element_stress_damage"] = tm
+        ptr32, elems32, tri32 = self._indices(mesh)
+        args = (vel, vel_sum, sigma, ptr32, elems32, su.wb, su.wc, su.m_dt, su.fext, su.cda, terms.current,
+                terms.cos_turn, terms.sin_turn, half_mf, ns.fixed, pres0, pres1, tri32, ns.b, ns.c, damage,
+                conc_factor, coh, sig_c, sig_t, self.td, heal, e_dt, gamma, dt_s, kxx, kxy, kss, rh.q,
+                rh._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), flag)
+        if self.kernel_choice is None:
+            self._choose_kernels(args)
+            par = ns.parallel
+        ta = time.perf_counter()
+        if self.profile_kernels:
+            n_capped, tn, tm = self._profiled_substeps(par, n_sub, args)
+            kt["node_velocity"] = tn
+            kt["element_stress_damage"] = tm
+        else:
+            n_capped = SUBSTEPS[int(par)](n_sub, *args)
+        kt["substeps"] = time.perf_counter() - ta
         state.velocity = vel
         state.stress = sigma
         state.damage = damage
         self._transport = vel_sum / n_sub
-        self._strain_rate = STRAIN_RATE[int(par)](tri, b, c, self._transport)
+        self._strain_rate = STRAIN_RATE[int(par)](tri, ns.b, ns.c, self._transport)
         self.last_substeps = n_sub
         rh.n_capped_total += int(n_capped)
         for k, v in kt.items():
             self.kernel_timings[k] += v
         info = StepInfo(iterations=n_sub, residual=0.0, n_damaged=int(flag.sum()), n_capped=int(n_capped))
-        info.timings = {"assembly": kt["forcing"] + kt["setup"], "solve": kt["node_velocity"],
+        info.timings = {"assembly": kt["forcing"] + kt["setup"],
+                        "solve": kt["node_velocity"] if self.profile_kernels else kt["substeps"],
                         "damage": kt["element_stress_damage"]}
         info.kernel_timings = kt
         return info
