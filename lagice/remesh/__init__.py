@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import ConfigError, MeshError
 from ..fields import remapped_element_fields
-from ..mesh import Mesh, angles_deg, signed_areas
+from ..mesh import Mesh, angles_deg, renumber_for_locality, signed_areas
 from .patch import Stitch, grow_patch, make_manifold, mesh_patch, patch_boundary, stitch
 from .remap import interpolate_nodal, intersect_triangles, locate_points, remap_field, remap_weights
 from .trigger import TriggerParams, TriggerResult, check_trigger, evaluate_size
@@ -66,6 +66,8 @@ class RemeshEvent:
     min_angle_after: float = 0.0
     kept_elements: np.ndarray | None = field(default=None, repr=False)  # old index of new element k < len
     kept_nodes: np.ndarray | None = field(default=None, repr=False)     # old index of new node k < len
+    node_perm: np.ndarray | None = field(default=None, repr=False)      # renumbering after the stitch
+    element_perm: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def elements_touched(self) -> int:
@@ -186,13 +188,17 @@ def remesh_region(state, mask: np.ndarray, size_field, *, algorithm: int = 6,
     return nm, fields, velocity, st, {"gmsh": t_gmsh, "remap": t_remap}
 
 
-def apply_remesh(state, nm, fields, velocity, solver=None, kept_nodes=None):
+def apply_remesh(state, nm, fields, velocity, solver=None, kept_nodes=None, renumber: bool = False):
     """Install the result of :func:`remesh_region` in ``state`` (mesh, element
     fields, velocity, ``counters["remesh_events"]``) and reset the solver topology.
 
     ``kept_nodes`` (old indices of the first new nodes, :class:`Stitch`) carries
     the persistent ``state.node_id`` over; the appended nodes get fresh ids.
-    Without it the ids are dropped (``None``: continuity unknown)."""
+    Without it the ids are dropped (``None``: continuity unknown).
+    ``renumber``: renumber the new mesh's nodes and elements along a Morton curve
+    (:func:`lagice.mesh.renumber_for_locality`; the stitched mesh appends the patch
+    at the end, far in memory from its neighbours), the fields and ids with it.
+    Returns ``(node_perm, element_perm)`` of that renumbering (None without it)."""
     if kept_nodes is not None:
         old = state.node_id if state.node_id is not None else np.arange(state.mesh.n_nodes, dtype=np.int64)
         nxt = int(state.counters.get("next_node_id", int(old.max()) + 1 if old.size else 0))
@@ -201,6 +207,14 @@ def apply_remesh(state, nm, fields, velocity, solver=None, kept_nodes=None):
         state.counters["next_node_id"] = nxt + n_new
     else:
         state.node_id = None
+    perms = None
+    if renumber:
+        nm, pn, pe = renumber_for_locality(nm)
+        fields = {k: v[pe] for k, v in fields.items()}
+        velocity = velocity[pn]
+        if state.node_id is not None:
+            state.node_id = state.node_id[pn]
+        perms = (pn, pe)
     state.mesh = nm
     for k, v in fields.items():
         setattr(state, k, v)
@@ -208,6 +222,7 @@ def apply_remesh(state, nm, fields, velocity, solver=None, kept_nodes=None):
     state.counters["remesh_events"] = int(state.counters.get("remesh_events", 0)) + 1
     if solver is not None:
         solver.reset_topology(nm)
+    return perms
 
 
 def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | None = None,
@@ -215,7 +230,7 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
                      flagged=None, log: RemeshLog | None = None, algorithm: int = 6,
                      remap_method: str = "auto", damage_remap: str = "area",
                      force_global: bool = False, time_s: float = 0.0, step: int = 0,
-                     before_remap=None) -> RemeshEvent | None:
+                     before_remap=None, renumber: bool = False) -> RemeshEvent | None:
     """Check the trigger and, if needed, remesh and remap ``state`` in place.
 
     Args:
@@ -238,6 +253,9 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
         before_remap: called (no arguments) when the trigger fired, before any field
             is read (:meth:`lagice.model.Model.needs_host_state`: a device stepper's
             fields come to the host only when a remesh happens).
+        renumber: renumber the new mesh for memory locality (:func:`apply_remesh`);
+            ``kept_elements``/``kept_nodes`` of the event refer to the stitched order
+            before it, ``element_perm``/``node_perm`` map it (new k is stitched ``perm[k]``).
 
     Returns:
         :class:`RemeshEvent`, or None when the trigger found nothing.
@@ -297,11 +315,13 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
     ev.extrema_before = _extrema(fields_before, pe)
     ang_old = angles_deg(mesh.nodes, mesh.triangles[pe])
     ev.min_angle_before = float(np.nanmin(ang_old)) if ang_old.size else 0.0
-    apply_remesh(state, nm, fields, velocity, solver, kept_nodes=st.kept_nodes)
     k0 = len(st.kept_elements)
-    ev.extrema_after = _extrema(element_fields(state), slice(k0, None))
+    ev.extrema_after = _extrema(fields, slice(k0, None))
+    perms = apply_remesh(state, nm, fields, velocity, solver, kept_nodes=st.kept_nodes, renumber=renumber)
+    if perms is not None:
+        ev.node_perm, ev.element_perm = perms
     ev.min_angle_after = float(np.nanmin(angles_deg(nm.nodes, nm.triangles[k0:])))
-    ev.totals_after = totals(nm, state)
+    ev.totals_after = totals(state.mesh, state)
     ev.rel_change = {k: (ev.totals_after[k] - v) / v if v != 0 else ev.totals_after[k] - v
                      for k, v in ev.totals_before.items()}
     ev.n_patch_old = len(pe)

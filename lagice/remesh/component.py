@@ -17,13 +17,15 @@ class Remesher:
     Args:
         size_field: target element size [m] (number or vectorised ``f(x, y)``).
         min_angle_deg: trigger on any angle below this [deg].
+        renumber: renumber nodes and elements for memory locality after each remesh
+            (the scene's ``domain.renumber``).
         **params: :class:`~lagice.remesh.trigger.TriggerParams` fields and the
             options in :data:`REMESH_OPTIONS`; anything else is a ConfigError naming it.
     """
 
     name = "remeshing"
 
-    def __init__(self, size_field, min_angle_deg=10.0, **params):
+    def __init__(self, size_field, min_angle_deg=10.0, renumber: bool = False, **params):
         from . import RemeshLog
 
         known = set(TriggerParams.__dataclass_fields__) | set(REMESH_OPTIONS)
@@ -38,6 +40,7 @@ class Remesher:
             raise ConfigError(f"[remesh.params]: {exc}") from None
         self.options = {k: v for k, v in params.items() if k in REMESH_OPTIONS}
         self.log = RemeshLog()
+        self.renumber = bool(renumber)
 
     def advance(self, model, dt_s: float):
         from . import remesh_if_needed
@@ -47,7 +50,7 @@ class Remesher:
         ev = remesh_if_needed(st, self.size_field, solver=model.stepper, params=self.trigger,
                               flagged=motion.last_flagged if motion is not None else None, log=self.log,
                               time_s=model.clock.time_s + dt_s, step=model.clock.iteration + 1,
-                              before_remap=model.needs_host_state, **self.options)
+                              before_remap=model.needs_host_state, renumber=self.renumber, **self.options)
         if ev is not None and ev.kind != "failed":
             st.counters["remesh_count"] = st.counters.get("remesh_count", 0) + 1
             st.counters["mesh_epoch"] = st.counters.get("mesh_epoch", 0) + 1

@@ -196,20 +196,27 @@ def _domain_points(poly, n: int = 30) -> np.ndarray:
     return np.vstack([v, np.column_stack([gx.ravel(), gy.ravel()])])
 
 
-def build_mesh(cfg: dict):
-    """The scene's mesh (gmsh), rotated and renumbered as asked; also returns the polygon."""
+def build_mesh(cfg: dict, with_order: bool = False):
+    """The scene's mesh (gmsh), renumbered and rotated as asked; also returns the polygon.
+
+    ``domain.renumber`` (default true) renumbers nodes and elements along a Morton
+    curve (:func:`lagice.mesh.renumber_for_locality`: the kernels' gathers hit nearby
+    memory). ``with_order=True`` also returns the element permutation (new element k
+    is gmsh's element ``order[k]``; the identity without renumbering), so that per-element
+    random draws can be made in gmsh's order and stay the same with or without it."""
     d = cfg["domain"]
     poly, segs, ext_tag, size = build_domain(d)
     mesh = generate_mesh(poly, size, segments=segs, exterior_tag=ext_tag)
+    order = np.arange(mesh.n_elements)
     if d["renumber"]:
-        mesh = renumber_for_locality(mesh)[0]
+        mesh, _, order = renumber_for_locality(mesh)
     if d["rotate_deg"]:
         c = poly.centroid
         mesh = rotate_mesh(mesh, d["rotate_deg"], (c.x, c.y))
         poly = shapely.affinity.rotate(poly, d["rotate_deg"], origin=c)
     for tag in cfg["boundary"]:
         mesh.tag_id(tag)  # unknown boundary tag -> ConfigError naming it
-    return mesh, poly
+    return (mesh, poly, order) if with_order else (mesh, poly)
 
 
 # -- checks before any mesh work ---------------------------------------------------
@@ -393,7 +400,10 @@ def solver_options(cfg: dict) -> dict:
 
 
 # -- the model -----------------------------------------------------------------------
-def initial_state(cfg: dict, mesh, rheo, rng) -> IceState:
+def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
+    """The scene's initial state on ``mesh``; ``order`` (see :func:`build_mesh`): random
+    cohesion is drawn in the mesh generator's element order, then permuted, so the
+    realisation does not depend on ``domain.renumber``."""
     c = mesh.centroids()
     x, y = c[:, 0], c[:, 1]
     ini = cfg["initial"]
@@ -403,6 +413,8 @@ def initial_state(cfg: dict, mesh, rheo, rng) -> IceState:
             cohesion = np.zeros(mesh.n_elements)
         else:
             cohesion = draw_cohesion(mesh.n_elements, rheo.params, rng)
+            if order is not None:
+                cohesion = cohesion[order]
     else:
         cohesion = spatial_values(coh, x, y, "initial.cohesion_pa")
     state = IceState.uniform(
@@ -429,10 +441,10 @@ def build_model(cfg: dict, validated: bool = False) -> Model:
     """The model of a scene (``validated``: :func:`validate_config` already ran)."""
     if not validated:
         validate_config(cfg)
-    mesh, poly = build_mesh(cfg)
+    mesh, poly, order = build_mesh(cfg, with_order=True)
     rng = np.random.default_rng(cfg["run"]["seed"])
     rheo = build_rheology(cfg)
-    state = initial_state(cfg, mesh, rheo, rng)
+    state = initial_state(cfg, mesh, rheo, rng, order)
     bcs = []
     for tag, bc in cfg["boundary"].items():
         kw = {comp: (time_space_callable(bc[comp], f"boundary.{tag}.{comp}") if isinstance(bc[comp], str)

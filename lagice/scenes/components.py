@@ -546,4 +546,5 @@ def build_remesher(cfg):
     res = cfg["domain"]["resolution_m"]
     size = res if not isinstance(res, str) else (
         lambda x, y: spatial_values(res, np.atleast_1d(x), np.atleast_1d(y), "domain.resolution_m"))
-    return Remesher(size, cfg["remesh"]["min_angle_deg"], **cfg["remesh"]["params"])
+    return Remesher(size, cfg["remesh"]["min_angle_deg"], renumber=cfg["domain"]["renumber"],
+                    **cfg["remesh"]["params"])

@@ -35,7 +35,7 @@ SCHEMA = {
         "x0_m": (NUM, 0.0), "y0_m": (NUM, 0.0), "vertices": (list, None), "islands": (list, []),
         "file": (str, None), "function": (str, None), "params": (dict, {}),
         "resolution_m": (EXPR, None), "exterior_tag": (str, "coast"),
-        "segments": (dict, {}), "rotate_deg": (NUM, 0.0), "renumber": (bool, False),
+        "segments": (dict, {}), "rotate_deg": (NUM, 0.0), "renumber": (bool, True),
         "crs": (str, "EPSG:3413"), "file_crs": (str, None),
     },
     "initial": {

@@ -381,7 +381,7 @@ class ExplicitSolver:
                                              f"({self.kernel_choice['method']})")
         else:
             scratch = tuple(a.copy() if isinstance(a, np.ndarray) and a.flags.writeable else a for a in args)
-            n_trial = int(min(100, max(2, math.ceil(AUTOTUNE_WORK / max(m, 1)))))
+            n_trial = int(min(20, max(2, math.ceil(AUTOTUNE_WORK / max(m, 1)))))
 
             def trial(par):
                 SUBSTEPS[int(par)](n_trial, *scratch)
