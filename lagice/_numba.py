@@ -67,8 +67,9 @@ def autotune(trial, n_elements: int, *, max_threads: int | None = None, repeats:
 
     ``trial(parallel: bool) -> None`` runs a fixed amount of the real work (the
     caller's kernels on copies of its arrays). Each candidate, serial (1 thread)
-    and parallel with 2..``max_threads`` numba threads (default: all numba
-    threads), is run once to warm up (loads the compiled kernels), then timed
+    and parallel with 2..``max_threads`` numba threads (default: numba's current
+    thread count, ``numba.get_num_threads()``: ``NUMBA_NUM_THREADS`` or what
+    ``numba.set_num_threads`` limited it to), is run once to warm up (loads the compiled kernels), then timed
     ``repeats`` times; the best time of each counts. The parallel build is chosen
     only when it is :data:`AUTOTUNE_MARGIN` faster than the serial one. Below
     ``min_size`` elements (default :data:`AUTOTUNE_MIN_SIZE`) the serial build is
@@ -78,7 +79,7 @@ def autotune(trial, n_elements: int, *, max_threads: int | None = None, repeats:
     returns ``{"parallel", "threads", "method", "timings_ms", "n_elements"}``; the
     choice is logged on the ``lagice`` logger (the run log).
     """
-    n_max = numba.config.NUMBA_NUM_THREADS if max_threads is None else int(max_threads)
+    n_max = numba.get_num_threads() if max_threads is None else int(max_threads)
     n_max = max(1, min(n_max, numba.config.NUMBA_NUM_THREADS))
     min_size = AUTOTUNE_MIN_SIZE if min_size is None else int(min_size)
     out = {"n_elements": int(n_elements), "timings_ms": {}}
