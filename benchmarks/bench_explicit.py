@@ -104,6 +104,44 @@ def kernel_bytes(st, mesh) -> dict:
             "index_bytes": (ptr.nbytes + elems.nbytes + tri.nbytes) / m}
 
 
+def element_kernel_rates(n_target: int = 50_000, reps: int = 20) -> dict:
+    """The serial element kernel alone on a Morton-ordered square mesh, per CPU second
+    [elements/s]: without damage (huge cohesion, no healing), with healing acting on
+    damaged elements (moduli refreshed every sub-step) and with every element damaging
+    (``_dcrit`` and the damage step everywhere): where the kernel's time goes."""
+    import shapely
+
+    from lagice.fem import shape_gradients
+    from lagice.mesh import generate_mesh, renumber_for_locality
+    from lagice.rheology import MaxwellEB
+    from lagice.solvers.explicit import element_stress_damage_kernel_serial as kernel
+
+    rheo = MaxwellEB()
+    p = rheo.params
+    mesh = renumber_for_locality(generate_mesh(shapely.box(0, 0, DOMAIN_M, DOMAIN_M), resolution_for(n_target)))[0]
+    m, n = mesh.n_elements, mesh.n_nodes
+    b, c, _ = shape_gradients(mesh.nodes, mesh.triangles)
+    tri = mesh.triangles.astype(np.int32)
+    rng = np.random.default_rng(0)
+    vel = rng.normal(0, 0.1, (n, 2))
+    out = {"n_elements": m}
+    for name, coh, heal, d0 in (("no damage", 1e12, 0.0, 0.0), ("healing damaged ice", 1e12, 1e-6, 0.5),
+                                ("all damaging", 1e3, 1e-6, 0.5)):
+        sigma = rng.normal(0, 1e4, (m, 3))
+        damage = np.full(m, d0)
+        cohv = np.full(m, coh)
+        sc = 2 * cohv / rheo._denom
+        args = (tri, b, c, vel, sigma, damage, np.ones(m), cohv, sc, sc / rheo.q, np.full(m, 20.0),
+                np.full(m, heal), np.full(m, 4.0 * p.E0), np.full(m, 0.99), 4.0, 1.1, 0.3, 0.7, rheo.q,
+                rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, np.zeros(m, np.int8))
+        kernel(*args)
+        t0 = time.process_time()
+        for _ in range(reps):
+            kernel(*args)
+        out[name] = m * reps / (time.process_time() - t0)
+    return out
+
+
 def bench(n_target, steps, parallel, substeps, profile_kernels=False, extra=None):
     res = resolution_for(n_target)
     ov = {"domain.resolution_m": res, "lagrangian.enabled": False, "forcing.wind.params.ramp_h": 0.0,
@@ -177,6 +215,9 @@ def main(argv=None):
     triad = {"serial": stream_triad(False), "parallel": stream_triad(True)}
     print(f"STREAM triad (numba, {TRIAD_N:.0e} float64 per array): serial {triad['serial']:.2f} GB/s, "
           f"parallel ({numba.get_num_threads()} threads) {triad['parallel']:.2f} GB/s", flush=True)
+    ek = element_kernel_rates()
+    print(f"element kernel alone (serial, {ek['n_elements']} elements, per CPU second): "
+          + ", ".join(f"{k} {v / 1e6:.1f} M/s" for k, v in ek.items() if k != "n_elements"), flush=True)
     print(f"{'elements':>9} {'mode':>12} {'sub/step':>8} {'Mel-sub/s':>10} {'loop':>8} {'node':>8} {'element':>8} "
           f"{'B/el-sub':>8} {'GB/s':>6} {'%triad':>6} {'overhead ms/step':>16} {'loop ms/step':>12}")
     rows = []
@@ -207,7 +248,7 @@ def main(argv=None):
     for r in rows:
         r["threading_layer"] = layer
     a.json.parent.mkdir(parents=True, exist_ok=True)
-    a.json.write_text(json.dumps({"triad_GB_s": triad, "rows": rows}, indent=1))
+    a.json.write_text(json.dumps({"triad_GB_s": triad, "element_kernel_per_cpu_s": ek, "rows": rows}, indent=1))
     print(f"threading layer: {layer}; wrote {a.json}")
 
 

@@ -38,8 +38,8 @@ DAY_S = 86400.0
 COMPONENTS = ("dynamics", "mesh_motion", "thermodynamics", "remeshing", "drifters")
 
 
-def bench(days: float, resolution_m: float, parallel, outputs: bool = True) -> dict:
-    ov = {"domain.resolution_m": resolution_m, "run.duration": days * DAY_S + 600.0}
+def bench(days: float, resolution_m: float, parallel, outputs: bool = True, extra=None) -> dict:
+    ov = {"domain.resolution_m": resolution_m, "run.duration": days * DAY_S + 600.0, **(extra or {})}
     if parallel is not None:
         ov["solver.parallel"] = parallel
     sim = scene_simulation("winter_basin", ov, outputs=outputs)
@@ -80,14 +80,20 @@ def main(argv=None):
     ap.add_argument("--parallel", choices=["auto", "yes", "no", "both"], default="auto")
     ap.add_argument("--no-outputs", action="store_true", help="leave snapshots and checkpoints out")
     ap.add_argument("--quick", action="store_true", help="20 km, 1 day")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="scene override as `lagice run --set` (e.g. domain.renumber=false)")
     ap.add_argument("--json", type=Path, default=Path("benchmarks/out/winter.json"))
     a = ap.parse_args(argv)
+    from lagice.scenes.config import _split
+
+    extra = dict(_split(kv) for kv in a.set)
     if a.quick:
         a.days, a.resolution = 1.0, 20e3
     modes = {"auto": [None], "yes": [True], "no": [False], "both": [False, True]}[a.parallel]
     rows = []
     for par in modes:
-        r = bench(a.days, a.resolution, par, outputs=not a.no_outputs)
+        r = bench(a.days, a.resolution, par, outputs=not a.no_outputs, extra=extra)
+        r["overrides"] = a.set
         r["requested"] = {None: "auto", True: "parallel", False: "serial"}[par]
         rows.append(r)
         kern = f"parallel on {r['threads']} threads" if r["parallel"] else "serial"
