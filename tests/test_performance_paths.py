@@ -187,3 +187,20 @@ def test_auto_kernel_choice_is_measured_and_recorded(tmp_path, caplog, monkeypat
 def test_bad_parallel_setting_names_the_key(tmp_path):
     with pytest.raises(ConfigError, match=r"solver.parallel = 'fast'.*true, false or \"auto\""):
         scene_sim("wind_square", tmp_path, {**KW, "solver.parallel": "fast"})
+
+
+def test_import_makes_openmp_workers_sleep_unless_the_user_chose():
+    """`import lagice` sets OMP_WAIT_POLICY=PASSIVE before numba's OpenMP runtime loads
+    (spinning workers made the parallel kernels 4-5x slower on shared cores and slowed the
+    serial components, docs/benchmarks.md); a user's own setting is kept."""
+    import os
+    import subprocess
+    import sys
+
+    code = "import os, lagice; print(os.environ['OMP_WAIT_POLICY'])"
+    env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "PASSIVE"
+    out = subprocess.run([sys.executable, "-c", code], env={**env, "OMP_WAIT_POLICY": "ACTIVE"},
+                         capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "ACTIVE"
