@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import lagice._numba as lnumba
+import lagice.solvers.explicit as explicit
 from lagice.errors import ConfigError
 from lagice.mesh import morton_order
 from lagice.remesh import remesh_global, totals
@@ -147,9 +148,9 @@ def test_auto_kernel_choice_is_measured_and_recorded(tmp_path, caplog, monkeypat
     size floor the serial build is chosen without measuring."""
     n = numba.get_num_threads()
     monkeypatch.setattr(lnumba, "AUTOTUNE_MIN_SIZE", 0)
-    sim = scene_sim("wind_square", tmp_path / "a", {**KW, "run.duration": "1h", "solver.parallel": "auto"})
+    sim = scene_sim("wind_square", tmp_path / "a", {**KW, "run.duration": "2h", "solver.parallel": "auto"})
     with caplog.at_level(logging.INFO, logger="lagice"):
-        sim.run()
+        sim.run(n_steps=6)
     ch = sim.model.stepper.kernel_choice
     if n < 2:
         assert ch["method"].startswith("rule") and not ch["parallel"]
@@ -163,9 +164,13 @@ def test_auto_kernel_choice_is_measured_and_recorded(tmp_path, caplog, monkeypat
             assert ch["timings_ms"][best] * lnumba.AUTOTUNE_MARGIN < ch["timings_ms"]["serial"]
         else:
             assert ch["threads"] == 1
-    assert sim.model.stepper.nodes.parallel is ch["parallel"]
+    assert sim.model.stepper.nodes.parallel is ch["parallel"] and ch["n_measurements"] == 1
     assert any("explicit kernels:" in r.getMessage() and f"{sim.model.mesh.n_elements} elements" in r.getMessage()
                for r in caplog.records)
+    # measured again once AUTOTUNE_INTERVAL_S of wall time has passed (the load changes)
+    monkeypatch.setattr(explicit, "AUTOTUNE_INTERVAL_S", 0.0)
+    sim.run(n_steps=2)
+    assert sim.model.stepper.kernel_choice["n_measurements"] == 3
     numba.set_num_threads(n)
     monkeypatch.setattr(lnumba, "AUTOTUNE_MIN_SIZE", 10**9)
     sim = scene_sim("wind_square", tmp_path / "b", {**KW, "run.duration": "1h"})

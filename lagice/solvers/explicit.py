@@ -54,6 +54,9 @@ KERNELS = ("forcing", "setup", "substeps", "node_velocity", "element_stress_dama
 
 #: sub-steps per autotuning trial: about this many element-sub-steps (a few ms)
 AUTOTUNE_WORK = 300_000
+#: with ``parallel="auto"`` the choice is measured again after this much wall time [s]
+#: (the load of a shared machine changes during a long run; a measurement costs ~0.1 s)
+AUTOTUNE_INTERVAL_S = 600.0
 
 
 def _node_velocity(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
@@ -234,8 +237,9 @@ class ExplicitSolver:
             when Δt_s is beyond the measured limit instead of raising ConfigError.
         parallel: True/False, or None / ``"auto"`` (default): serial or parallel kernel
             builds and the numba thread count chosen by measurement on this mesh at
-            the first step (:func:`lagice._numba.autotune`); the choice is logged
-            and kept in :attr:`kernel_choice`.
+            the first step (:func:`lagice._numba.autotune`) and again every
+            :data:`AUTOTUNE_INTERVAL_S` of wall time; the choice is logged and kept
+            in :attr:`kernel_choice`.
         profile_kernels: time the node and element kernels separately (a Python
             loop over the sub-steps, two kernel calls each) instead of running the
             whole sub-step loop in one compiled call (the default; same results).
@@ -290,6 +294,7 @@ class ExplicitSolver:
         #: the kernel build and thread count in use ({"parallel", "threads", "method", ...}),
         #: set at the first step (None before)
         self.kernel_choice = None
+        self._tuned_at = 0.0
         self._idx = (None, None)
         self.nodes = NodeSystem(mesh, bcs, parallel, geometry_hook=self._geometry_extras)
 
@@ -386,9 +391,12 @@ class ExplicitSolver:
             def trial(par):
                 SUBSTEPS[int(par)](n_trial, *scratch)
 
+            n_tunes = self.kernel_choice["n_measurements"] if self.kernel_choice else 0
             self.kernel_choice = autotune(trial, m, what="explicit kernels")
             self.kernel_choice["trial_substeps"] = n_trial
+            self.kernel_choice["n_measurements"] = n_tunes + 1
         self.nodes.parallel = self.kernel_choice["parallel"]
+        self._tuned_at = time.perf_counter()
 
     def _profiled_substeps(self, par, n_sub, args):
         """The sub-step loop in Python with each kernel timed (``profile_kernels``)."""
@@ -460,7 +468,9 @@ class ExplicitSolver:
                 terms.cos_turn, terms.sin_turn, half_mf, ns.fixed, pres0, pres1, tri32, ns.b, ns.c, damage,
                 conc_factor, coh, sig_c, sig_t, self.td, heal, e_dt, gamma, dt_s, kxx, kxy, kss, rh.q,
                 rh._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), flag)
-        if self.kernel_choice is None:
+        if self.kernel_choice is None or (
+                self.parallel_setting is None
+                and time.perf_counter() - self._tuned_at > AUTOTUNE_INTERVAL_S):
             self._choose_kernels(args)
             par = ns.parallel
         ta = time.perf_counter()
