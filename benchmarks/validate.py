@@ -209,11 +209,13 @@ def analyse_basin(out: Path, scene: str, days: float, buffer_m: float, physics=N
 
 
 def git_commit() -> dict:
-    """HEAD of the repository and whether the work tree differs from it (tracked files)."""
+    """HEAD of the repository and whether its code differs from it (tracked files outside
+    docs/, which this script writes)."""
     def git(*a):
         return subprocess.run(["git", *a], cwd=ROOT, capture_output=True, text=True, check=False).stdout.strip()
 
-    return {"commit": git("rev-parse", "HEAD"), "dirty": bool(git("status", "--porcelain", "--untracked-files=no"))}
+    changed = git("status", "--porcelain", "--untracked-files=no", "--", ".", ":(exclude)docs")
+    return {"commit": git("rev-parse", "HEAD"), "dirty": bool(changed)}
 
 
 def basin_imprint(run: Path, days: float, buffer_m: float) -> dict:
