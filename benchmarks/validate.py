@@ -688,7 +688,8 @@ def write_report(res: dict, md: Path, figs: dict):
     if res.get("compression") is not None:
         lines += compression_lines(res, figs)
     else:
-        lines += ["## Uniaxial compression", "", "Not part of this report: the fault angles at N = 40 with and without node jitter are in docs/physics.md §4 (compression test).", ""]
+        lines += ["## Uniaxial compression", "", "Not part of this report: the fault angles at N = 40 with and "
+                  "without node jitter are in docs/physics.md §4 (compression test).", ""]
     lines += ["## Where the model misses, and why", ""] + res.get("discussion", ["(not written)"]) + [""]
     md.write_text("\n".join(lines))
     return md
