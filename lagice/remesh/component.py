@@ -38,6 +38,9 @@ class Remesher:
             raise ConfigError(f"[remesh.params]: {exc}") from None
         self.options = {k: v for k, v in params.items() if k in REMESH_OPTIONS}
         self.log = RemeshLog()
+        #: callables ``f(state)`` run after each successful remesh, after the remap (e.g.
+        #: :meth:`lagice.strength.StrengthLaw.apply`: every element gets the strength of its size)
+        self.after_remesh = []
 
     def advance(self, model, dt_s: float):
         from . import remesh_if_needed
@@ -51,6 +54,8 @@ class Remesher:
         if ev is not None and ev.kind != "failed":
             st.counters["remesh_count"] = st.counters.get("remesh_count", 0) + 1
             st.counters["mesh_epoch"] = st.counters.get("mesh_epoch", 0) + 1
+            for f in self.after_remesh:
+                f(st)
         return ev
 
     def checkpoint_state(self):

@@ -201,6 +201,10 @@ def build_mesh(cfg: dict):
     d = cfg["domain"]
     poly, segs, ext_tag, size = build_domain(d)
     mesh = generate_mesh(poly, size, segments=segs, exterior_tag=ext_tag)
+    if d["jitter"]:  # mesh-imprint option (issue 12): break the lattice of gmsh's frontal meshes
+        from ..mesh.perturb import jitter_mesh
+
+        mesh = jitter_mesh(mesh, d["jitter"], cfg["run"]["seed"] + 104729)
     if d["renumber"]:
         mesh = renumber_for_locality(mesh)[0]
     if d["rotate_deg"]:
@@ -213,6 +217,19 @@ def build_mesh(cfg: dict):
 
 
 # -- checks before any mesh work ---------------------------------------------------
+
+
+def strength_law(cfg: dict):
+    """The scene's strength law (:class:`lagice.strength.StrengthLaw`), or None for the
+    uniform draw in [cohesion_min_pa, cohesion_max_pa]; keys checked (ConfigError
+    naming key, value and range) before any mesh work."""
+    from .. import strength
+
+    law = strength.from_config(cfg["rheology"], cfg["run"]["seed"])
+    if law is not None and cfg["rheology"]["law"] != "maxwell_eb":
+        raise ConfigError(f"rheology.strength_law = 'scaled' applies to rheology.law = 'maxwell_eb' only "
+                          f"(rheology.law is {cfg['rheology']['law']!r})")
+    return law
 
 
 def build_rheology(cfg: dict):
@@ -250,6 +267,10 @@ def validate_config(cfg: dict) -> None:
                           f"solver.dt = {dt:g} s")
     check_range("run.max_speed_m_s", cfg["run"]["max_speed_m_s"], 0.0, None, low_open=True, unit="m s-1")
     rheo = build_rheology(cfg)
+    strength_law(cfg)
+    from ..mesh.perturb import check_jitter
+
+    check_jitter(cfg["domain"]["jitter"], "domain.jitter")
     sv = cfg["solver"]
     want = SOLVER_RHEOLOGY.get(sv["name"], "?")
     if sv["name"] in SOLVERS and want is not None and rheo.name != want:
@@ -394,8 +415,11 @@ def initial_state(cfg: dict, mesh, rheo, rng) -> IceState:
     ini = cfg["initial"]
     coh = ini["cohesion_pa"]
     if coh == "random":
+        law = strength_law(cfg)
         if not isinstance(rheo, MaxwellEB):
             cohesion = np.zeros(mesh.n_elements)
+        elif law is not None:  # C from each element's size and its disorder factor (issue 12)
+            cohesion = law.cohesion(mesh.nodes, mesh.triangles, np.arange(mesh.n_nodes, dtype=np.int64))
         else:
             cohesion = draw_cohesion(mesh.n_elements, rheo.params, rng)
     else:
@@ -435,6 +459,9 @@ def build_model(cfg: dict, validated: bool = False) -> Model:
         bcs.append(VelocityBC(tag, **kw))
     duration = parse_duration(cfg["run"]["duration"], "run.duration")
     parts = components.build(cfg, mesh, state, rheo, duration)
+    law = strength_law(cfg)
+    if law is not None and parts["remesher"] is not None:
+        parts["remesher"].after_remesh.append(law.apply)  # new elements get the strength of their size
     opts = solver_options(cfg)
     solver = cfg["solver"]["name"]
     if cfg["solver"]["device"] == "cuda":  # the explicit stepper on the GPU (validate_config checked both)

@@ -52,10 +52,10 @@ from ..schedule import parse_duration
 from . import checks
 from .config import resolve_hook, time_space_callable
 
-WIND_KINDS = ("uniform", "random", "cyclones", "file", "expression", "function")
+WIND_KINDS = ("uniform", "random", "cyclones", "climatology", "file", "expression", "function")
 OCEAN_KINDS = ("rest", "uniform", "gyre", "file", "expression", "function")
 AIR_KINDS = ("synthetic", "constant", "file", "expression")
-HEAL_LAWS = ("none", "constant", "thermodynamic", "fdd")
+HEAL_LAWS = ("none", "constant", "thermodynamic", "fdd", "nextsim")
 
 
 def time_step_s(cfg: dict) -> float:
@@ -199,7 +199,7 @@ def validate(cfg: dict, duration_s: float) -> None:
     if law not in HEAL_LAWS:
         raise ConfigError(f"healing.law = {law!r}: expected one of {list(HEAL_LAWS)}")
     fc = cfg["forcing"]
-    if law in ("thermodynamic", "fdd") and fc["air_temperature"] is None:
+    if law in ("thermodynamic", "fdd", "nextsim") and fc["air_temperature"] is None:
         raise ConfigError(f"healing.law = {law!r} needs [forcing.air_temperature]")
     if cfg["thermo"]["enabled"] and fc["air_temperature"] is None:
         raise ConfigError("thermo.enabled = true needs [forcing.air_temperature]")
@@ -226,6 +226,8 @@ def validate(cfg: dict, duration_s: float) -> None:
             _constant_air(t)
         elif key == "air_temperature":
             _check_air_kwargs(t, kind, cfg["run"]["start_date"])
+        elif kind == "climatology":
+            _climatology_kwargs(_generator_table(t, key, kind))
         else:
             _check_kwargs(t, key, kind)
         if kind in ("uniform", "random", "cyclones", "gyre", "synthetic"):
@@ -269,6 +271,11 @@ def _check_coriolis(c: dict) -> None:
 
 def _check_healing(cfg: dict) -> None:
     law, params = cfg["healing"]["law"], cfg["healing"]["params"]
+    if law == "nextsim":  # neXtSIM's temperature- and concentration-dependent healing (issue 12)
+        from ..strength import check_nextsim_healing_params
+
+        check_nextsim_healing_params(params)
+        return
     if law not in ("thermodynamic", "fdd"):
         if params:
             raise ConfigError(f"healing.params is set but healing.law = {law!r} takes no parameters "
@@ -297,6 +304,31 @@ def _check_remesh(rm: dict) -> None:
     for k, v in trig.items():
         checks.check_value(f"remesh.params.{k}", v, checks.Spec(checks.NUMBER))
     Remesher(1.0, rm["min_angle_deg"], **params)  # unknown keys and trigger ranges
+
+
+def _climatology_kwargs(t: dict) -> dict:
+    """Keywords of a ``[forcing.wind]`` table of kind ``"climatology"``
+    (:func:`forcing.climatology.climatology_wind`): ``seed``, ``interval_s`` and the
+    :class:`~forcing.climatology.ClimatologyParams` fields, checked before any mesh work
+    (unknown keys and out-of-range values raise ConfigError naming key, value and range)."""
+    from forcing.climatology import ClimatologyParams, make_params
+
+    from ..errors import check_range
+
+    kw = {k: v for k, v in t.items() if k != "kind"}
+    known = {"seed", "interval_s"} | set(ClimatologyParams.__dataclass_fields__)
+    for k in kw:
+        if k not in known:
+            raise ConfigError(f"unknown key forcing.wind.{k} for kind 'climatology'; known keys: {sorted(known)}")
+    if "seed" in kw and (isinstance(kw["seed"], bool) or not isinstance(kw["seed"], int)):
+        raise ConfigError(f"forcing.wind.seed = {kw['seed']!r}: expected an integer")
+    if "interval_s" in kw:
+        check_range("forcing.wind.interval_s", kw["interval_s"], 0.0, 86400.0, low_open=True, unit="s")
+    try:
+        make_params(**{k: v for k, v in kw.items() if k not in ("seed", "interval_s")})
+    except (ConfigError, TypeError) as exc:
+        raise ConfigError(f"forcing.wind (kind 'climatology'): {exc}") from None
+    return kw
 
 
 def _constant_air(t: dict) -> None:
@@ -394,6 +426,12 @@ def build_wind(t: dict, grid, bbox, t_end, seed, crs="EPSG:3413", start_date=Non
         wkw = {k: kw.pop(k) for k in list(kw) if k in inspect.signature(syn.cyclone_wind).parameters}
         cyclones = syn.random_cyclones(bbox, t_end, n, seed=cseed, **kw)
         return syn.cyclone_wind(grid, t_end, cyclones, **wkw)
+    if kind == "climatology":  # winter wind climatology (issue 12, docs/physics.md §1)
+        from forcing.climatology import climatology_wind
+
+        kw = _climatology_kwargs(tt)
+        kw.setdefault("seed", seed)
+        return climatology_wind(grid, t_end, domain_bbox=bbox, **kw)
     if kind == "file":
         return gridded.open_wind(**_file_kw(t, "wind", [gridded.open_wind, gridded.open_gridded], crs, start_date))
     if kind == "function":
@@ -529,6 +567,10 @@ def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
         except TypeError as exc:
             raise ConfigError(f"[healing.params] for law {law!r}: {exc}") from None
         parts["healing"] = HealingComponent(h, air, dt_s=time_step_s(cfg))
+    if law == "nextsim":
+        from ..strength import NextsimHealing, NextsimHealingComponent
+
+        parts["healing"] = NextsimHealingComponent(NextsimHealing(air, **cfg["healing"]["params"]))
     if cfg["lagrangian"]["enabled"]:
         from ..lagrangian import MeshMotion
 

@@ -37,6 +37,8 @@ SCHEMA = {
         "resolution_m": (EXPR, None), "exterior_tag": (str, "coast"),
         "segments": (dict, {}), "rotate_deg": (NUM, 0.0), "renumber": (bool, False),
         "crs": (str, "EPSG:3413"), "file_crs": (str, None),
+        # interior node jitter, a fraction of the local edge length (lagice.mesh.perturb; issue 12)
+        "jitter": (NUM, 0.0),
     },
     "initial": {
         "thickness_m": (EXPR, 1.0), "concentration": (EXPR, 1.0), "damage": (EXPR, 0.0),
@@ -51,6 +53,10 @@ SCHEMA = {
         "max_damage": (NUM, 1.0 - 1e-6),
         "p_star": (NUM, 27.5e3), "c_star": (NUM, 20.0), "ellipse": (NUM, 2.0), "delta_min": (NUM, 2e-9),
         "replacement_pressure": (bool, False),
+        # strength law (lagice.strength; issue 12): "uniform" = cohesion_min/max_pa,
+        # "scaled" = C_lab sqrt(L_lab/dx_e) (1 + disorder U_e) per element (maxwell_eb only)
+        "strength_law": (str, "uniform"), "strength_lab_pa": (NUM, None), "strength_lab_scale_m": (NUM, None),
+        "strength_disorder": (NUM, None),
     },
     "solver": {
         "name": (str, "implicit"), "dt": (EXPR, None), "substeps": (int, None),

@@ -1,0 +1,89 @@
+"""Spun-up initial states: the end of a model run as the start of another (issue 12).
+
+A spin-up run (e.g. ``examples/winter_basin_spinup.toml``: 14 days of the winter wind
+climatology on pristine ice) leaves a heterogeneous, partly damaged pack.
+:func:`save_spinup` keeps its element fields at the last snapshot (centroids,
+damage, thickness, concentration; float32) in a small ``.npz``; the scene hooks
+:func:`winter_basin_damage`, :func:`winter_basin_thickness`,
+:func:`winter_basin_concentration` read ``data_stubs/winter_basin_spinup.npz`` and give
+each new element the value of the nearest spin-up centroid, so they serve any
+resolution (``[initial] damage = "lagice.spinup:winter_basin_damage"``).
+
+    python -m lagice.spinup RUN_DIR OUT.npz        # save the last snapshot of a run
+"""
+from __future__ import annotations
+
+import json
+import sys
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ConfigError
+
+ROOT = Path(__file__).resolve().parents[1]
+WINTER_BASIN = ROOT / "data_stubs" / "winter_basin_spinup.npz"
+FIELDS = ("damage", "thickness", "concentration")
+
+
+def save_spinup(run_dir, out_path) -> Path:
+    """Element centroids and FIELDS of the last snapshot of ``run_dir`` → ``out_path``."""
+    import xarray as xr
+
+    run_dir = Path(run_dir)
+    idx = json.loads((run_dir / "snapshots" / "index.json").read_text())
+    last = idx[-1]
+    with xr.open_dataset(run_dir / "snapshots" / last["file"], decode_times=False) as ds:
+        nodes = np.column_stack([ds["mesh_node_x"].values, ds["mesh_node_y"].values])
+        tri = ds["mesh_face_nodes"].values.astype(np.int64)
+        arrays = {k: ds[k].values[0].astype(np.float32) for k in FIELDS}
+    c = nodes[tri].mean(axis=1)
+    out = Path(out_path)
+    np.savez_compressed(out, centroid_x_m=c[:, 0].astype(np.float32), centroid_y_m=c[:, 1].astype(np.float32),
+                        time_s=np.float64(last["time_s"]), source=str(run_dir.name), **arrays)
+    return out
+
+
+@lru_cache(maxsize=4)
+def _load(path: str):
+    from scipy.spatial import cKDTree
+
+    p = Path(path)
+    if not p.exists():
+        raise ConfigError(f"spin-up state {p} does not exist; make it with "
+                          "`python benchmarks/physics_experiments.py spinup`")
+    z = np.load(p)
+    xy = np.column_stack([z["centroid_x_m"], z["centroid_y_m"]]).astype(np.float64)
+    return cKDTree(xy), {k: z[k].astype(np.float64) for k in FIELDS}
+
+
+def field_from_spinup(path, name, x, y) -> np.ndarray:
+    """Value of spin-up field ``name`` at the nearest spin-up centroid of each (x, y)."""
+    tree, fields = _load(str(path))
+    _, i = tree.query(np.column_stack([np.asarray(x, np.float64), np.asarray(y, np.float64)]))
+    v = fields[name][i]
+    if name == "damage":  # float32 storage may round 0.9999999 up to 1
+        v = np.minimum(v, 1.0 - 1e-6)
+    return v
+
+
+def winter_basin_damage(x, y):
+    """Damage of the winter_basin spin-up (scene hook)."""
+    return field_from_spinup(WINTER_BASIN, "damage", x, y)
+
+
+def winter_basin_thickness(x, y):
+    """Effective thickness [m] of the winter_basin spin-up (scene hook)."""
+    return field_from_spinup(WINTER_BASIN, "thickness", x, y)
+
+
+def winter_basin_concentration(x, y):
+    """Concentration of the winter_basin spin-up (scene hook)."""
+    return np.clip(field_from_spinup(WINTER_BASIN, "concentration", x, y), 0.0, 1.0)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3:
+        raise SystemExit("usage: python -m lagice.spinup RUN_DIR OUT.npz")
+    print(f"wrote {save_spinup(sys.argv[1], sys.argv[2])}")

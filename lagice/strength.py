@@ -1,0 +1,245 @@
+"""Cohesion that scales with element size, plus quenched disorder (issue 12).
+
+Law (neXtSIM, ``model/finiteelement.cpp`` lines 6993–6999 and 3909–3913 at
+``nansencenter/nextsim@7bd58b15``): the cohesion measured on a laboratory sample of
+size L_lab = 0.1 m falls with the scale of observation as
+
+    C_e = C_lab · sqrt(L_lab / Δx_e) · f_e,     Δx_e = sqrt(area_e),
+
+per element, from the element's own size (neXtSIM uses one mean resolution for the
+whole mesh, sqrt of the mean element area; lagice meshes are not uniform, so each
+element uses its own), and f_e = 1 + ``disorder`` · U_e, U_e uniform in [0, 1) is the
+disorder (neXtSIM's ``C_fix + C_alea·U`` with ``C_alea = alea_factor·C_fix``;
+Dansereau et al. 2016's cohesion uniform in [C, 2C] is ``disorder = 1``).
+
+Criterion form. lagice's envelope is Dansereau et al. (2016) eq. 8 in principal
+stresses (tension positive), q σ1 − σ2 ≤ σc, with q = (sqrt(μ²+1) + μ)² and
+σc = 2C/(sqrt(μ²+1) − μ): the Coulomb criterion |τ| + μ σn ≤ C on the most
+critical plane. neXtSIM writes σ_s + tanφ σ_mean ≤ C_N with σ_s = (σ1 − σ2)/2 and
+σ_mean = (σ1 + σ2)/2 (``finiteelement.cpp`` line 4226), i.e. a Coulomb envelope in
+the (σ_mean, σ_s) plane. The two describe the same envelope exactly when
+μ = tanφ/sqrt(1 − tan²φ) and C = C_N/sqrt(1 − tan²φ) (derivation in
+docs/physics.md §2; :func:`from_nextsim`): neXtSIM's tanφ = 0.7 and C_lab = 2 MPa are
+μ = 0.980 and C_lab = 2.80 MPa in lagice's form.
+
+Disorder and remeshing. U_e is a deterministic hash of the run seed and the
+persistent ids of the element's three nodes (``IceState.node_id``). An element that
+survives a remesh keeps its nodes, hence its U_e; a new element gets a fresh,
+independent draw from the same distribution. The disorder is white (uncorrelated
+from element to element), so a fresh draw keeps exactly what characterises it: its
+distribution (mean and spread) and its lack of spatial correlation. Remapping it
+as an area-weighted mean would instead shrink its spread in every remeshed patch
+(averaging several independent values) until the pack became homogeneous. No extra
+field is stored: C is saved with the state, U_e is recomputed from the ids.
+
+After every remesh :meth:`StrengthLaw.apply` sets C of every element from its
+current size and its factor (a hook of the ``remeshing`` component,
+:attr:`lagice.remesh.Remesher.after_remesh`, set by the scene builder). Between
+remeshes C is a material property of the element and is not changed by the
+Lagrangian motion.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import ConfigError, check_range
+
+#: keys of ``[rheology]`` handled here, not by MaxwellEBParams
+RHEOLOGY_KEYS = ("strength_law", "strength_lab_pa", "strength_lab_scale_m", "strength_disorder")
+LAWS = ("uniform", "scaled")
+
+
+def from_nextsim(cohesion_pa: float, tan_phi: float):
+    """(C, μ) of lagice's envelope q σ1 − σ2 ≤ σc that equals neXtSIM's
+    σ_s + tanφ σ_mean ≤ C_N exactly: μ = tanφ/√(1 − tan²φ), C = C_N/√(1 − tan²φ)."""
+    check_range("tan_phi", tan_phi, 0.0, 1.0, high_open=True)
+    check_range("cohesion_pa", cohesion_pa, 0.0, None, unit="Pa")
+    k = math.sqrt(1.0 - tan_phi * tan_phi)
+    return cohesion_pa / k, tan_phi / k
+
+
+def element_size(nodes: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """Δx_e = sqrt(area_e) [m] (neXtSIM's resolution measure, per element)."""
+    p = nodes[triangles]
+    a = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+                     - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
+    return np.sqrt(a)
+
+
+_M1 = np.uint64(0xBF58476D1CE4E5B9)
+_M2 = np.uint64(0x94D049BB133111EB)
+_GOLD = np.uint64(0x9E3779B97F4A7C15)
+
+
+def _mix(z: np.ndarray) -> np.ndarray:
+    """splitmix64 finaliser (Steele, Lea & Flood 2014), vectorised on uint64."""
+    z = z ^ (z >> np.uint64(30))
+    z = z * _M1
+    z = z ^ (z >> np.uint64(27))
+    z = z * _M2
+    return z ^ (z >> np.uint64(31))
+
+
+def element_uniforms(node_id: np.ndarray, triangles: np.ndarray, seed: int) -> np.ndarray:
+    """U_e in [0, 1) per element: a hash of ``seed`` and the sorted persistent ids of
+    the element's nodes (independent of the node order and of the element index)."""
+    if node_id is None:
+        raise ConfigError("the scaled strength law needs persistent node ids (state.node_id is None)")
+    ids = np.sort(np.asarray(node_id, np.int64)[triangles], axis=1).astype(np.uint64)
+    with np.errstate(over="ignore"):
+        h = _mix(np.uint64(int(seed) & 0xFFFFFFFFFFFFFFFF) + _GOLD)
+        for k in range(3):
+            h = _mix(h ^ (ids[:, k] + _GOLD))
+    return (h >> np.uint64(11)).astype(np.float64) * (1.0 / 9007199254740992.0)  # 53-bit mantissa
+
+
+@dataclass(frozen=True)
+class StrengthLaw:
+    """C_e = ``lab_cohesion_pa`` · sqrt(``lab_scale_m``/Δx_e) · (1 + ``disorder`` U_e).
+
+    ``lab_cohesion_pa`` is in lagice's (Dansereau et al. 2016) criterion form; convert
+    neXtSIM's values with :func:`from_nextsim`."""
+
+    lab_cohesion_pa: float = 2.0e6 / math.sqrt(1.0 - 0.49)
+    lab_scale_m: float = 0.1
+    disorder: float = 1.0
+    seed: int = 0
+
+    def __post_init__(self):
+        check_range("rheology.strength_lab_pa", self.lab_cohesion_pa, 1e4, 1e8, unit="Pa")
+        check_range("rheology.strength_lab_scale_m", self.lab_scale_m, 1e-3, 10.0, unit="m")
+        check_range("rheology.strength_disorder", self.disorder, 0.0, 10.0)
+
+    def scale_factor(self, size_m):
+        """sqrt(L_lab/Δx) [-]."""
+        return np.sqrt(self.lab_scale_m / np.asarray(size_m, np.float64))
+
+    def disorder_factor(self, node_id, triangles) -> np.ndarray:
+        """f_e = 1 + disorder · U_e [-]."""
+        return 1.0 + self.disorder * element_uniforms(node_id, triangles, self.seed)
+
+    def cohesion(self, nodes, triangles, node_id) -> np.ndarray:
+        """C_e [Pa] of every element from its size and its disorder factor."""
+        return (self.lab_cohesion_pa * self.scale_factor(element_size(nodes, triangles))
+                * self.disorder_factor(node_id, triangles))
+
+    def apply(self, state) -> None:
+        """Set ``state.cohesion`` of every element from its current size (after a remesh)."""
+        m = state.mesh
+        state.cohesion = self.cohesion(m.nodes, m.triangles, state.node_id)
+
+
+def from_config(rheology: dict, seed: int) -> StrengthLaw | None:
+    """The strength law of a scene's ``[rheology]`` table (None for ``"uniform"``:
+    cohesion uniform in [cohesion_min_pa, cohesion_max_pa], the default). Raises
+    ConfigError naming key, value and range; called before any mesh work."""
+    law = rheology.get("strength_law", "uniform")
+    if law not in LAWS:
+        raise ConfigError(f"rheology.strength_law = {law!r}: expected one of {list(LAWS)}")
+    if law == "uniform":
+        for k in RHEOLOGY_KEYS[1:4]:
+            if rheology.get(k) is not None:
+                raise ConfigError(f"rheology.{k} is set but rheology.strength_law = 'uniform'; "
+                                  "set strength_law = 'scaled' to use it")
+        return None
+    kw = {"seed": int(seed)}
+    for key, name in (("strength_lab_pa", "lab_cohesion_pa"), ("strength_lab_scale_m", "lab_scale_m"),
+                      ("strength_disorder", "disorder")):
+        if rheology.get(key) is not None:
+            kw[name] = rheology[key]
+    return StrengthLaw(**kw)
+
+
+class NextsimHealing:
+    """Healing tied to the ice temperature and the concentration, as in neXtSIM
+    (``finiteelement.cpp`` lines 4256–4257 and 5856–5876; ``options.cpp`` 329–331):
+
+        H = exp(−c*(1 − A)) / T_h,   T_h = th0 · ΔT0 / ΔT,
+        ΔT = (Tf − Ta)⁺ / (1 + ki hs / (ks h))   (no healing at or above freezing),
+
+    th0 = 25 days, ΔT0 = 20 K (``dynamics.time_relaxation_damage``,
+    ``dynamics.deltaT_relaxation_damage``), c* = 20 (lagice's ``concentration_c``,
+    neXtSIM's ``compaction_param`` = −20). ΔT is the temperature difference across the
+    ice: neXtSIM takes it from its thermodynamics (bottom minus snow–ice interface);
+    lagice's zero-layer ice has a linear profile through snow and ice in series with the
+    surface at the air temperature, which gives the formula above (ki, ks, Tf of
+    ``thermo.zero_layer.ThermoParams``). Thin snow-free ice heals as
+    th0 ΔT0/(Tf − Ta); open, low-concentration ice heals slowly (e^(−20·0.08) = 0.2 at
+    A = 0.92). Returns the rate [s-1] per element for the solver's d ← d − H dt.
+    """
+
+    def __init__(self, air_temperature, th0_s=25.0 * 86400.0, delta_t0_k=20.0, concentration_c=20.0,
+                 freezing_point_c=-1.8, conductivity_ice_w_m_k=2.0, conductivity_snow_w_m_k=0.31):
+        from forcing.base import SCALAR, as_field
+
+        self.air_temperature = as_field(air_temperature, SCALAR, "degC")
+        if self.air_temperature is None:
+            raise ConfigError("healing.law = 'nextsim' needs [forcing.air_temperature]")
+        self.th0_s = check_range("healing.params.th0_s", th0_s, 0.0, None, low_open=True, unit="s")
+        self.delta_t0_k = check_range("healing.params.delta_t0_k", delta_t0_k, 0.0, None, low_open=True, unit="K")
+        self.concentration_c = check_range("healing.params.concentration_c", concentration_c, 0.0, 100.0)
+        self.freezing_point_c = check_range("healing.params.freezing_point_c", freezing_point_c, -10.0, 0.0,
+                                            unit="degC")
+        self.ki = check_range("healing.params.conductivity_ice_w_m_k", conductivity_ice_w_m_k, 0.0, None,
+                              low_open=True)
+        self.ks = check_range("healing.params.conductivity_snow_w_m_k", conductivity_snow_w_m_k, 0.0, None,
+                              low_open=True)
+
+    def rate(self, air_temperature_c, thickness_m, concentration, snow_m=None):
+        """H [s-1] per element."""
+        h = np.maximum(np.asarray(thickness_m, np.float64), 1e-6)
+        hs = 0.0 if snow_m is None else np.asarray(snow_m, np.float64)
+        dT = np.maximum(self.freezing_point_c - np.asarray(air_temperature_c, np.float64), 0.0)
+        dT = dT / (1.0 + self.ki * hs / (self.ks * h))
+        return np.exp(-self.concentration_c * (1.0 - np.asarray(concentration, np.float64))) * dT / (
+            self.th0_s * self.delta_t0_k)
+
+    def element_rate(self, state, t_s):
+        """H [s-1] per element of ``state`` at time ``t_s`` [s] (air temperature at the centroids)."""
+        c = state.mesh.centroids()
+        ta = self.air_temperature.evaluate(t_s, np.ascontiguousarray(c[:, 0]), np.ascontiguousarray(c[:, 1]))
+        return self.rate(ta, state.thickness, state.concentration, state.snow)
+
+
+class NextsimHealingComponent:
+    """Component ``healing`` of :class:`lagice.model.Model` with :class:`NextsimHealing`
+    (``[healing] law = "nextsim"``): :meth:`rate` gives the stepper's per-element rate
+    for d ← max(0, d − H dt). It holds no state of its own."""
+
+    name = "healing"
+
+    def __init__(self, law: NextsimHealing):
+        self.law = law
+
+    def rate(self, state, t_s):
+        return self.law.element_rate(state, t_s)
+
+    __call__ = rate
+
+    def advance(self, model, dt_s):
+        """Nothing to advance: the stepper applies :meth:`rate` in its damage update."""
+        return None
+
+    def checkpoint_state(self):
+        return {}, {}
+
+    def restore(self, arrays, meta):
+        pass
+
+
+#: keyword parameters of ``[healing.params]`` for ``law = "nextsim"``
+NEXTSIM_HEALING_PARAMS = ("th0_s", "delta_t0_k", "concentration_c", "freezing_point_c", "conductivity_ice_w_m_k",
+                          "conductivity_snow_w_m_k")
+
+
+def check_nextsim_healing_params(params: dict) -> None:
+    """``[healing.params]`` of the nextsim law: unknown keys and out-of-range values raise
+    ConfigError naming key, value and range (before any mesh work)."""
+    for k in params:
+        if k not in NEXTSIM_HEALING_PARAMS:
+            raise ConfigError(f"unknown key healing.params.{k} for healing.law = 'nextsim'; known keys: "
+                              f"{sorted(NEXTSIM_HEALING_PARAMS)}")
+    NextsimHealing(-20.0, **params)

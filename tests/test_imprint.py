@@ -1,0 +1,190 @@
+"""Mesh-imprint metric (lagice/diagnostics/imprint.py): chance level on isotropic
+fractures, ≈ 1 on fractures drawn along mesh edges, the rotation test."""
+import numpy as np
+import pytest
+
+from lagice.diagnostics.imprint import (
+    fracture_orientations,
+    imprint_index,
+    imprint_summary,
+    mesh_directions,
+    mesh_edges,
+    orientation_shift_deg,
+)
+from lagice.mesh import generate_mesh, rectangle_domain
+
+H = 5e3
+
+
+@pytest.fixture(scope="module")
+def lattice_mesh():
+    """gmsh frontal-Delaunay mesh of a 300 km square at 5 km: a near-lattice."""
+    poly, segs = rectangle_domain(300e3, 300e3)
+    return generate_mesh(poly, H, segments=segs)
+
+
+def _centroids(m):
+    return m.nodes[m.triangles].mean(axis=1)
+
+
+def _line_field(m, lines, half_width):
+    """1 on the elements whose centroid is within half_width of one of the segments
+    (x0, y0, angle_deg, length), else 0."""
+    c = _centroids(m)
+    f = np.zeros(len(c))
+    for x0, y0, ang, ln in lines:
+        t = np.radians(ang)
+        d = c - [x0, y0]
+        along = d[:, 0] * np.cos(t) + d[:, 1] * np.sin(t)
+        across = -d[:, 0] * np.sin(t) + d[:, 1] * np.cos(t)
+        f[(np.abs(across) <= half_width) & (np.abs(along) <= 0.5 * ln)] = 1.0
+    return f
+
+
+def test_gmsh_mesh_is_lattice_like(lattice_mesh):
+    """The issue's observation: most of gmsh's edge length lies within ±7.5° of three
+    directions 60° apart."""
+    md = mesh_directions(lattice_mesh.nodes, lattice_mesh.triangles)
+    d = np.sort(md.directions_deg)
+    assert md.lattice_fraction > 0.8
+    gaps = np.diff(np.concatenate([d, [d[0] + 180.0]]))
+    np.testing.assert_allclose(gaps, 60.0, atol=3.0)
+
+
+def test_isotropic_fractures_give_chance(lattice_mesh):
+    """Straight bands of uniformly random directions: index ≈ 0 (|index| < 0.12)."""
+    rng = np.random.default_rng(1)
+    lines = [(rng.uniform(30e3, 270e3), rng.uniform(30e3, 270e3), rng.uniform(0, 180), 80e3) for _ in range(120)]
+    idx = []
+    for k in range(0, 120, 20):
+        f = _line_field(lattice_mesh, lines[k:k + 20], 0.6 * H)
+        s = imprint_summary(lattice_mesh.nodes, lattice_mesh.triangles, f, radius_m=4 * H, threshold=0.5)
+        idx.append(s["index"])
+    assert abs(np.mean(idx)) < 0.12, idx
+    assert s["chance"] == pytest.approx(0.25, abs=0.01)
+
+
+def test_recovers_band_directions(lattice_mesh):
+    """A single band at 15° (between lattice directions) is measured at 15° ± 3°."""
+    f = _line_field(lattice_mesh, [(150e3, 150e3, 15.0, 200e3)], 0.6 * H)
+    fo = fracture_orientations(_centroids(lattice_mesh), f, 4 * H, threshold=0.5)
+    assert fo.angles_deg.size > 20
+    assert np.median(fo.angles_deg) == pytest.approx(15.0, abs=3.0)
+
+
+def _edge_chains(m, directions, n_chains, steps, rng):
+    """Chains of mesh edges, each following one lattice direction: from a random node,
+    repeatedly take the incident edge closest to the direction (within 12°)."""
+    e = mesh_edges(m.triangles)
+    nbr = [[] for _ in range(m.n_nodes)]
+    for a, b in e:
+        nbr[a].append(b)
+        nbr[b].append(a)
+    chains = []
+    for _ in range(n_chains):
+        d = np.radians(rng.choice(directions))
+        u = np.array([np.cos(d), np.sin(d)])
+        i = int(rng.integers(m.n_nodes))
+        for _ in range(steps):
+            js = np.array(nbr[i])
+            v = m.nodes[js] - m.nodes[i]
+            cos = v @ u / np.hypot(v[:, 0], v[:, 1])
+            k = int(np.argmax(cos))
+            if cos[k] < np.cos(np.radians(12.0)):
+                break
+            chains.append((i, int(js[k])))
+            i = int(js[k])
+    return chains
+
+
+def test_fractures_along_mesh_edges_give_one(lattice_mesh):
+    """Bands made of the elements on both sides of chains of mesh edges along the
+    lattice directions: index ≈ 1 (> 0.8). (Where bands cross, the local direction is
+    a mix: a dense network of crossing mesh-aligned bands scores lower.)"""
+    m = lattice_mesh
+    md = mesh_directions(m.nodes, m.triangles)
+    chains = _edge_chains(m, md.directions_deg, 12, 25, np.random.default_rng(2))
+    f = np.zeros(m.n_elements)
+    tri = np.sort(m.triangles, axis=1)
+    for a, b in chains:
+        a, b = min(a, b), max(a, b)
+        on = ((tri[:, 0] == a) | (tri[:, 1] == a) | (tri[:, 2] == a)) & \
+             ((tri[:, 0] == b) | (tri[:, 1] == b) | (tri[:, 2] == b))
+        f[on] = 1.0
+    s = imprint_summary(m.nodes, m.triangles, f, radius_m=3 * H, threshold=0.5)
+    assert s["n_segments"] > 200
+    assert s["index"] > 0.8, s["index"]
+
+
+def test_rotation_shift():
+    """The rotation test's estimator: a direction histogram rotated by 20° is found
+    shifted by 20°; an unrotated one by 0°."""
+    rng = np.random.default_rng(3)
+    a = np.concatenate([rng.normal(40, 4, 500), rng.normal(130, 4, 300)]) % 180
+    w = np.ones_like(a)
+    assert orientation_shift_deg(a, w, (a + 20) % 180, w)["shift_deg"] == pytest.approx(20.0, abs=2.5)
+    b = np.concatenate([rng.normal(40, 4, 500), rng.normal(130, 4, 300)]) % 180
+    assert orientation_shift_deg(a, w, b, w)["shift_deg"] == pytest.approx(0.0, abs=2.5)
+
+
+def test_index_definition():
+    """Hand values: three 15° windows cover a quarter of the directions; all in → 1."""
+    dirs = [0.0, 60.0, 120.0]
+    r = imprint_index([1.0, 59.0, 125.0, 178.0], np.ones(4), dirs)
+    assert r["chance"] == pytest.approx(0.25, abs=1e-3) and r["index"] == pytest.approx(1.0)
+    r = imprint_index([30.0, 90.0, 150.0, 30.0], np.ones(4), dirs)
+    assert r["index"] == pytest.approx(-1.0 / 3.0, abs=1e-3)
+
+
+# -- mesh options of the imprint experiments (lagice/mesh/perturb.py) ---------------------
+def test_rotated_disk_mesh_keeps_its_boundary():
+    """The disk scene's mesh rotated by 15° (``[domain] rotate_deg``): same elements,
+    lattice directions turned by 15°, boundary nodes still on the 1°-vertex coast."""
+    import shapely
+
+    from lagice.scenes.builder import build_mesh
+    from lagice.scenes.config import load_scene
+
+    cfg0 = load_scene("imprint_cyclone_disk", {"domain.resolution_m": 30e3})
+    cfg1 = load_scene("imprint_cyclone_disk", {"domain.resolution_m": 30e3, "domain.rotate_deg": 15.0})
+    (m, poly), (r, _) = build_mesh(cfg0), build_mesh(cfg1)
+    np.testing.assert_allclose(np.abs(r.areas()), np.abs(m.areas()), rtol=1e-9)
+    d0 = np.sort(mesh_directions(m.nodes, m.triangles).directions_deg)
+    d1 = np.sort(mesh_directions(r.nodes, r.triangles).directions_deg)
+    shift = (d1[:, None] - d0[None, :] + 90.0) % 180.0 - 90.0
+    assert np.min(np.abs(shift - 15.0)) < 1.5
+    b = np.unique(r.boundary_edges)
+    assert shapely.distance(shapely.points(r.nodes[b]), poly.boundary).max() < 1e-6 * np.sqrt(poly.area)
+
+
+def test_jitter_breaks_the_lattice_and_keeps_the_mesh_valid(lattice_mesh):
+    """jitter 0.3: every triangle positive with angles >= 15° (or no worse than before),
+    boundary nodes unmoved, and the lattice fraction of edge length falls."""
+    from lagice.mesh import angles_deg
+    from lagice.mesh.perturb import jitter_mesh
+
+    j = jitter_mesh(lattice_mesh, 0.3, seed=5)
+    assert np.all(j.areas() > 0)
+    a0 = angles_deg(lattice_mesh.nodes, lattice_mesh.triangles).min(axis=1)
+    a1 = angles_deg(j.nodes, j.triangles).min(axis=1)
+    assert np.all((a1 >= 15.0) | (a1 >= 0.999 * a0))
+    b = np.unique(lattice_mesh.boundary_edges)
+    np.testing.assert_array_equal(j.nodes[b], lattice_mesh.nodes[b])
+    moved = np.hypot(*(j.nodes - lattice_mesh.nodes).T)
+    assert np.mean(moved > 0) > 0.8 and moved.max() <= 0.3 * 1.3 * H
+    f0 = mesh_directions(lattice_mesh.nodes, lattice_mesh.triangles).lattice_fraction
+    f1 = mesh_directions(j.nodes, j.triangles).lattice_fraction
+    assert f0 > 0.85 and f1 < 0.6
+
+
+def test_bad_jitter_fails_before_meshing(monkeypatch):
+    from lagice.errors import ConfigError
+    from lagice.scenes import builder
+    from lagice.scenes.config import load_scene
+
+    def boom(*a, **k):
+        raise AssertionError("meshing must not start")
+
+    monkeypatch.setattr(builder, "generate_mesh", boom)
+    with pytest.raises(ConfigError, match=r"domain.jitter = 0.6 is out of range; expected a value in \[0, 0.45\]"):
+        builder.build_model(load_scene("imprint_cyclone_disk", {"domain.jitter": 0.6}))

@@ -1,0 +1,228 @@
+"""Strength law scaled with element size (lagice/strength.py): the neXtSIM scaling,
+the exact conversion of neXtSIM's criterion to lagice's, disorder, remeshing, and
+parameter checks before any mesh work."""
+import math
+
+import numpy as np
+import pytest
+
+from lagice.errors import ConfigError
+from lagice.mesh import generate_mesh, rectangle_domain
+from lagice.rheology import dcrit
+from lagice.strength import StrengthLaw, element_size, element_uniforms, from_config, from_nextsim
+
+
+def _mesh(size):
+    poly, segs = rectangle_domain(200e3, 200e3)
+    return generate_mesh(poly, size, segments=segs)
+
+
+def test_cohesion_follows_the_size_scaling():
+    """Without disorder C·sqrt(Δx) is the same constant C_lab·sqrt(L_lab) on a 10 km and
+    a 40 km mesh (every element, exactly), so C at 40 km is half of C at 10 km for
+    elements 4 times as large."""
+    law = StrengthLaw(lab_cohesion_pa=2.8e6, disorder=0.0)
+    for size in (10e3, 40e3):
+        m = _mesh(size)
+        c = law.cohesion(m.nodes, m.triangles, np.arange(m.n_nodes))
+        dx = element_size(m.nodes, m.triangles)
+        np.testing.assert_allclose(c * np.sqrt(dx), 2.8e6 * math.sqrt(0.1), rtol=1e-12)
+    assert law.cohesion(np.array([[0, 0], [4e4, 0], [0, 1e4]], float), np.array([[0, 1, 2]]), np.arange(3))[0] \
+        == pytest.approx(0.5 * law.cohesion(np.array([[0, 0], [1e4, 0], [0, 2.5e3]], float), np.array([[0, 1, 2]]),
+                                            np.arange(3))[0], rel=1e-12)
+
+
+def test_nextsim_values():
+    """neXtSIM: C_fix = C_lab sqrt(0.1/res) with C_lab = 2 MPa (options.cpp:319,
+    finiteelement.cpp:6996-6997): 6.32 kPa at res = 10 km; in lagice's form with
+    tanφ = 0.7 that is C = 6.32/sqrt(0.51) = 8.86 kPa and μ = 0.980."""
+    c_n = 2e6 * math.sqrt(0.1 / 10e3)
+    assert c_n == pytest.approx(6324.6, rel=1e-4)
+    c, mu = from_nextsim(c_n, 0.7)
+    assert c == pytest.approx(8856.2, rel=1e-4)
+    assert mu == pytest.approx(0.98020, rel=1e-4)
+
+
+def test_conversion_gives_the_same_envelope():
+    """With (C, μ) = from_nextsim(C_N, tanφ), lagice's d_crit (Dansereau et al. 2016
+    eq. 8) equals neXtSIM's C_N/(σ_s + tanφ σ_mean) for every stress state outside the
+    envelope with σ2 ≤ 0 (compression–shear and uniaxial tension)."""
+    rng = np.random.default_rng(4)
+    c_n, tphi = 7.8e3, 0.7
+    c, mu = from_nextsim(c_n, tphi)
+    s1 = rng.uniform(-30e3, 15e3, 20000)
+    s2 = s1 - rng.uniform(0.0, 80e3, 20000)
+    keep = s2 <= 0.0
+    s1, s2 = s1[keep], s2[keep]
+    th = rng.uniform(0, np.pi, s1.size)  # rotate the principal axes: the criteria are isotropic
+    cs, sn = np.cos(th), np.sin(th)
+    sig = np.column_stack([s1 * cs**2 + s2 * sn**2, s1 * sn**2 + s2 * cs**2, (s1 - s2) * cs * sn])
+    nx = c_n / (0.5 * (s1 - s2) + tphi * 0.5 * (s1 + s2))
+    outside = (nx > 0) & (nx < 1)
+    assert outside.sum() > 1000
+    np.testing.assert_allclose(dcrit(sig[outside], c, mu), nx[outside], rtol=1e-9)
+    # inside neXtSIM's envelope is inside lagice's
+    inside = (nx >= 1) | (nx < 0)
+    assert np.all(dcrit(sig[inside], c, mu) == 1.0)
+
+
+def test_disorder_factor_distribution_and_ids():
+    """U_e is uniform in [0, 1), depends only on the seed and the set of node ids
+    (not their order or the element index)."""
+    tri = np.random.default_rng(0).integers(0, 10**6, size=(20000, 3))
+    ids = np.arange(10**6)
+    u = element_uniforms(ids, tri, 3)
+    assert 0.0 <= u.min() and u.max() < 1.0
+    assert abs(u.mean() - 0.5) < 0.01 and abs(u.std() - math.sqrt(1 / 12)) < 0.005
+    np.testing.assert_array_equal(u, element_uniforms(ids, tri[:, [2, 0, 1]], 3))
+    np.testing.assert_array_equal(u[::-1], element_uniforms(ids, tri[::-1], 3))
+    assert not np.allclose(u, element_uniforms(ids, tri, 4))
+
+
+def test_after_a_remesh_every_element_carries_the_strength_of_its_size():
+    """winter_basin_pack at 60 km (a coast-refined mesh whose element sizes vary),
+    interior distorted, then a global remesh through the model's ``remeshing``
+    component and its strength hook: afterwards every element has
+    C = C_lab sqrt(L/Δx_e) f_e for its own current size, kept elements keep their
+    disorder factor, and the new ones draw factors from the same distribution."""
+    from lagice.scenes.builder import build_model
+    from lagice.scenes.config import load_scene
+
+    model = build_model(load_scene("winter_basin_pack", {"domain.resolution_m": 60e3, "run.duration": "1h",
+                                                         "solver.dt": "1h"}))
+    st = model.state
+    law = from_config(model.config["rheology"], model.config["run"]["seed"])
+    m = st.mesh
+    f_before = st.cohesion / (law.lab_cohesion_pa * law.scale_factor(element_size(m.nodes, m.triangles)))
+    inner = np.ones(m.n_nodes, bool)
+    inner[np.unique(m.boundary_edges)] = False
+    m.nodes[inner, 0] += 8e3 * np.sin(m.nodes[inner, 1] / 80e3)
+    rem = model.component("remeshing")
+    assert any(getattr(f, "__self__", None) == law for f in rem.after_remesh)  # the scene's law is the hook
+    rem.options["force_global"] = True
+    ev = rem.advance(model, 3600.0)
+    assert ev is not None and ev.kind == "global"
+    nm = st.mesh
+    dx = element_size(nm.nodes, nm.triangles)
+    f = law.disorder_factor(st.node_id, nm.triangles)
+    np.testing.assert_allclose(st.cohesion, 2.8e6 * np.sqrt(0.1 / dx) * f, rtol=1e-12)
+    assert dx.max() / dx.min() > 2.0  # sizes really differ
+    k0 = len(ev.kept_elements)
+    np.testing.assert_allclose(f[:k0], f_before[ev.kept_elements], rtol=1e-12)
+    new = f[k0:]
+    assert new.size > 100 and 1.0 <= new.min() and new.max() < 2.0
+    assert abs(new.mean() - 1.5) < 0.06  # same distribution: mean 1.5, std 0.289
+    assert abs(new.std() - math.sqrt(1 / 12)) < 0.04
+
+
+@pytest.mark.parametrize("key,value,fragment", [
+    ("strength_lab_pa", 5.0, "rheology.strength_lab_pa = 5.0 Pa is out of range; expected a value in [10000, 1e+08]"),
+    ("strength_disorder", -0.5, "rheology.strength_disorder = -0.5 is out of range; expected a value in [0, 10]"),
+    ("strength_lab_scale_m", 100.0, "rheology.strength_lab_scale_m = 100.0 m is out of range"),
+    ("strength_law", "weird", "rheology.strength_law = 'weird': expected one of ['uniform', 'scaled']"),
+])
+def test_bad_strength_parameters_fail_before_meshing(monkeypatch, key, value, fragment):
+    from lagice.scenes import builder, config
+
+    def boom(*a, **k):
+        raise AssertionError("meshing must not start")
+
+    monkeypatch.setattr(builder, "generate_mesh", boom)
+    cfg = config.load_scene("winter_basin_pack", {f"rheology.{key}": value})
+    with pytest.raises(ConfigError) as exc:
+        builder.build_model(cfg)
+    assert fragment in str(exc.value)
+
+
+def test_unknown_law_and_orphan_keys():
+    with pytest.raises(ConfigError, match="strength_law = 'weird'"):
+        from_config({"strength_law": "weird"}, 0)
+    with pytest.raises(ConfigError, match="strength_disorder is set but rheology.strength_law = 'uniform'"):
+        from_config({"strength_law": "uniform", "strength_disorder": 0.5}, 0)
+    assert from_config({"strength_law": "uniform"}, 0) is None
+
+
+def test_scene_uses_the_law():
+    """winter_basin at 40 km with strength_law = "scaled": the initial cohesion is the
+    law's, element by element."""
+    from lagice.scenes import builder, config
+
+    cfg = config.load_scene("winter_basin", {"rheology.strength_law": "scaled", "rheology.strength_disorder": 0.5,
+                                             "domain.resolution_m": 40e3, "run.duration": "6h"})
+    model = builder.build_model(cfg)
+    st = model.state
+    law = from_config(cfg["rheology"], cfg["run"]["seed"])
+    np.testing.assert_allclose(st.cohesion, law.cohesion(st.mesh.nodes, st.mesh.triangles, st.node_id), rtol=1e-12)
+    dx = element_size(st.mesh.nodes, st.mesh.triangles)
+    c = st.cohesion / law.disorder_factor(st.node_id, st.mesh.triangles)
+    np.testing.assert_allclose(c * np.sqrt(dx), law.lab_cohesion_pa * math.sqrt(0.1), rtol=1e-12)
+    assert dx.max() / dx.min() > 2.0  # a non-uniform mesh: each element has its own C
+
+
+def test_scaled_strength_needs_the_maxwell_eb_rheology():
+    from lagice.scenes import builder, config
+
+    cfg = config.load_scene("winter_basin_pack", {"rheology.law": "viscous_plastic", "solver.name": "evp",
+                                                  "healing.law": "none", "solver.dt": "30min"})
+    with pytest.raises(ConfigError, match="strength_law = 'scaled' applies to rheology.law = 'maxwell_eb' only"):
+        builder.validate_config(cfg)
+
+
+def test_nextsim_healing_rate():
+    """neXtSIM healing: H = e^(−20(1 − A)) ΔT/(th0 ΔT0), ΔT = (Tf − Ta)/(1 + ki hs/(ks h)):
+    th0 = 25 d at ΔT = 20 K for compact snow-free ice; snow and low concentration slow it;
+    none at or above freezing."""
+    from lagice.strength import NextsimHealing
+
+    h = NextsimHealing(-21.8)
+    day = 86400.0
+    r = h.rate(np.array([-21.8, -21.8, -21.8, 0.0]), np.array([1.0, 1.0, 1.0, 1.0]), np.array([1.0, 1.0, 0.9, 1.0]),
+               np.array([0.0, 0.31, 0.0, 0.0]))
+    assert r[0] == pytest.approx(1.0 / (25 * day), rel=1e-12)
+    assert r[1] == pytest.approx(1.0 / (25 * day) / (1.0 + 2.0), rel=1e-12)  # ki hs/(ks h) = 2
+    assert r[2] == pytest.approx(np.exp(-2.0) / (25 * day), rel=1e-12)
+    assert r[3] == 0.0
+    with pytest.raises(ConfigError, match="healing.params.th0_s"):
+        NextsimHealing(-20.0, th0_s=-1.0)
+
+
+@pytest.mark.parametrize("params,fragment", [
+    ({"th0_s": -1.0}, "healing.params.th0_s = -1.0 s is out of range"),
+    ({"concentration_c": 500.0}, "healing.params.concentration_c = 500.0 is out of range; expected a value in "
+                                 "[0, 100]"),
+    ({"half_life": 3.0}, "unknown key healing.params.half_life for healing.law = 'nextsim'"),
+])
+def test_bad_nextsim_healing_fails_before_meshing(monkeypatch, params, fragment):
+    from lagice.scenes import builder, config
+
+    def boom(*a, **k):
+        raise AssertionError("meshing must not start")
+
+    monkeypatch.setattr(builder, "generate_mesh", boom)
+    cfg = config.load_scene("winter_basin_pack", {"healing.params": params})
+    with pytest.raises(ConfigError) as exc:
+        builder.build_model(cfg)
+    assert fragment in str(exc.value)
+
+
+def test_nextsim_healing_component_in_the_model():
+    """[healing] law = "nextsim": the model's healing component gives the stepper
+    NextsimHealing's rate at the element centroids (air temperature, thickness,
+    concentration and snow of the state)."""
+    from lagice.scenes import builder, config
+    from lagice.strength import NextsimHealingComponent
+
+    model = builder.build_model(config.load_scene("winter_basin_pack", {"domain.resolution_m": 60e3,
+                                                                        "run.duration": "1h", "solver.dt": "1h"}))
+    comp = model.component("healing")
+    assert isinstance(comp, NextsimHealingComponent)
+    st = model.state
+    c = st.mesh.centroids()
+    ta = comp.law.air_temperature.evaluate(3600.0, np.ascontiguousarray(c[:, 0]), np.ascontiguousarray(c[:, 1]))
+    assert np.all(ta < -1.8)  # January air: every element heals
+    r = comp.rate(st, 3600.0)
+    hs = st.snow
+    expect = (np.exp(-20.0 * (1.0 - st.concentration)) * (-1.8 - ta) / (1.0 + 2.0 * hs / (0.31 * st.thickness))
+              / (25 * 86400.0 * 20.0))
+    np.testing.assert_allclose(r, expect, rtol=1e-12)
+    assert model.stepper.heal_rate == comp.rate
