@@ -159,13 +159,19 @@ def test_scene_uses_the_law():
     assert dx.max() / dx.min() > 2.0  # a non-uniform mesh: each element has its own C
 
 
-def test_scaled_strength_needs_the_maxwell_eb_rheology():
+def test_strength_law_is_a_maxwell_eb_key():
+    """The EVP comparison of the flagship scene: the viscous-plastic rheology has no
+    cohesion, so the scene's strength law is not used (as cohesion_min/max_pa), but its
+    values are still checked."""
     from lagice.scenes import builder, config
 
-    cfg = config.load_scene("winter_basin_pack", {"rheology.law": "viscous_plastic", "solver.name": "evp",
-                                                  "healing.law": "none", "solver.dt": "30min"})
-    with pytest.raises(ConfigError, match="strength_law = 'scaled' applies to rheology.law = 'maxwell_eb' only"):
-        builder.validate_config(cfg)
+    evp = {"rheology.law": "viscous_plastic", "solver.name": "evp", "healing.law": "none", "solver.dt": "30min"}
+    cfg = config.load_scene("winter_basin_pack", evp)
+    builder.validate_config(cfg)
+    assert builder.strength_law(cfg) is None
+    assert builder.strength_law(config.load_scene("winter_basin_pack")) is not None
+    with pytest.raises(ConfigError, match="rheology.strength_lab_pa = 5.0 Pa is out of range"):
+        builder.validate_config(config.load_scene("winter_basin_pack", {**evp, "rheology.strength_lab_pa": 5.0}))
 
 
 def test_nextsim_healing_rate():

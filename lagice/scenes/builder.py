@@ -221,15 +221,14 @@ def build_mesh(cfg: dict):
 
 def strength_law(cfg: dict):
     """The scene's strength law (:class:`lagice.strength.StrengthLaw`), or None for the
-    uniform draw in [cohesion_min_pa, cohesion_max_pa]; keys checked (ConfigError
-    naming key, value and range) before any mesh work."""
+    uniform draw in [cohesion_min_pa, cohesion_max_pa] (and for rheologies without
+    cohesion); keys checked (ConfigError naming key, value and range) before any mesh work."""
     from .. import strength
 
     law = strength.from_config(cfg["rheology"], cfg["run"]["seed"])
-    if law is not None and cfg["rheology"]["law"] != "maxwell_eb":
-        raise ConfigError(f"rheology.strength_law = 'scaled' applies to rheology.law = 'maxwell_eb' only "
-                          f"(rheology.law is {cfg['rheology']['law']!r})")
-    return law
+    # like cohesion_min/max_pa, the strength law is a Maxwell-EB key: the viscous-plastic
+    # rheology (EVP comparison runs of the same scene) has no cohesion and does not use it
+    return law if cfg["rheology"]["law"] == "maxwell_eb" else None
 
 
 def build_rheology(cfg: dict):

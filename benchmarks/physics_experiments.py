@@ -1,0 +1,214 @@
+"""The flagship runs of issue 12 (docs/physics.md §4): the recommended parameter set
+(``examples/winter_basin_pack.toml``) at 10 km for 28 days, closed basin and strait,
+the EVP comparison and the ±50 % sensitivity runs (strength, air drag, wind scale).
+
+Every experiment is a ``lagice run`` subprocess of a bundled scene (scene builder +
+Simulation, the production path) with ``--set`` overrides, analysed exactly as
+``benchmarks/validate.py`` does (:func:`lagice.diagnostics.window_statistics`: Lagrangian
+3-day windows from day 1, elements ≥ 100 km from the coast, medians over the windows),
+plus the mean total deformation rate, the remesh count and drift distances (mean and
+largest displacement of the nodes that exist at the start and at the end).
+
+    python benchmarks/physics_experiments.py list
+    python benchmarks/physics_experiments.py run F10 F10s ...     # one after the other
+    python benchmarks/physics_experiments.py analyse F10 ...      # re-analyse finished runs
+    python benchmarks/physics_experiments.py table                # markdown table of all results
+    python benchmarks/physics_experiments.py spinup               # remake data_stubs/winter_basin_spinup.npz
+
+Runs go to ``benchmarks/out/physics/NAME`` (logs NAME.log); results accumulate in
+``benchmarks/out/physics/experiments.json`` and ``docs/figures/physics_experiments.json``.
+Use ``NUMBA_NUM_THREADS=1`` and at most two runs at a time on a shared 2-core host.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shlex
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+OUT = ROOT / "benchmarks" / "out" / "physics"
+DAY = 86400.0
+#: observed ranges (issue 12; sources in benchmarks/validate.py TARGETS)
+TARGETS = {"beta_space": (0.17, 0.20), "pdf_tail_exponent_shear": (1.9, 2.5),
+           "pdf_tail_exponent_divergence": (2.2, 2.8), "localisation_half_shear_area_fraction": (0.04, 0.08),
+           "shear_divergence_r2": (0.73, 0.93), "mean_total_deformation_rate_per_day": (0.01, 0.05)}
+SHORT = {"beta_space": "β", "pdf_tail_exponent_shear": "tail sh", "pdf_tail_exponent_divergence": "tail div",
+         "localisation_half_shear_area_fraction": "half-shear area", "shear_divergence_r2": "R²",
+         "mean_total_deformation_rate_per_day": "⟨ε̇tot⟩ d⁻¹"}
+SCENES = {"closed": "winter_basin_pack", "strait": "winter_basin_pack_strait"}
+#: the EVP comparison rheology on the same scene (as benchmarks/validate.py)
+EVP = ["solver.name=evp", "rheology.law=viscous_plastic", "healing.law=none", "solver.dt=30min",
+       "solver.substeps=300"]
+
+#: name -> (scene, overrides, resolution_m, days, what it is)
+EXPERIMENTS = {
+    "F10": ("closed", [], 10e3, 28, "recommended set, closed basin, 10 km (flagship)"),
+    "F10s": ("strait", [], 10e3, 28, "recommended set, strait, 10 km (flagship)"),
+    "E10": ("closed", EVP, 10e3, 28, "EVP, same scene and forcing, closed, 10 km"),
+    "E10s": ("strait", EVP, 10e3, 28, "EVP, same scene and forcing, strait, 10 km"),
+    "E20": ("closed", EVP, 20e3, 28, "EVP, same scene and forcing, closed, 20 km"),
+    "E20s": ("strait", EVP, 20e3, 28, "EVP, same scene and forcing, strait, 20 km"),
+    "S20": ("closed", [], 20e3, 28, "recommended set, closed basin, 20 km (sensitivity baseline)"),
+    "X-str-50": ("closed", ["rheology.strength_lab_pa=1.4e6"], 20e3, 28, "strength −50 %"),
+    "X-str+50": ("closed", ["rheology.strength_lab_pa=4.2e6"], 20e3, 28, "strength +50 %"),
+    "X-drag-50": ("closed", ["forcing.drag.air_drag=1.0e-3"], 20e3, 28, "air drag −50 %"),
+    "X-drag+50": ("closed", ["forcing.drag.air_drag=3.0e-3"], 20e3, 28, "air drag +50 %"),
+    "X-wind-50": ("closed", ["forcing.wind.wind_scale=0.5"], 20e3, 28, "winds ×0.5"),
+    "X-wind+50": ("closed", ["forcing.wind.wind_scale=1.5"], 20e3, 28, "winds ×1.5"),
+}
+
+
+def command(scene, overrides, res, days, out) -> list:
+    sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
+            "run.progress=false", "checkpoint.every=7d", *overrides]
+    cmd = [sys.executable, "-m", "lagice.cli", "run", str(ROOT / "examples" / f"{SCENES[scene]}.toml"),
+           "--out", str(out)]
+    for s in sets:
+        cmd += ["--set", s]
+    return cmd
+
+
+def drift(run: Path, days: float) -> dict:
+    """Mean and largest displacement [km] over the run of the nodes present at its start
+    and its end (followed through remeshing by their ids)."""
+    from lagice.io.snapshots import load_window
+
+    w = load_window(run, 0.0, days * DAY)
+    d = np.hypot(*(w["xy1"] - w["xy0"]).T) / 1e3
+    moving = d > 0
+    return {"mean_km": float(d[moving].mean()) if moving.any() else 0.0,
+            "max_km": float(d.max()) if d.size else 0.0, "days": days}
+
+
+def analyse(name: str, run: Path, days: float, buffer_m: float = 100e3) -> dict:
+    """Window statistics of one run (as benchmarks/validate.py), drift, remeshing, wall time."""
+    from validate import analyse_run
+
+    r = analyse_run(run, days, buffer_m)
+    med = dict(r["median"])
+    rates = [w["interior"]["mean_total_s"] * DAY for w in r["windows"]]
+    med["mean_total_deformation_rate_per_day"] = float(np.mean(rates)) if rates else float("nan")
+    summ = json.loads((run / "summary.json").read_text()) if (run / "summary.json").exists() else {}
+    return {"name": name, "median": med, "min": r["min"], "max": r["max"],
+            "window_rates_per_day": rates, "remesh_events": r["remesh_events"],
+            "remesh_count": summ.get("remesh_count", r["remesh_events"]), "wall_s": r["wall_s"],
+            "outflow_m3": r["outflow_m3"], "mean_speed_m_s": float(np.mean(r["mean_speed_m_s"][1:])),
+            "drift": drift(run, days),
+            "per_window": [{k: w["interior"][k] for k in ("beta_space", "pdf_tail_exponent_shear",
+                                                           "pdf_tail_exponent_divergence",
+                                                           "localisation_half_shear_area_fraction",
+                                                           "shear_divergence_r2", "mean_total_s")}
+                           | {"start_day": w["start_day"]} for w in r["windows"]],
+            "inside": {k: bool(TARGETS[k][0] <= med[k] <= TARGETS[k][1]) for k in TARGETS}}
+
+
+def _store(res: dict):
+    OUT.mkdir(parents=True, exist_ok=True)
+    p = OUT / "experiments.json"
+    allr = json.loads(p.read_text()) if p.exists() else {}
+    allr[res["name"]] = res
+    p.write_text(json.dumps(allr, indent=1, default=float))
+    (ROOT / "docs" / "figures").mkdir(parents=True, exist_ok=True)
+    (ROOT / "docs" / "figures" / "physics_experiments.json").write_text(json.dumps(allr, indent=1, default=float))
+
+
+def git_commit() -> str:
+    try:
+        return subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True,
+                              check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def run_experiment(name: str, force: bool = False, run: bool = True) -> dict:
+    scene, overrides, res, days, what = EXPERIMENTS[name]
+    out = OUT / name
+    cmd = command(scene, overrides, res, days, out)
+    if run and (force or not (out / "summary.json").exists()):
+        OUT.mkdir(parents=True, exist_ok=True)
+        t0 = time.perf_counter()
+        print(f"physics: run {name}: {what}", flush=True)
+        with open(OUT / f"{name}.log", "w") as log:
+            log.write(f"# git {git_commit()}\n" + " ".join(cmd) + "\n")
+            log.flush()
+            p = subprocess.run(cmd + (["--overwrite"] if out.exists() else []), stdout=log,
+                               stderr=subprocess.STDOUT, cwd=ROOT, check=False,
+                               env={**os.environ, "NUMBA_NUM_THREADS": os.environ.get("NUMBA_NUM_THREADS", "1")})
+        if p.returncode != 0:
+            raise SystemExit(f"physics: {name} failed; log {OUT / (name + '.log')}")
+        print(f"physics: {name} done in {time.perf_counter() - t0:.0f} s", flush=True)
+    r = analyse(name, out, days)
+    command_line = "NUMBA_NUM_THREADS=1 lagice run " + " ".join(shlex.quote(str(c)) for c in cmd[4:])
+    r.update({"scene": SCENES[scene], "overrides": overrides, "resolution_m": res, "days": days, "what": what,
+              "command": command_line.replace(str(ROOT) + "/", "")})
+    _store(r)
+    print(row(r), flush=True)
+    return r
+
+
+def row(r: dict) -> str:
+    m = r["median"]
+    cells = []
+    for k in TARGETS:
+        v = m[k]
+        mark = " ✓" if r["inside"][k] else ""
+        cells.append(f"{100 * v:.1f} %{mark}" if k == "localisation_half_shear_area_fraction" else f"{v:.3g}{mark}")
+    return (f"| {r['name']} | {r['what']} | " + " | ".join(cells)
+            + f" | {r['remesh_count']} | {r['drift']['mean_km']:.0f} / {r['drift']['max_km']:.0f} | "
+              f"{(r['wall_s'] or 0):.0f} |")
+
+
+def table() -> str:
+    p = OUT / "experiments.json"
+    allr = json.loads(p.read_text()) if p.exists() else {}
+    lines = ["| run | settings | " + " | ".join(SHORT[k] for k in TARGETS)
+             + " | remeshes | drift mean / max (km) | wall (s) |",
+             "|---|---|" + "---|" * (len(TARGETS) + 3),
+             "| | observed | 0.17–0.20 | 1.9–2.5 | 2.2–2.8 | 4–8 % | 0.73–0.93 | 0.01–0.05 | | | |"]
+    lines += [row(allr[n]) for n in EXPERIMENTS if n in allr]
+    return "\n".join(lines)
+
+
+def spinup(days=14, res=10e3):
+    """The spin-up: ``examples/winter_basin_spinup.toml`` (pristine ice, seed 2025) for
+    ``days``, then its last snapshot → data_stubs/winter_basin_spinup.npz."""
+    from lagice.spinup import WINTER_BASIN, save_spinup
+
+    out = OUT / "spinup"
+    cmd = [sys.executable, "-m", "lagice.cli", "run", str(ROOT / "examples" / "winter_basin_spinup.toml"), "--out",
+           str(out), "--set", f"run.duration={days:g}d", "--set", f"domain.resolution_m={res:g}"]
+    print("physics: spin-up: " + " ".join(cmd), flush=True)
+    subprocess.run(cmd + (["--overwrite"] if out.exists() else []), check=True, cwd=ROOT)
+    print(f"physics: wrote {save_spinup(out, WINTER_BASIN)}")
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("what", choices=("list", "run", "table", "spinup", "analyse"))
+    ap.add_argument("names", nargs="*")
+    ap.add_argument("--force", action="store_true", help="run again even if the run finished")
+    args = ap.parse_args(argv)
+    if args.what == "list":
+        for k, (sc, ov, res, days, what) in EXPERIMENTS.items():
+            print(f"{k}: {SCENES[sc]} {res / 1e3:g} km {days} d: {what}\n    {' '.join(ov)}")
+    elif args.what in ("run", "analyse"):
+        for n in args.names:
+            if n not in EXPERIMENTS:
+                raise SystemExit(f"physics: unknown experiment {n!r}; known: {list(EXPERIMENTS)}")
+            run_experiment(n, force=args.force, run=args.what == "run")
+    elif args.what == "spinup":
+        spinup()
+    else:
+        print(table())
+
+
+if __name__ == "__main__":
+    main()
