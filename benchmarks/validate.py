@@ -1,11 +1,12 @@
 """Validation report: deformation statistics of Maxwell-EB and EVP against
-observed sea-ice statistics (GitHub issue 7; seeds 000, 001, 004).
+observed sea-ice statistics (GitHub issues 7 and 12; seeds 000, 001, 004).
 
 Two experiments:
 
-1. **winter basin**, 10 km, 28 days: ``examples/winter_basin.toml`` (closed)
-   and ``examples/winter_basin_strait.toml`` (the same basin with an open strait),
-   each run with Maxwell-EB (the scene's explicit solver) and with the EVP
+1. **winter basin**, 10 km, 28 days: the flagship ``examples/winter_basin_pack.toml``
+   (closed; issue 12: wind climatology, size-scaled strength, neXtSIM healing, spun-up
+   pack; docs/physics.md) and ``examples/winter_basin_pack_strait.toml`` (the same basin
+   with an open strait), each run with Maxwell-EB (the scene's explicit solver) and with the EVP
    comparison rheology (``solver.name = "evp"``, ``rheology.law = "viscous_plastic"``, no
    healing) on the same mesh and forcing.
    The runs are ``lagice run`` subprocesses (scene builder + Simulation, two at a
@@ -17,8 +18,10 @@ Two experiments:
    function ``lagice diagnose RUN --window-days 3 --start-day 1`` uses. Per window: β
    of the spatial coarse-graining, ML tail exponents of the shear and |divergence|
    PDFs, localisation (area holding half of the shear), shear–|divergence| R²; the
-   report gives medians and [min, max] over the windows. ``--sensitivity`` adds Maxwell-EB runs of the closed basin with
-   another α (``SENSITIVITY``), reported apart.
+   report gives medians and [min, max] over the windows, and the mean total
+   deformation rate ⟨ε̇tot⟩ (median over the windows). ``--sensitivity`` adds
+   Maxwell-EB runs of the closed basin with strength, air drag or wind scale ±50 %
+   (``SENSITIVITY``, 20 km), reported apart.
 2. **uniaxial compression** (seed 004 §4–5, N = 40; scene builder + Simulation,
    recorded by a callback activity): the macroscopic stress of every step, the
    damage and the transport velocity averaged over blocks of N steps (an elastic
@@ -37,6 +40,8 @@ model misses") is placed into the report.
     python benchmarks/validate.py --sensitivity    # full: ~35 min + ~20 min sensitivity on 2 cores
     python benchmarks/validate.py --quick          # 4-day basins at 20 km, N = 20 compression (~3 min)
     python benchmarks/validate.py --analyse-only   # re-analyse the runs already in --out
+    python benchmarks/validate.py --analyse-only --from-physics --evp-km 20
+        # analyse the runs of benchmarks/physics_experiments.py (F10, F10s, E20, E20s, S20, X-*)
 
 Writes ``--out`` (default ``benchmarks/out/validate``: runs, logs, the full
 ``validation.json``), ``docs/validation.md``, ``docs/figures/validation_*.png``
@@ -64,9 +69,10 @@ from lagice.io.snapshots import read_index
 
 ROOT = Path(__file__).resolve().parents[1]
 #: basin scenes: the shipped closed basin and its variant with an open strait
-SCENES = {"closed": ROOT / "examples" / "winter_basin.toml",
-          "strait": ROOT / "examples" / "winter_basin_strait.toml"}
-SCENE_LABELS = {"closed": "closed basin (winter_basin)", "strait": "basin with an open strait (winter_basin_strait)"}
+SCENES = {"closed": ROOT / "examples" / "winter_basin_pack.toml",
+          "strait": ROOT / "examples" / "winter_basin_pack_strait.toml"}
+SCENE_LABELS = {"closed": "closed basin (winter_basin_pack)",
+                "strait": "basin with an open strait (winter_basin_pack_strait)"}
 DAY = 86400.0
 
 #: observed values and the band counted as "inside"; (low, high, source, note)
@@ -79,20 +85,39 @@ TARGETS = {
     "localisation_half_shear_area_fraction": (0.04, 0.08, "RGPS 10 km: 6 % (seed 000; EB 4 %, VP > 20 %)",
                                               "±2 points is ours"),
     "shear_divergence_r2": (0.73, 0.93, "RGPS: 0.83 (seed 000; EB 0.77, VP 0.58)", "±0.1 is ours"),
+    "mean_total_deformation_rate_per_day": (0.01, 0.05, "RGPS winter, 10 km, 3 days: about 0.01–0.05 day⁻¹ "
+                                            "(seed 001 ch. 2)", "band from the issue"),
 }
+#: metrics window_statistics computes (the rate is its mean_total_s, converted to day⁻¹)
+WINDOW_TARGETS = tuple(k for k in TARGETS if k != "mean_total_deformation_rate_per_day")
 LABELS = {
     "beta_space": "β, ⟨ε̇tot⟩ ∝ L^−β (3-day window)",
     "pdf_tail_exponent_divergence": "PDF tail exponent, \\|divergence\\|",
     "pdf_tail_exponent_shear": "PDF tail exponent, shear",
     "localisation_half_shear_area_fraction": "area holding half of the shear",
     "shear_divergence_r2": "shear–\\|divergence\\| R²",
+    "mean_total_deformation_rate_per_day": "⟨ε̇tot⟩ (day⁻¹)",
 }
 #: Maxwell-EB sensitivity runs (``--sensitivity``): the closed basin with one parameter
 #: changed, reported apart from the headline and not used to pick any value
 SENSITIVITY = {
-    "alpha5": ("closed", ["rheology.alpha=5"], "α = 5 (neXtSIM BBM value, DESIGN §9)"),
-    "alpha7": ("closed", ["rheology.alpha=7"], "α = 7 (the largest α seed 004 §3.1.5 keeps memory effects for)"),
+    "base": ("closed", [], "recommended set at 20 km (the reference of the ±50 % runs)"),
+    "strength-50": ("closed", ["rheology.strength_lab_pa=1.4e6"], "strength −50 % (C_lab 1.4 MPa)"),
+    "strength+50": ("closed", ["rheology.strength_lab_pa=4.2e6"], "strength +50 % (C_lab 4.2 MPa)"),
+    "drag-50": ("closed", ["forcing.drag.air_drag=1.0e-3"], "air drag −50 % (1.0e-3)"),
+    "drag+50": ("closed", ["forcing.drag.air_drag=3.0e-3"], "air drag +50 % (3.0e-3)"),
+    "wind-50": ("closed", ["forcing.wind.wind_scale=0.5"], "winds ×0.5"),
+    "wind+50": ("closed", ["forcing.wind.wind_scale=1.5"], "winds ×1.5"),
 }
+#: resolution of the sensitivity runs [m]
+SENSITIVITY_RESOLUTION_M = 20e3
+#: the runs of benchmarks/physics_experiments.py that --from-physics analyses
+#: (``{evp}``: E10/E20 by --evp-km)
+PHYSICS_RUNS = {"closed_maxwell_eb": "F10", "strait_maxwell_eb": "F10s", "closed_evp": "E{evp}",
+                "strait_evp": "E{evp}s", "sensitivity_base": "S20", "sensitivity_strength-50": "X-str-50",
+                "sensitivity_strength+50": "X-str+50", "sensitivity_drag-50": "X-drag-50",
+                "sensitivity_drag+50": "X-drag+50", "sensitivity_wind-50": "X-wind-50",
+                "sensitivity_wind+50": "X-wind+50"}
 RHEOLOGIES = {
     "maxwell_eb": {"label": "Maxwell-EB", "overrides": []},
     "evp": {"label": "EVP (mEVP, Hibler ellipse)",
@@ -119,8 +144,8 @@ def basin_commands(out: Path, days: float, resolution_m: float | None):
 
 
 def sensitivity_commands(out: Path, days: float, resolution_m: float | None):
-    return {f"sensitivity_{name}": _run_command(SCENES[scene], out / f"sensitivity_{name}", days, resolution_m,
-                                                sets)
+    return {f"sensitivity_{name}": _run_command(SCENES[scene], out / f"sensitivity_{name}", days,
+                                                resolution_m or SENSITIVITY_RESOLUTION_M, sets)
             for name, (scene, sets, _) in SENSITIVITY.items()}
 
 
@@ -129,7 +154,11 @@ def analyse_run(run: Path, days: float, buffer_m: float, window_days: float = 3.
     median, min and max over the windows) and the run's wall time, remeshing, outflow
     and mean speeds."""
     ws = window_statistics(run, window_days=window_days, coast_buffer_km=buffer_m / 1e3, start_day=spinup_days,
-                           end_day=days, metrics=tuple(TARGETS), keep_arrays=True)
+                           end_day=days, metrics=WINDOW_TARGETS + ("mean_total_s",), keep_arrays=True)
+    for part in ("median", "min", "max", "median_all_elements"):
+        v = ws[part].pop("mean_total_s")
+        ws[part]["mean_total_deformation_rate_per_day"] = None if v is None else v * DAY
+    cfg = json.loads((run / "lagice_run.json").read_text()) if (run / "lagice_run.json").exists() else {}
     for s in ws["skipped"]:
         print(f"validate: {run.name}: {s['reason']}", flush=True)
     idx = read_index(run)
@@ -140,11 +169,84 @@ def analyse_run(run: Path, days: float, buffer_m: float, window_days: float = 3.
             "outflow_m3": summary.get("volume_budget", {}).get("outflow_m3"),
             "mean_speed_m_s": mean_speeds(run),
             "median": ws["median"], "min": ws["min"], "max": ws["max"],
-            "median_all_elements": ws["median_all_elements"]}
+            "median_all_elements": ws["median_all_elements"],
+            "mean_total_deformation_rate_per_day": ws["median"]["mean_total_deformation_rate_per_day"],
+            "resolution_m": run_resolution_m(run), "run_command": cfg.get("command"), "run_dir": str(run),
+            "drift_km": drift_km(run, days)}
 
 
-def analyse_basin(out: Path, scene: str, days: float, buffer_m: float):
-    return {key: analyse_run(out / f"{scene}_{key}", days, buffer_m) for key in RHEOLOGIES}
+def run_resolution_m(run: Path):
+    """The ``domain.resolution_m`` a run used (from its newest checkpoint's config; None if unknown)."""
+    ck = sorted((run / "checkpoints").glob("*.npz")) if (run / "checkpoints").exists() else []
+    if not ck:
+        return None
+    from lagice.simulation import load_checkpoint
+
+    return load_checkpoint(ck[-1])[2]["config"]["domain"]["resolution_m"]
+
+
+def drift_km(run: Path, days: float) -> dict:
+    """Mean and largest displacement [km] over the run of the nodes present at its start
+    and its end (followed through remeshing by their ids)."""
+    from lagice.io.snapshots import load_window
+
+    w = load_window(run, 0.0, days * DAY)
+    d = np.hypot(*(w["xy1"] - w["xy0"]).T) / 1e3
+    moving = d > 0
+    return {"mean": float(d[moving].mean()) if moving.any() else 0.0, "max": float(d.max()) if d.size else 0.0}
+
+
+def run_dir(out: Path, name: str, physics: Path | None = None, evp_km: float = 10.0) -> Path:
+    """The folder of run ``name`` (``closed_maxwell_eb``, ``sensitivity_wind+50``...): in
+    ``out``, or with ``physics`` the run of benchmarks/physics_experiments.py (PHYSICS_RUNS)."""
+    if physics is None:
+        return out / name
+    return physics / PHYSICS_RUNS[name].format(evp=f"{evp_km:g}")
+
+
+def analyse_basin(out: Path, scene: str, days: float, buffer_m: float, physics=None, evp_km=10.0):
+    return {key: analyse_run(run_dir(out, f"{scene}_{key}", physics, evp_km), days, buffer_m) for key in RHEOLOGIES}
+
+
+def git_commit() -> dict:
+    """HEAD of the repository and whether the work tree differs from it (tracked files)."""
+    def git(*a):
+        return subprocess.run(["git", *a], cwd=ROOT, capture_output=True, text=True, check=False).stdout.strip()
+
+    return {"commit": git("rev-parse", "HEAD"), "dirty": bool(git("status", "--porcelain", "--untracked-files=no"))}
+
+
+def basin_imprint(run: Path, days: float, buffer_m: float) -> dict:
+    """Mesh-imprint metric (lagice.diagnostics.imprint, docs/physics.md §3) of a basin run:
+    the fracture directions of the top decile of the shear rate of the last 3-day window
+    (Lagrangian, elements away from the coast) against the directions of the mesh at the
+    window start; and of the damage ≥ 0.9 of the last snapshot."""
+    from lagice.diagnostics.imprint import imprint_summary
+    from lagice.io.snapshots import load_window
+
+    w = load_window(run, (days - 3.0) * DAY, days * DAY)
+    from lagice.diagnostics import lagrangian_velocity_gradients
+    from lagice.diagnostics.faults import interior_triangles
+
+    rates = lagrangian_velocity_gradients(w["xy0"], w["xy1"], w["triangles"], w["dt_s"])
+    keep = interior_triangles(w["xy0"], w["triangles"], buffer_m)
+    shear = np.where(keep, rates.shear_s, 0.0)
+    out = {"shear_top_decile_last_window": _imprint_public(imprint_summary(w["xy0"], w["triangles"], shear,
+                                                                           quantile=0.9))}
+    import xarray as xr
+
+    idx = read_index(run)
+    with xr.open_dataset(run / "snapshots" / idx[-1]["file"], decode_times=False) as ds:
+        nodes = np.column_stack([ds["mesh_node_x"].values, ds["mesh_node_y"].values])
+        tri = ds["mesh_face_nodes"].values.astype(np.int64)
+        d = ds["damage"].values[0].copy()
+    out["damage_ge_0.9_last_snapshot"] = _imprint_public(imprint_summary(nodes, tri, d, threshold=0.9))
+    out["damaged_fraction_ge_0.9"] = float(np.mean(d >= 0.9))
+    return out
+
+
+def _imprint_public(s: dict) -> dict:
+    return {k: v for k, v in s.items() if not k.startswith("_")}
 
 
 def mean_speeds(run_dir: Path) -> list:
@@ -356,8 +458,9 @@ def figures_basin(basin: dict, fig_dir: Path, scene: str) -> list[Path]:
         ax.axhspan(lo, hi, color="0.85", label="observed band")
         for key, r in basin.items():
             days = [w["end_day"] for w in r["windows"]]
-            ax.plot(days, [w["interior"][k] for w in r["windows"]], "o-", color=colours[key],
-                    label=RHEOLOGIES[key]["label"])
+            vals = [w["interior"]["mean_total_s"] * DAY if k == "mean_total_deformation_rate_per_day"
+                    else w["interior"][k] for w in r["windows"]]
+            ax.plot(days, vals, "o-", color=colours[key], label=RHEOLOGIES[key]["label"])
         ax.set_title(LABELS[k].replace("\\|", "|"), fontsize=8)
         ax.set_xlabel("window end (day)")
         ax.grid(True, alpha=0.3)
@@ -436,6 +539,8 @@ def _inside(k, v):
     miss = lo - v if v < lo else v - hi
     if k == "localisation_half_shear_area_fraction":
         return f"misses by {100 * miss:.1f} points"
+    if k == "mean_total_deformation_rate_per_day":
+        return f"misses by {miss:.2g} ({v / (lo if v < lo else hi):.2g}× the band edge)"
     return f"misses by {miss:.2f}"
 
 
@@ -448,39 +553,46 @@ def _fmt(k, v):
         return "n/a"
     if k == "localisation_half_shear_area_fraction":
         return f"{100 * v:.1f} %"
+    if k == "mean_total_deformation_rate_per_day":
+        return f"{v:.2g}"
     return f"{v:.2f}"
 
 
+def _res_km(r: dict) -> str:
+    return "?" if r.get("resolution_m") is None else f"{r['resolution_m'] / 1e3:g} km"
+
+
 def _basin_section(scene: str, b: dict, res: dict, figs: list[Path]) -> list[str]:
-    e, v = b["maxwell_eb"], b["evp"]
-    lines = [f"## {SCENE_LABELS[scene][0].upper() + SCENE_LABELS[scene][1:]}: Maxwell-EB against EVP", "",
-             "| metric | observed | band used | Maxwell-EB | EVP | Maxwell-EB | EVP |",
-             "|---|---|---|---|---|---|---|"]
+    keys = [k for k in RHEOLOGIES if k in b]
+    labels = [f"{RHEOLOGIES[k]['label']} ({_res_km(b[k])})" for k in keys]
+    lines = [f"## {SCENE_LABELS[scene][0].upper() + SCENE_LABELS[scene][1:]}: "
+             + " against ".join(RHEOLOGIES[k]["label"] for k in keys), "",
+             "| metric | observed | band used | " + " | ".join(labels) + " | " + " | ".join(labels) + " |",
+             "|---|---|---|" + "---|" * (2 * len(keys))]
     for k, (lo, hi, src, note) in TARGETS.items():
         band = f"{_fmt(k, lo)}–{_fmt(k, hi)}"
-        lines.append(f"| {LABELS[k]} | {src} | {band} ({note}) | {_fmt(k, e['median'][k])} "
-                     f"[{_fmt(k, e['min'][k])}, {_fmt(k, e['max'][k])}] | {_fmt(k, v['median'][k])} "
-                     f"[{_fmt(k, v['min'][k])}, {_fmt(k, v['max'][k])}] | {_inside(k, e['median'][k])} | "
-                     f"{_inside(k, v['median'][k])} |")
-    mt = {key: np.mean([w["interior"]["mean_total_s"] for w in r["windows"]]) * DAY for key, r in b.items()}
-    ms = {key: np.mean(r["mean_speed_m_s"][1:]) for key, r in b.items()}
-    lines += ["", f"Mean over the windows of ⟨ε̇tot⟩ at 10 km: Maxwell-EB "
-              f"{mt['maxwell_eb']:.2g} day⁻¹, EVP {mt['evp']:.2g} day⁻¹ (RGPS winter: about 0.01–0.05 day⁻¹ at "
-              f"10 km, seed 001 ch. 2). Mean ice speed: Maxwell-EB {ms['maxwell_eb']:.2g} m s⁻¹, EVP "
-              f"{ms['evp']:.2g} m s⁻¹. Ice exported: Maxwell-EB {(e['outflow_m3'] or 0) / 1e9:.3g} km³, "
-              f"EVP {(v['outflow_m3'] or 0) / 1e9:.3g} km³. Remesh events: {e['remesh_events']} and "
-              f"{v['remesh_events']}. Run wall time: {e['wall_s'] or float('nan'):.0f} s and "
-              f"{v['wall_s'] or float('nan'):.0f} s.", "",
-              "The same statistics on all elements (coastal shear zones included), medians over the windows:", "",
-              "| metric | Maxwell-EB | EVP |", "|---|---|---|"]
+        cells = [f"{_fmt(k, b[r]['median'][k])} [{_fmt(k, b[r]['min'][k])}, {_fmt(k, b[r]['max'][k])}]"
+                 for r in keys]
+        lines.append(f"| {LABELS[k]} | {src} | {band} ({note}) | " + " | ".join(cells) + " | "
+                     + " | ".join(_inside(k, b[r]["median"][k]) for r in keys) + " |")
+    lines.append("")
+    for r in keys:
+        x = b[r]
+        lines.append(f"* {RHEOLOGIES[r]['label']} at {_res_km(x)}: mean ice speed "
+                     f"{np.mean(x['mean_speed_m_s'][1:]):.2g} m s⁻¹; drift of the nodes over the run "
+                     f"{x['drift_km']['mean']:.0f} km on average, "
+                     f"{x['drift_km']['max']:.0f} km at most; ice exported {(x['outflow_m3'] or 0) / 1e9:.3g} km³; "
+                     f"remesh events {x['remesh_events']}; run wall time {x['wall_s'] or float('nan'):.0f} s "
+                     f"(NUMBA_NUM_THREADS=1, two runs at a time on the shared 2-core host).")
+    lines += ["", "The same statistics on all elements (coastal shear zones included), medians over the windows:", "",
+              "| metric | " + " | ".join(labels) + " |", "|---|" + "---|" * len(keys)]
     for k in TARGETS:
-        lines.append(f"| {LABELS[k]} | {_fmt(k, e['median_all_elements'][k])} | "
-                     f"{_fmt(k, v['median_all_elements'][k])} |")
+        lines.append(f"| {LABELS[k]} | " + " | ".join(_fmt(k, b[r]['median_all_elements'][k]) for r in keys) + " |")
     lines += ["", "Per window (elements away from the coast; elements of remeshed patches left out):", "",
               "| rheology | days | elements (left out) | β | tail shear | tail \\|div\\| | half-shear area | R² | "
               "⟨ε̇tot⟩ (day⁻¹) |", "|---|---|---|---|---|---|---|---|---|"]
-    for key, r in b.items():
-        for w in r["windows"]:
+    for key in keys:
+        for w in b[key]["windows"]:
             i = w["interior"]
             lines.append(f"| {RHEOLOGIES[key]['label']} | {w['start_day']:.0f}–{w['end_day']:.0f} | "
                          f"{w['n_elements']} ({w['n_elements_lost']}) | {i['beta_space']:.3f} ± "
@@ -495,46 +607,92 @@ def _basin_section(scene: str, b: dict, res: dict, figs: list[Path]) -> list[str
     return lines
 
 
+def headline(res: dict) -> list[str]:
+    """The README headline table: the flagship Maxwell-EB runs (and EVP) against the bands."""
+    cols = [(s, k) for s in SCENES for k in RHEOLOGIES if k in res["basin"].get(s, {})]
+    head = [f"{RHEOLOGIES[k]['label']}, {s} ({_res_km(res['basin'][s][k])})" for s, k in cols]
+    lines = ["| metric (median of 3-day windows) | observed | " + " | ".join(head) + " |",
+             "|---|---|" + "---|" * len(cols)]
+    for m, (lo, hi, _src, _n) in TARGETS.items():
+        cells = []
+        for s, k in cols:
+            v = res["basin"][s][k]["median"][m]
+            cells.append(_fmt(m, v) + (" ✓" if v is not None and np.isfinite(v) and lo <= v <= hi else " ✗"))
+        lines.append(f"| {LABELS[m]} | {_fmt(m, lo)}–{_fmt(m, hi)} | " + " | ".join(cells) + " |")
+    lines.append("| remesh events | | " + " | ".join(str(res["basin"][s][k]["remesh_events"]) for s, k in cols) + " |")
+    lines.append("| mean / largest drift (km) | tens of km | " + " | ".join(
+        f"{res['basin'][s][k]['drift_km']['mean']:.0f} / {res['basin'][s][k]['drift_km']['max']:.0f}"
+        for s, k in cols) + " |")
+    return lines
+
+
 def write_report(res: dict, md: Path, figs: dict):
-    lines = ["# Validation report: deformation statistics against observations (issue 7)", "",
-             f"Written by `python benchmarks/validate.py{' --quick' if res['quick'] else ''} --sensitivity` "
-             f"on {res['date']} (two runs at a time on the 2-core host; the wall time of each run is in its "
-             f"section). Method: `docs/diagnostics.md`; all numbers in `{res['json']}`.", ""]
+    cmd = "python benchmarks/validate.py" + (" --quick" if res["quick"] else "") + (
+        f" --analyse-only --from-physics --evp-km {res['evp_km']:g}" if res.get("from_physics") else " --sensitivity")
+    lines = ["# Validation report: deformation statistics against observations (issues 7 and 12)", "",
+             f"Written by `{cmd}` on {res['date']} from the code of commit `{res['git_commit']['commit'][:10]}`"
+             f"{' (work tree modified)' if res['git_commit']['dirty'] else ''}. Method: `docs/diagnostics.md`, "
+             f"physics: `docs/physics.md`; all numbers in `{res['json']}`.", "",
+             "## Headline (for README)", "", "Flagship scene `winter_basin_pack` (one parameter set, docs/physics.md "
+             "§4), 28 days; ✓ inside the observed band, ✗ outside:", ""]
+    lines += headline(res) + [""]
     lines += res.get("summary", []) + [""]
     lines += ["## Set-up", "",
-              f"* Basin runs: `examples/winter_basin.toml` (closed basin) and `examples/winter_basin_strait.toml` "
-              f"(the same basin with a 140 km open strait on the east coast), {res['basin_days']:g} days at "
-              f"{res['resolution_km']:g} km with their shipped settings: Maxwell-EB with the explicit solver, "
-              f"cohesion 10–20 kPa (seeds 000/001), thermodynamic healing; EVP on the same mesh with the same "
-              f"forcing, thermodynamics and mesh motion, `solver.name = \"evp\"`, Δt = 30 min, 300 mEVP iterations "
-              f"(`docs/evp.md`). The cyclone schedule is drawn for the run length, so all "
-              f"four runs see the same winds.",
+              f"* Basin runs: `examples/winter_basin_pack.toml` (closed basin) and "
+              f"`examples/winter_basin_pack_strait.toml` (the same basin with a 140 km open strait on the east coast), "
+              f"{res['basin_days']:g} days, with the recommended parameter set of `docs/physics.md` §4: "
+              f"Maxwell-EB with the explicit solver, the winter wind climatology with the air drag of ERA5-like winds "
+              f"(2.0e-3), neXtSIM's strength scaled with each element's size (converted to lagice's criterion, "
+              f"friction 0.98), neXtSIM's healing law, 25 cm of snow, starting from a spun-up pack. EVP on the same "
+              f"scene (mesh generator, forcing, thermodynamics, mesh motion), `solver.name = \"evp\"`, Δt = 30 "
+              f"min, 300 mEVP iterations (`docs/evp.md`). The wind climatology is drawn record by record from the "
+              f"seed, so every run sees the same winds.",
               f"* Deformation as RGPS measures it: Lagrangian rates from the node displacements over back-to-back "
               f"3-day windows from day 1 on (the first day is spin-up), nodes followed through remeshing by their "
               f"ids (`load_window`), on the elements ≥ {res['coast_buffer_km']:g} km from the coast (seed 000 "
               f"used 150 km in the whole Arctic; this basin is about 3 times smaller).",
-              "* Values in the tables: median over the windows (a window in which the ice hardly moves gives "
-              "degenerate values, and the median is not pulled by one such window), [min, max] in brackets. "
+              "* Values in the tables: median over the windows, [min, max] in brackets. "
               "The bands are the seeds' "
               "observed values; where a seed gives one number, the width of the band is ours and is stated.",
               "* No parameter was tuned to any metric.", ""]
     for scene, b in res["basin"].items():
-        lines += _basin_section(scene, b, res, figs[scene])
+        lines += _basin_section(scene, b, res, figs.get(scene, []))
     if res.get("sensitivity"):
-        base = res["basin"]["closed"]["maxwell_eb"]
-        lines += ["## Sensitivity of Maxwell-EB to α (closed basin; not a calibration)", "",
-                  "α sets how fast the Maxwell viscosity η ∝ (1 − d)^α of damaged ice falls with damage. "
-                  "These runs change α alone and are reported for what they show; no value was chosen from them.",
+        lines += [f"## Sensitivity of Maxwell-EB to strength, air drag and wind scale (±50 %, closed basin, "
+                  f"{SENSITIVITY_RESOLUTION_M / 1e3:g} km; not a calibration)", "",
+                  "Each run changes one value of the recommended set by ±50 %; they are reported for what they show "
+                  "and no value was chosen from them.",
                   "", "| run | " + " | ".join(LABELS[k] for k in TARGETS)
-                  + " | median ⟨ε̇tot⟩ (day⁻¹) | mean speed (m s⁻¹) |",
+                  + " | remesh events | mean speed (m s⁻¹) |",
                   "|---|" + "---|" * (len(TARGETS) + 2)]
-        rows = [("α = 4 (shipped, seed 004)", base)] + [(SENSITIVITY[n][2], r) for n, r in res["sensitivity"].items()]
-        for label, r in rows:
-            mt = np.median([w["interior"]["mean_total_s"] for w in r["windows"]]) * DAY
-            lines.append(f"| {label} | " + " | ".join(
+        for n, r in res["sensitivity"].items():
+            lines.append(f"| {SENSITIVITY[n][2]} | " + " | ".join(
                 f"{_fmt(k, r['median'][k])} ({_inside(k, r['median'][k])})" for k in TARGETS)
-                + f" | {mt:.2g} | {np.mean(r['mean_speed_m_s'][1:]):.2g} |")
+                + f" | {r['remesh_events']} | {np.mean(r['mean_speed_m_s'][1:]):.2g} |")
         lines.append("")
+    mi = res.get("mesh_imprint") or {}
+    if mi:
+        lines += ["## Mesh imprint (docs/physics.md §3)", "",
+                  "Imprint index (F − F0)/(1 − F0) of the fracture directions against the mesh directions "
+                  "(0: chance, 1: every band along a mesh direction):", ""]
+        for k, v in (mi.get("basin_closed_maxwell_eb") or {}).items():
+            if isinstance(v, dict) and "index" in v:
+                lines.append(f"* flagship closed basin, {k.replace('_', ' ')}: index {v['index']:.2f}")
+        rt = mi.get("rotation_test")
+        if rt:
+            lines.append(f"* rotation test ({rt.get('source', '')}): {rt.get('summary', '')}")
+        lines.append("")
+    if res.get("compression") is not None:
+        lines += compression_lines(res, figs)
+    else:
+        lines += ["## Uniaxial compression", "", "Not re-run for this report (see docs/physics.md §5).", ""]
+    lines += ["## Where the model misses, and why", ""] + res.get("discussion", ["(not written)"]) + [""]
+    md.write_text("\n".join(lines))
+    return md
+
+
+def compression_lines(res: dict, figs: dict) -> list[str]:
+    lines = []
     c = res["compression"]
     lines += ["## Uniaxial compression (seed 004 §4–5)", "",
               f"N = {c['n_across']} ({c['steps']} steps of {c['dt_s']:.1f} s, {c['wall_s']:.0f} s wall), seed 0, "
@@ -566,9 +724,7 @@ def write_report(res: dict, md: Path, figs: dict):
     lines.append(f"| β of the rupture block | 0.15 ± 0.02 | {c['beta_rupture_block']:.3f} | "
                  f"{'inside' if 0.13 <= c['beta_rupture_block'] <= 0.17 else 'outside'} 0.13–0.17 |")
     lines += ["", f"![validation_compression](figures/{figs['compression'].name})", ""]
-    lines += ["## Where the model misses, and why", ""] + res.get("discussion", ["(not written)"]) + [""]
-    md.write_text("\n".join(lines))
-    return md
+    return lines
 
 
 #: arrays left out of the copy of validation.json kept in docs/figures (the full file
@@ -646,6 +802,13 @@ def main(argv=None):
     ap.add_argument("--only-sensitivity", action="store_true",
                     help="run only the sensitivity runs (the others are already in --out), then analyse all")
     ap.add_argument("--compression-job", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--from-physics", action="store_true",
+                    help="with --analyse-only: analyse the runs of benchmarks/physics_experiments.py "
+                         "(benchmarks/out/physics: F10, F10s, E10/E20, S20, X-*)")
+    ap.add_argument("--evp-km", type=float, default=10.0, help="with --from-physics: the EVP runs' resolution")
+    ap.add_argument("--physics-dir", type=Path, default=ROOT / "benchmarks" / "out" / "physics",
+                    help="with --from-physics: where benchmarks/physics_experiments.py put its runs")
+    ap.add_argument("--no-compression", action="store_true", help="leave the compression test out")
     args = ap.parse_args(argv)
     days = args.days or (4.0 if args.quick else 28.0)
     n_across = args.n_across or (20 if args.quick else 40)
@@ -654,27 +817,62 @@ def main(argv=None):
     out.mkdir(parents=True, exist_ok=True)
     if args.compression_job:
         return _compression_job(out, n_across, args.max_strain)
+    if args.from_physics and not args.analyse_only:
+        raise SystemExit("validate: --from-physics analyses finished runs; add --analyse-only")
+    physics = args.physics_dir.resolve() if args.from_physics else None
     args.fig_dir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     comp_path = out / f"compression_N{n_across}.npz"
     if not args.analyse_only:
-        jobs = {"compression": [sys.executable, str(Path(__file__).resolve()), "--compression-job", "--out", str(out),
-                                "--n-across", str(n_across), "--max-strain", str(args.max_strain)]}
+        jobs = {} if args.no_compression else {
+            "compression": [sys.executable, str(Path(__file__).resolve()), "--compression-job", "--out", str(out),
+                            "--n-across", str(n_across), "--max-strain", str(args.max_strain)]}
         jobs.update({f"{s}_{k}": cmd for (s, k), cmd in basin_commands(out, days, resolution).items()})
         if args.only_sensitivity:
             jobs = {}
         if args.sensitivity or args.only_sensitivity:
             jobs.update(sensitivity_commands(out, days, resolution))
         run_jobs(jobs, out, max(1, args.jobs))
-    basin = {s: analyse_basin(out, s, days, args.coast_buffer_km * 1e3) for s in SCENES}
-    sens = {name: analyse_run(out / f"sensitivity_{name}", days, args.coast_buffer_km * 1e3)
-            for name in SENSITIVITY if (out / f"sensitivity_{name}" / "snapshots" / "index.json").exists()}
-    comp = analyse_compression(comp_path)
-    figs = {s: figures_basin(basin[s], args.fig_dir, s) for s in SCENES}
-    figs["compression"] = figure_compression(comp, args.fig_dir)
+
+    def done(run: Path) -> bool:
+        return (run / "summary.json").exists()
+
+    basin = {}
+    for s in SCENES:
+        b = {}
+        for key in RHEOLOGIES:
+            run = run_dir(out, f"{s}_{key}", physics, args.evp_km)
+            if done(run):
+                b[key] = analyse_run(run, days, args.coast_buffer_km * 1e3)
+            else:
+                print(f"validate: {run} has not finished: left out", flush=True)
+        if b:
+            basin[s] = b
+    sens = {}
+    for name in SENSITIVITY:
+        run = run_dir(out, f"sensitivity_{name}", physics, args.evp_km)
+        if done(run):
+            sens[name] = analyse_run(run, days, args.coast_buffer_km * 1e3)
+    comp = None if args.no_compression or not comp_path.exists() else analyse_compression(comp_path)
+    figs = {s: figures_basin(basin[s], args.fig_dir, s) for s in basin}
+    if comp is not None:
+        figs["compression"] = figure_compression(comp, args.fig_dir)
+    imprint = {}
+    if "closed" in basin and "maxwell_eb" in basin["closed"]:
+        imprint["basin_closed_maxwell_eb"] = basin_imprint(Path(basin["closed"]["maxwell_eb"]["run_dir"]), days,
+                                                           args.coast_buffer_km * 1e3)
+        figs.setdefault("closed", []).append(figure_rate_map(Path(basin["closed"]["maxwell_eb"]["run_dir"]), days,
+                                                             args.fig_dir, "closed"))
+    if "strait" in basin and "maxwell_eb" in basin["strait"]:
+        figs.setdefault("strait", []).append(figure_rate_map(Path(basin["strait"]["maxwell_eb"]["run_dir"]), days,
+                                                             args.fig_dir, "strait"))
+    mi_json = args.fig_dir / "mesh_imprint.json"
+    if mi_json.exists():
+        imprint["rotation_test"] = rotation_test_summary(json.loads(mi_json.read_text()))
     res = {"quick": args.quick, "date": time.strftime("%Y-%m-%d"), "wall_s": time.perf_counter() - t0,
-           "basin_days": days, "resolution_km": (resolution or 10e3) / 1e3, "coast_buffer_km": args.coast_buffer_km,
-           "basin": basin, "sensitivity": sens, "compression": comp,
+           "git_commit": git_commit(), "from_physics": bool(physics), "evp_km": args.evp_km,
+           "basin_days": days, "coast_buffer_km": args.coast_buffer_km,
+           "basin": basin, "sensitivity": sens, "compression": comp, "mesh_imprint": imprint,
            "targets": {k: list(v) for k, v in TARGETS.items()},
            "json": str((args.fig_dir.resolve() / "validation.json").relative_to(ROOT))
            if args.fig_dir.resolve().is_relative_to(ROOT) else str(args.fig_dir / "validation.json")}
@@ -683,18 +881,64 @@ def main(argv=None):
         head, _, tail = text.partition("<!-- misses -->")
         res["summary"], res["discussion"] = head.strip().splitlines(), tail.strip().splitlines()
     full = _strip(res)
+    full["git_commit"] = res["git_commit"]["commit"]
+    full["git_dirty"] = res["git_commit"]["dirty"]
     (out / "validation.json").write_text(json.dumps(full, indent=1))
     (args.fig_dir / "validation.json").write_text(json.dumps(_drop(full, BULKY), indent=1))
     md = write_report(res, args.md, figs)
     print(f"validate: report {md}")
-    for s in SCENES:
-        for k in TARGETS:
-            print(f"  {s:7s} {k}: EB {_num(basin[s]['maxwell_eb']['median'][k])}  "
-                  f"EVP {_num(basin[s]['evp']['median'][k])}  "
-                  f"(band {TARGETS[k][0]}–{TARGETS[k][1]})")
-    print(f"  compression: fault angles {comp['fault_angles_rate_deg']} (MC {comp['mohr_coulomb_angle_deg']:.1f}), "
-          f"skewness {comp['skewness_increments_all']:.2f}, β after rupture {comp['beta_after_rupture']:.3f}")
+    print("\n".join(headline(res)))
+    if comp is not None:
+        print(f"  compression: fault angles {comp['fault_angles_rate_deg']} (MC {comp['mohr_coulomb_angle_deg']:.1f}), "
+              f"skewness {comp['skewness_increments_all']:.2f}, β after rupture {comp['beta_after_rupture']:.3f}")
     return res
+
+
+def rotation_test_summary(mi: dict) -> dict:
+    """The rotation test of benchmarks/mesh_imprint.py (docs/figures/mesh_imprint.json):
+    per variant and field, the imprint index at each lattice rotation and the histogram
+    correlation at no shift and at the rotation."""
+    out = {"source": mi.get("source", "benchmarks/mesh_imprint.py cyclone"), "git_commit": mi.get("git_commit"),
+           "variants": {}}
+    parts = []
+    for variant, fields in (mi.get("cyclone") or {}).items():
+        v = {}
+        for field, per in fields.items():
+            v[field] = {rot: {"index": s.get("index"), "shift_vs_r0": s.get("shift_vs_r0")} for rot, s in per.items()}
+            idx = " / ".join(f"{s.get('index', float('nan')):.2f}" for s in per.values())
+            parts.append(f"{variant} {field}: index {idx} at rotations {', '.join(per)}°")
+        out["variants"][variant] = v
+    out["summary"] = "; ".join(parts)
+    return out
+
+
+def figure_rate_map(run: Path, days: float, fig_dir: Path, scene: str) -> Path:
+    """Total deformation rate (Lagrangian, over 3-day windows) of a basin run: the LKFs."""
+    from matplotlib.colors import LogNorm
+
+    from lagice.diagnostics import lagrangian_velocity_gradients
+    from lagice.io.snapshots import load_window
+
+    starts = [d for d in (7.0, 16.0, days - 3.0) if d + 3.0 <= days]
+    fig = _fig(5.2 * len(starts), 5.0)
+    axes = np.atleast_1d(fig.subplots(1, len(starts)))
+    for ax, t0 in zip(axes, starts):
+        w = load_window(run, t0 * DAY, (t0 + 3.0) * DAY)
+        r = lagrangian_velocity_gradients(w["xy0"], w["xy1"], w["triangles"], w["dt_s"])
+        v = np.maximum(r.total_s * DAY, 1e-4)
+        xy = w["xy1"]
+        tp = ax.tripcolor(xy[:, 0] / 1e3, xy[:, 1] / 1e3, w["triangles"], facecolors=v, cmap="magma",
+                          norm=LogNorm(vmin=1e-3, vmax=0.3))
+        ax.set_title(f"ε̇tot (day$^{{-1}}$), days {t0:.0f}–{t0 + 3:.0f}", fontsize=9)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (km)")
+        fig.colorbar(tp, ax=ax, shrink=0.8)
+    axes[0].set_ylabel("y (km)")
+    fig.suptitle(f"{SCENE_LABELS[scene]}, Maxwell-EB: total deformation rate over 3-day windows (LKFs)", fontsize=10)
+    fig.tight_layout()
+    p = fig_dir / f"validation_{scene}_deformation_rate_map.png"
+    fig.savefig(p, dpi=110)
+    return p
 
 
 if __name__ == "__main__":
