@@ -298,9 +298,10 @@ class BlockRecorder:
               f"{self.mean_damage[k]:.4f}  [{time.perf_counter() - self.t0:.0f} s]", flush=True)
 
 
-def run_compression(out: Path, n_across: int, max_strain: float, seed: int = 0) -> Path:
+def run_compression(out: Path, n_across: int, max_strain: float, seed: int = 0, overrides=None) -> Path:
     """Run the ``uniaxial_compression`` scene with N elements across the plate (scene builder
-    + Simulation) and keep the per-step macro stress and the block means."""
+    + Simulation; ``overrides``: further scene keys, e.g. ``{"domain.jitter": 0.3}``) and keep
+    the per-step macro stress and the block means."""
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from scene_runs import scene_config, scene_simulation, timed_run
 
@@ -313,7 +314,7 @@ def run_compression(out: Path, n_across: int, max_strain: float, seed: int = 0) 
     n_steps = (int(np.ceil(max_strain * length / push / dt)) // block) * block
     sim = scene_simulation("uniaxial_compression", {
         "domain.resolution_m": dx, "solver.dt": "td", "run.duration": n_steps * dt, "run.seed": seed,
-        "output.timeseries": None})
+        "output.timeseries": None, **(overrides or {})})
     rec = BlockRecorder(sim, n_steps, block)
     wall = timed_run(sim)
     m = sim.model
