@@ -1,5 +1,5 @@
 """Validation report: deformation statistics of Maxwell-EB and EVP against
-observed sea-ice statistics (GitHub issues 7 and 12; seeds 000, 001, 004).
+observed sea-ice statistics (GitHub issues 7 and 12; Girard et al. 2011; Girard 2010; Dansereau et al. 2016).
 
 Two experiments:
 
@@ -13,7 +13,7 @@ Two experiments:
    time). Deformation is Lagrangian, from the node displacements over back-to-back
    3-day windows after a 1-day spin-up (as RGPS; nodes are followed through
    remeshing by their ids), on the elements at least ``--coast-buffer-km`` from
-   the coast (seed 000 uses 150 km in the Arctic; the basin is ~3 times smaller,
+   the coast (Girard et al. 2011 uses 150 km in the Arctic; the basin is ~3 times smaller,
    so the default is 100 km): :func:`lagice.diagnostics.window_statistics`, the
    function ``lagice diagnose RUN --window-days 3 --start-day 1`` uses. Per window: β
    of the spatial coarse-graining, ML tail exponents of the shear and |divergence|
@@ -22,16 +22,16 @@ Two experiments:
    deformation rate ⟨ε̇tot⟩ (median over the windows). ``--sensitivity`` adds
    Maxwell-EB runs of the closed basin with strength, air drag or wind scale ±50 %
    (``SENSITIVITY``, 20 km), reported apart.
-2. **uniaxial compression** (seed 004 §4–5, N = 40; scene builder + Simulation,
+2. **uniaxial compression** (Dansereau et al. 2016 §4–5, N = 40; scene builder + Simulation,
    recorded by a callback activity): the macroscopic stress of every step, the
    damage and the transport velocity averaged over blocks of N steps (an elastic
-   shear wave crossing the plate width; seed 004 §5.2).
+   shear wave crossing the plate width; Dansereau et al. 2016 §5.2).
    Reported: the angle between the faults and the compression axis against
    the Mohr–Coulomb prediction 45° − atan(μ)/2, the skewness of the
-   macroscopic stress increments Δσ/Δt (seed 004 §5.3: ≈ −6) and β at the
-   macro-rupture (seed 004 §5.2: 0.15 ± 0.02).
+   macroscopic stress increments Δσ/Δt (Dansereau et al. 2016 §5.3: ≈ −6) and β at the
+   macro-rupture (Dansereau et al. 2016 §5.2: 0.15 ± 0.02).
 
-Observed ranges (``TARGETS``) come from the seeds; where a seed gives a single
+Observed ranges (``TARGETS``) come from the source papers; where a paper gives a single
 value, the band around it is ours and is written next to it in the report. No
 parameter is tuned per metric: the scenes run with their shipped settings.
 ``benchmarks/validation_discussion.md`` (hand-written summary and "where the
@@ -77,16 +77,16 @@ DAY = 86400.0
 
 #: observed values and the band counted as "inside"; (low, high, source, note)
 TARGETS = {
-    "beta_space": (0.17, 0.20, "RGPS, 3 days (seed 000; seed 001 ch. 2: 0.18; Marsan et al. 2004: 0.2)",
-                   "band from the issue; EB in seed 000 gave 0.10"),
-    "pdf_tail_exponent_divergence": (2.2, 2.8, "RGPS \\|divergence\\|, 10 km, 3 days: 2.5 (seed 000)",
+    "beta_space": (0.17, 0.20, "RGPS, 3 days (Girard et al. 2011; Girard 2010 ch. 2: 0.18; Marsan et al. 2004: 0.2)",
+                   "band from the issue; EB in Girard et al. 2011 gave 0.10"),
+    "pdf_tail_exponent_divergence": (2.2, 2.8, "RGPS \\|divergence\\|, 10 km, 3 days: 2.5 (Girard et al. 2011)",
                                      "±0.3 is ours: the RGPS shear–divergence difference"),
-    "pdf_tail_exponent_shear": (1.9, 2.5, "RGPS shear, 10 km, 3 days: 2.2 (seed 000)", "±0.3 is ours"),
-    "localisation_half_shear_area_fraction": (0.04, 0.08, "RGPS 10 km: 6 % (seed 000; EB 4 %, VP > 20 %)",
+    "pdf_tail_exponent_shear": (1.9, 2.5, "RGPS shear, 10 km, 3 days: 2.2 (Girard et al. 2011)", "±0.3 is ours"),
+    "localisation_half_shear_area_fraction": (0.04, 0.08, "RGPS 10 km: 6 % (Girard et al. 2011; EB 4 %, VP > 20 %)",
                                               "±2 points is ours"),
-    "shear_divergence_r2": (0.73, 0.93, "RGPS: 0.83 (seed 000; EB 0.77, VP 0.58)", "±0.1 is ours"),
+    "shear_divergence_r2": (0.73, 0.93, "RGPS: 0.83 (Girard et al. 2011; EB 0.77, VP 0.58)", "±0.1 is ours"),
     "mean_total_deformation_rate_per_day": (0.01, 0.05, "RGPS winter, 10 km, 3 days: about 0.01–0.05 day⁻¹ "
-                                            "(seed 001 ch. 2)", "band from the issue"),
+                                            "(Girard 2010 ch. 2)", "band from the issue"),
 }
 #: metrics window_statistics computes (the rate is its mean_total_s, converted to day⁻¹)
 WINDOW_TARGETS = tuple(k for k in TARGETS if k != "mean_total_deformation_rate_per_day")
@@ -419,7 +419,7 @@ def figures_basin(basin: dict, fig_dir: Path, scene: str) -> list[Path]:
             if x0:
                 ax.axvline(x0 * DAY, color=colours[key], lw=0.6, ls=":")
     Lr = np.geomspace(10, 500, 10)
-    ax1.loglog(Lr, 0.05 * (Lr / 10) ** -0.18, "k--", label="RGPS slope β = 0.18 (seed 001)")
+    ax1.loglog(Lr, 0.05 * (Lr / 10) ** -0.18, "k--", label="RGPS slope β = 0.18 (Girard 2010)")
     ax1.set(xlabel="scale L (km)", ylabel="⟨ε̇tot⟩ (day$^{-1}$)", title="spatial scaling, last 3-day window")
     ax2.set(xlabel="shear rate (day$^{-1}$)", ylabel="PDF / max", title="shear (10 km, 3 days; dotted: tail start)")
     ax3.set(xlabel="|divergence| rate (day$^{-1}$)", ylabel="PDF / max", title="|divergence| (10 km, 3 days)")
@@ -652,11 +652,12 @@ def write_report(res: dict, md: Path, figs: dict):
               f"seed, so every run sees the same winds.",
               f"* Deformation as RGPS measures it: Lagrangian rates from the node displacements over back-to-back "
               f"3-day windows from day 1 on (the first day is spin-up), nodes followed through remeshing by their "
-              f"ids (`load_window`), on the elements ≥ {res['coast_buffer_km']:g} km from the coast (seed 000 "
+              f"ids (`load_window`), on the elements ≥ {res['coast_buffer_km']:g} km from the coast "
+              f"(Girard et al. 2011 "
               f"used 150 km in the whole Arctic; this basin is about 3 times smaller).",
               "* Values in the tables: median over the windows, [min, max] in brackets. "
-              "The bands are the seeds' "
-              "observed values; where a seed gives one number, the width of the band is ours and is stated.",
+              "The bands are the source papers' "
+              "observed values; where a paper gives one number, the width of the band is ours and is stated.",
               "* No parameter was tuned to any metric.", ""]
     for scene, b in res["basin"].items():
         lines += _basin_section(scene, b, res, figs.get(scene, []))
@@ -698,7 +699,7 @@ def write_report(res: dict, md: Path, figs: dict):
 def compression_lines(res: dict, figs: dict) -> list[str]:
     lines = []
     c = res["compression"]
-    lines += ["## Uniaxial compression (seed 004 §4–5)", "",
+    lines += ["## Uniaxial compression (Dansereau et al. 2016 §4–5)", "",
               f"N = {c['n_across']} ({c['steps']} steps of {c['dt_s']:.1f} s, {c['wall_s']:.0f} s wall), seed 0, "
               f"implicit solver, healing on. Peak {c['peak_stress_kpa']:.0f} kPa at strain "
               f"{c['peak_strain']:.2e}; the macro-rupture (largest stress drop over one block of "
@@ -716,13 +717,15 @@ def compression_lines(res: dict, figs: dict) -> list[str]:
                      f"{', '.join(f'{a:.1f}°' for a in angd)} | off by "
                      f"{', '.join(f'{a - mc:+.1f}°' for a in angd)} |")
     sk_a, sk_r = c["skewness_increments_all"], c["skewness_increments_from_peak"]
-    lines.append(f"| skewness of Δσ/Δt, whole run | strongly negative, ≈ −6 (seed 004 §5.3) | {sk_a:.1f} | "
+    lines.append("| skewness of Δσ/Δt, whole run | strongly negative, ≈ −6 (Dansereau et al. 2016 §5.3) | "
+                 f"{sk_a:.1f} | "
                  f"{'negative' if sk_a < 0 else 'NOT negative'}; {abs(sk_a - (-6)):.1f} from −6 |")
     if sk_r is not None:
-        lines.append(f"| skewness of Δσ/Δt, from the stress peak on (the regime of seed 004 Fig. 7) | ≈ −6 | "
+        lines.append("| skewness of Δσ/Δt, from the stress peak on (the regime of Dansereau et al. 2016 Fig. 7) "
+                     "| ≈ −6 | "
                      f"{sk_r:.1f} | "
                      f"{'negative' if sk_r < 0 else 'NOT negative'}; {abs(sk_r - (-6)):.1f} from −6 |")
-    lines.append(f"| β just after the macro-rupture (next block) | 0.15 ± 0.02 (seed 004 §5.2, N = 100) | "
+    lines.append(f"| β just after the macro-rupture (next block) | 0.15 ± 0.02 (Dansereau et al. 2016 §5.2, N = 100) | "
                  f"{c['beta_after_rupture']:.3f} | "
                  f"{'inside' if 0.13 <= c['beta_after_rupture'] <= 0.17 else 'outside'} 0.13–0.17 |")
     lines.append(f"| β of the rupture block | 0.15 ± 0.02 | {c['beta_rupture_block']:.3f} | "

@@ -1,4 +1,4 @@
-"""Remeshing: trigger, local gmsh patches, conservative remapping (DESIGN.md §5).
+"""Remeshing: trigger, local gmsh patches, conservative remapping (docs/design.md §5).
 
 The entry point is :func:`remesh_if_needed`, called once per outer step after
 the Lagrangian move (:func:`lagice.lagrangian.move_mesh`)::
@@ -146,7 +146,7 @@ def remesh_region(state, mask: np.ndarray, size_field, *, algorithm: int = 6,
 
     ``damage_remap``: ``"area"`` (default) remaps d as an area-weighted mean
     (conserves ∫d da); ``"compliance"`` remaps the compliance 1/(1 − d)
-    (keeps the series stiffness across thin damage bands, seed 003 eq. 1,
+    (keeps the series stiffness across thin damage bands, Åström & Benn 2019 eq. 1,
     at the price of raising ∫d da; see docs/remeshing.md).
     """
     if damage_remap not in ("area", "compliance"):

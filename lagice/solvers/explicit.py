@@ -1,4 +1,4 @@
-"""Explicit Maxwell-EB time stepper, neXtSIM BBM style (DESIGN.md §4.2).
+"""Explicit Maxwell-EB time stepper, neXtSIM BBM style (docs/design.md §4.2).
 
 One outer step Δt (forcing evaluated, lumped mass, geometry, moduli) is split
 into N elastic sub-steps Δt_s = Δt/N. Each sub-step is two numba kernels,
@@ -19,9 +19,9 @@ both parallel over their *own* entities so that no loop scatters:
    value, linearly interpolated in time across the outer step.
 
 2. **element kernel** (stress and damage): strain rate ε̇(u^{k+1}), Maxwell
-   update σ ← (σ + Δt_s E K:ε̇) λ/(λ+Δt_s) (seed 004 eq. 1, same
+   update σ ← (σ + Δt_s E K:ε̇) λ/(λ+Δt_s) (Dansereau et al. 2016 eq. 1, same
    discretisation as the implicit solver), then the damage/stress correction
-   and healing of seed 004 eqs. 9-11 with Δt_s — the same arithmetic as
+   and healing of Dansereau et al. 2016 eqs. 9-11 with Δt_s — the same arithmetic as
    :func:`lagice.rheology.damage_update_kernel`, built on its numba core
    ``_dcrit`` (a test checks both agree bit for bit). E = E0 (1−d) g and
    λ = λ0 ((1−d) g)^(α−1), g = exp(−c*(1−A)) (the rheology's formulas; a test
@@ -121,7 +121,7 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     damage changes from E = E0 (1−d) g, λ = λ0 ((1−d) g)^(α−1) with
     g = conc_factor = exp(−c*(1−A)) (rheology.young_modulus/relaxation_time;
     an integer α−1 is taken as repeated products). kxx = 1/(1−ν²), kxy = ν/(1−ν²), kss = (1−ν)/(1−ν²) are the
-    entries of K; sigma_c = 2C/denom and sigma_t = sigma_c/q [Pa] (seed 004 eqs. 4, 6)
+    entries of K; sigma_c = 2C/denom and sigma_t = sigma_c/q [Pa] (Dansereau et al. 2016 eqs. 4, 6)
     per element. Returns the number of elements whose damage hit the cap.
     """
     m = tri.shape[0]
