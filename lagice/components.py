@@ -41,3 +41,25 @@ class Component(Protocol):
 
     def restore(self, arrays: dict, meta: dict) -> None:
         """Restore what :meth:`checkpoint_state` returned."""
+
+
+class RateComponent:
+    """Base of components that only provide a rate the stepper applies (healing laws):
+    nothing to advance, no state of their own. Subclasses define ``name`` and
+    ``rate(state, t_s)``; calling the component is calling :meth:`rate`."""
+
+    def rate(self, state, t_s):  # pragma: no cover - defined by subclasses
+        raise NotImplementedError
+
+    def __call__(self, state, t_s):
+        return self.rate(state, t_s)
+
+    def advance(self, model, dt_s):
+        """Nothing to advance: the stepper applies :meth:`rate` in its damage update."""
+        return None
+
+    def checkpoint_state(self):
+        return {}, {}
+
+    def restore(self, arrays, meta):
+        pass

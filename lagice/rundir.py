@@ -87,14 +87,7 @@ def claim(out, overwrite: bool = False) -> Path:
     if not is_run_dir(out):
         raise ConfigError(f"output folder {out} is not empty and is not a lagice run folder (no {MARKER}, "
                           f"snapshots/ or checkpoints/); refusing to delete it with --overwrite")
-    for child in out.iterdir():
-        try:
-            if child.is_dir() and not child.is_symlink():
-                shutil.rmtree(child)
-            else:
-                child.unlink()
-        except OSError as exc:
-            raise OutputError(f"--overwrite: cannot remove {child}: {exc.strerror}") from None
+    clear_folder(out)
     log.info(f"cleared {out}/ (--overwrite)")
     return out
 
@@ -159,3 +152,18 @@ def clean_stale(out) -> list[Path]:
     for p in removed:
         log.info(f"removed a temporary file left by an interrupted write: {p}")
     return removed
+
+
+def clear_folder(folder: Path, keep: tuple[str, ...] = ()) -> None:
+    """Remove everything in ``folder`` but the names in ``keep`` (``--overwrite``);
+    a file that cannot be removed is an :class:`OutputError` naming it."""
+    for child in Path(folder).iterdir():
+        if child.name in keep:
+            continue
+        try:
+            if child.is_dir() and not child.is_symlink():
+                shutil.rmtree(child)
+            else:
+                child.unlink()
+        except OSError as exc:
+            raise OutputError(f"--overwrite: cannot remove {child}: {exc.strerror}") from None

@@ -45,6 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .components import RateComponent
 from .errors import ConfigError, check_range
 
 #: keys of ``[rheology]`` handled here, not by MaxwellEBParams
@@ -204,7 +205,7 @@ class NextsimHealing:
         return self.rate(ta, state.thickness, state.concentration, state.snow)
 
 
-class NextsimHealingComponent:
+class NextsimHealingComponent(RateComponent):
     """Component ``healing`` of :class:`lagice.model.Model` with :class:`NextsimHealing`
     (``[healing] law = "nextsim"``): :meth:`rate` gives the stepper's per-element rate
     for d ← max(0, d − H dt). It holds no state of its own."""
@@ -217,17 +218,6 @@ class NextsimHealingComponent:
     def rate(self, state, t_s):
         return self.law.element_rate(state, t_s)
 
-    __call__ = rate
-
-    def advance(self, model, dt_s):
-        """Nothing to advance: the stepper applies :meth:`rate` in its damage update."""
-        return None
-
-    def checkpoint_state(self):
-        return {}, {}
-
-    def restore(self, arrays, meta):
-        pass
 
 
 #: keyword parameters of ``[healing.params]`` for ``law = "nextsim"``

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from forcing.base import SCALAR, as_field
+from lagice.components import RateComponent
 from lagice.errors import ConfigError
 
 from .healing import ConstantHealing
@@ -82,7 +83,7 @@ class ThermoComponent:
         self.totals_m3.update(meta.get("totals_m3", {}))
 
 
-class HealingComponent:
+class HealingComponent(RateComponent):
     """Component ``healing``: ``Model(healing=HealingComponent(law, air_temperature, dt_s=...))``.
 
     :meth:`rate` returns the healing rate [s-1] per element for the stepper's
@@ -123,14 +124,3 @@ class HealingComponent:
         trial = d.copy()
         return self.healing.apply(trial, ta, self.dt_s) / self.dt_s
 
-    __call__ = rate
-
-    def advance(self, model, dt_s):
-        """Nothing to advance: the stepper applies :meth:`rate` in its damage update."""
-        return None
-
-    def checkpoint_state(self):
-        return {}, {}
-
-    def restore(self, arrays, meta):
-        pass

@@ -16,6 +16,7 @@ import uuid
 from pathlib import Path
 
 from ..errors import ConfigError, LagiceError
+from ..rundir import clear_folder
 from .member import STOP_FILE, member_state, run_member, write_json
 from .spec import EnsembleSpec, load_spec
 
@@ -68,24 +69,13 @@ class Ensemble:
     def clear_folder(self) -> None:
         """Remove an earlier ensemble in the output folder (``lagice ensemble --overwrite``):
         only a folder that holds an ensemble (``ensemble.json``) or nothing."""
-        from ..errors import OutputError
-
         if not self.out_dir.exists() or not any(self.out_dir.iterdir()):
             return
         if not (self.out_dir / "ensemble.json").exists():
             raise ConfigError(f"--out {self.out_dir}: the folder is not empty and holds no ensemble (no "
                               "ensemble.json); refusing to delete it with --overwrite")
         with _FolderLock(self.out_dir / "ensemble.lock"):
-            for child in self.out_dir.iterdir():
-                if child.name == "ensemble.lock":
-                    continue
-                try:
-                    if child.is_dir() and not child.is_symlink():
-                        shutil.rmtree(child)
-                    else:
-                        child.unlink()
-                except OSError as exc:
-                    raise OutputError(f"--overwrite: cannot remove {child}: {exc.strerror}") from None
+            clear_folder(self.out_dir, keep=("ensemble.lock",))
 
     def check_folder(self) -> dict:
         """Compare the spec with an earlier run in the output folder (``ensemble.json``):
