@@ -63,6 +63,11 @@ EXPERIMENTS = {
     "X-drag+50": ("closed", ["forcing.drag.air_drag=3.0e-3"], 20e3, 28, "air drag +50 %"),
     "X-wind-50": ("closed", ["forcing.wind.wind_scale=0.5"], 20e3, 28, "winds ×0.5"),
     "X-wind+50": ("closed", ["forcing.wind.wind_scale=1.5"], 20e3, 28, "winds ×1.5"),
+    # the background-wind spectrum (docs/physics.md §1): the exponential (k^-2) default
+    # against the first generator's gaussian spectrum, same code, closed basin, 20 km
+    "W20": ("closed", [], 20e3, 28, "recommended set, exponential (k⁻²) wind spectrum, closed, 20 km"),
+    "W20g": ("closed", ["forcing.wind.background_spectrum=gaussian"], 20e3, 28,
+             "as W20 with the gaussian wind spectrum of the first generator"),
 }
 
 

@@ -50,22 +50,27 @@ def main(argv=None):
     args = ap.parse_args(argv)
     runs = [generate_for_box(days=args.days, seed=s) for s in range(args.seeds)]
     stats = [wind_statistics(w) for w in runs]
+    # the first version of the generator: gaussian background spectrum, same seeds
+    gauss = [wind_statistics(generate_for_box(days=args.days, seed=s, background_spectrum="gaussian"))
+             for s in range(args.seeds)]
     old = old_cyclone_forcing()
     old_stats = wind_statistics(old)
     for k in ("cyclone_passages_per_box_year", "cyclones_in_domain_per_30_days"):
         old_stats[k] = float("nan")  # its systems are not CycloneTracks: not counted here
     print(f"wind climatology: {args.seeds} seeds x {args.days:g} days, 1000 km box, 25 km records")
-    print(f"{'statistic':34s} {'target':>14s}  {'per seed':40s} {'mean':>7s}  in band  | old 'cyclones' forcing")
+    print(f"{'statistic':34s} {'target':>14s}  {'per seed':40s} {'mean':>7s}  in band  | old 'cyclones' forcing"
+          " | gaussian spectrum (mean)")
     rows = {}
     for k, (lo, hi, unit, src) in TARGETS.items():
         vals = [s[k] for s in stats]
         m = float(np.nanmean(vals))
         inside = sum(lo <= v <= hi for v in vals)
         ov = old_stats.get(k, float("nan"))
+        gm = float(np.nanmean([g[k] for g in gauss]))
         rows[k] = {"target": [lo, hi], "unit": unit, "source": src, "per_seed": vals, "mean": m,
-                   "seeds_in_band": inside, "old_cyclones_forcing": ov}
+                   "seeds_in_band": inside, "old_cyclones_forcing": ov, "gaussian_spectrum_mean": gm}
         print(f"{k:34s} {f'{lo:g}–{hi:g}':>14s}  {' '.join(f'{v:7.2f}' for v in vals):40s} {m:7.2f}  "
-              f"{inside}/{len(vals)}     | {ov:.2f}")
+              f"{inside}/{len(vals)}     | {ov:6.2f}                 | {gm:.2f}")
     extra = ("speed_p50_m_s", "speed_p95_m_s", "speed_max_m_s", "basin_mean_speed_min_m_s",
              "basin_mean_vector_speed_m_s", "cyclones_in_domain_per_30_days", "cyclone_depth_mean_hpa",
              "cyclone_lifetime_mean_days")
@@ -77,18 +82,18 @@ def main(argv=None):
     args.fig_dir.mkdir(parents=True, exist_ok=True)
     out = {"seeds": args.seeds, "days": args.days, "params": make_params().as_dict(), "statistics": rows}
     (args.fig_dir / "wind_climatology.json").write_text(json.dumps(out, indent=1, default=float))
-    figure(runs, stats, old, old_stats, args.fig_dir / "wind_climatology.png")
+    figure(runs, stats, old, old_stats, gauss, args.fig_dir / "wind_climatology.png")
     print(f"wrote {args.fig_dir / 'wind_climatology.png'} and wind_climatology.json")
     return out
 
 
-def figure(runs, stats, old, old_stats, path):
+def figure(runs, stats, old, old_stats, gauss, path):
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(2, 3, figsize=(15, 8.5))
+    fig, ax = plt.subplots(3, 3, figsize=(15, 12.5))
     a = ax[0, 0]
     bins = np.linspace(0, 30, 61)
     for w in runs:
@@ -159,6 +164,25 @@ def figure(runs, stats, old, old_stats, path):
         a.set_aspect("equal")
         a.set_title(f"seed 0, day {day:g} (dashed: basin)")
         fig.colorbar(pc, ax=a, label="speed (m s⁻¹)", shrink=0.8)
+    a = ax[2, 0]
+    for lab, ss, col in (("climatology (k⁻² background)", stats, "C0"), ("gaussian background (first version)",
+                                                                       gauss, "C2")):
+        for i, st in enumerate(ss):
+            a.loglog(st["structure_distance_km"], st["structure_function_m2_s2"], color=col, lw=0.8,
+                     label=lab if i == 0 else None)
+    r = np.array([75.0, 300.0])
+    d0 = stats[0]["structure_function_m2_s2"][int(np.argmin(np.abs(np.array(stats[0]["structure_distance_km"])
+                                                                   - 75.0)))]
+    a.loglog(r, d0 * (r / 75.0) ** 1.0, "k--", lw=1, label="D ∝ r (spectrum k⁻²)")
+    a.loglog(r, 0.3 * d0 * (r / 75.0) ** 2.0, "k:", lw=1, label="D ∝ r² (smooth, k⁻³)")
+    a.axvspan(75, 300, color="0.9", zorder=0)
+    a.set_xlabel("separation r (km)")
+    a.set_ylabel("structure function D(r) (m² s⁻²)")
+    lo, hi = TARGETS["spectral_slope"][:2]
+    a.set_title(f"wind structure function (fit 75–300 km; target slope {lo:g} to {hi:g})", fontsize=10)
+    a.legend(fontsize=7)
+    ax[2, 1].axis("off")
+    ax[2, 2].axis("off")
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)

@@ -51,6 +51,8 @@ from .records import DAY_S, HOUR_S, InMemoryRecords, RecordField, RegularGrid
 OMEGA_EARTH = 7.2921e-5
 #: air density for the geostrophic wind [kg m-3] (the value lagice's wind stress uses)
 RHO_AIR = 1.3
+#: shapes of the background spectrum (:attr:`ClimatologyParams.background_spectrum`)
+BACKGROUND_SPECTRA = ("exponential", "gaussian")
 
 
 @dataclass(frozen=True)
@@ -60,8 +62,17 @@ class ClimatologyParams:
 
     #: standard deviation of each 10-m wind component of the background weather [m s-1]
     background_wind_std_m_s: float = 4.2
-    #: e-folding length of the background surface-pressure covariance [m]
+    #: e-folding length of the background covariance [m]: of the surface pressure for
+    #: the ``"gaussian"`` spectrum, of the 10-m wind for the ``"exponential"`` one
     correlation_length_m: float = 1000e3
+    #: shape of the background spectrum: ``"exponential"`` (wind covariance
+    #: exp(-r/L), kinetic-energy spectrum ~ k^-2 above 1/L, the slope of scatterometer
+    #: surface-wind spectra) or ``"gaussian"`` (pressure covariance exp(-r^2/2L^2),
+    #: almost no energy at wavelengths below a few hundred km; the first version)
+    background_spectrum: str = "exponential"
+    #: shortest wavelength of the background modes [m] (``"exponential"`` only): about
+    #: the effective resolution of a reanalysis wind like ERA5's, whose drag the scenes use
+    shortest_wavelength_m: float = 100e3
     #: e-folding time of the correlation of the background mode amplitudes [s]
     decorrelation_time_s: float = 3.0 * DAY_S
     #: uniform flow carrying the background pattern and steering the cyclones [m s-1]
@@ -100,6 +111,10 @@ class ClimatologyParams:
         c = check_range
         c("background_wind_std_m_s", self.background_wind_std_m_s, 0.0, 15.0, unit="m s-1")
         c("correlation_length_m", self.correlation_length_m, 100e3, 5000e3, unit="m")
+        if self.background_spectrum not in BACKGROUND_SPECTRA:
+            raise ConfigError(f"background_spectrum = {self.background_spectrum!r}: expected one of "
+                              f"{list(BACKGROUND_SPECTRA)}")
+        c("shortest_wavelength_m", self.shortest_wavelength_m, 10e3, 1000e3, unit="m")
         c("decorrelation_time_s", self.decorrelation_time_s, 6 * HOUR_S, 30 * DAY_S, unit="s")
         for name in ("steering_m_s", "mean_wind_m_s"):
             v = getattr(self, name)
@@ -200,9 +215,45 @@ def _rng(seed, stream, index):
 
 
 def _modes(p: ClimatologyParams, seed):
-    """Wave vectors (n, 2) [m-1] of the background modes, drawn from the spectral
-    density of the Gaussian covariance exp(−r²/(2L²))."""
-    return _rng(seed, 0, 0).normal(0.0, 1.0 / p.correlation_length_m, size=(int(p.n_modes), 2))
+    """Wave vectors (n, 2) [m-1] of the background modes.
+
+    * ``"gaussian"``: k ~ N(0, I/L²), the spectral density of the pressure covariance
+      exp(−r²/(2L²)).
+    * ``"exponential"``: k from the 2-D Cauchy law (the bivariate Student t with one
+      degree of freedom and scale 1/L: k = z / (L sqrt(w)), z ~ N(0, I), w ~ χ²₁),
+      whose characteristic function is exp(−|r|/L); modes with a wavelength shorter
+      than ``shortest_wavelength_m`` are drawn again (about 2 % at L = 1000 km and
+      100 km). With equal wind variance per mode (:func:`_pressure_amplitudes`) the
+      wind covariance is exp(−r/L) (truncated) and its kinetic-energy spectrum falls
+      as k⁻² at wavelengths below 2πL.
+    """
+    rng = _rng(seed, 0, 0)
+    n = int(p.n_modes)
+    L = p.correlation_length_m
+    if p.background_spectrum == "gaussian":
+        return rng.normal(0.0, 1.0 / L, size=(n, 2))
+    kmax = 2.0 * math.pi / p.shortest_wavelength_m
+    k = np.empty((0, 2))
+    while k.shape[0] < n:
+        z = rng.standard_normal((n, 2))
+        w = rng.chisquare(1.0, n)
+        kk = z / (L * np.sqrt(w))[:, None]
+        k = np.concatenate([k, kk[np.hypot(kk[:, 0], kk[:, 1]) <= kmax]])
+    return k[:n]
+
+
+def _pressure_amplitudes(p: ClimatologyParams, k):
+    """Standard deviation (n,) [Pa] of the two pressure amplitudes of each background
+    mode, such that each 10-m wind component has the standard deviation
+    ``background_wind_std_m_s``: the same for every mode with the gaussian spectrum,
+    ∝ 1/|k_j| (the same wind variance per mode) with the exponential one."""
+    n = k.shape[0]
+    scale = p.background_wind_std_m_s * RHO_AIR * p.coriolis_s / p.surface_factor
+    if p.background_spectrum == "gaussian":
+        ksq = float(np.sum(k * k)) / 2.0  # Σ k_x² ≈ Σ k_y²
+        return np.full(n, scale / math.sqrt(ksq) if ksq > 0 else 0.0)
+    # var(u) = (s/ρf)² Σ_j σ_j² |k_j|² / 2 = σw²  with  σ_j = c/|k_j|,  c = σw (ρf/s) sqrt(2/n)
+    return scale * math.sqrt(2.0 / n) / np.hypot(k[:, 0], k[:, 1])
 
 
 #: e-folding time of the correlation (1 + s) e^(−s) of the amplitudes, in units of the
@@ -225,9 +276,7 @@ def _background_amplitudes(p: ClimatologyParams, seed, times_s, interval_s):
     deviation ``background_wind_std_m_s``."""
     k = _modes(p, seed)
     n = k.shape[0]
-    ksq = float(np.sum(k * k)) / 2.0  # Σ k_x² ≈ Σ k_y²
-    f = p.coriolis_s
-    sigma_a = p.background_wind_std_m_s * RHO_AIR * f / (p.surface_factor * math.sqrt(ksq)) if ksq > 0 else 0.0
+    sigma_a = _pressure_amplitudes(p, k)  # (n,): equal (gaussian) or ∝ 1/|k| (exponential)
     phi = math.exp(-interval_s * _EFOLD_AR2 / p.decorrelation_time_s)
     a1, a2 = 2.0 * phi, -phi * phi
     # innovation std giving the stationary variance σa²: var = (1 + φ²) σe² / (1 − φ²)³
@@ -405,6 +454,9 @@ TARGETS = {
     "temporal_efolding_days": (1.0, 3.0, "day", "synoptic time scale (docs/physics.md)"),
     "spatial_efolding_km": (700.0, 1300.0, "km",
                             "ice-velocity / geostrophic-wind correlation length ≈ 1000 km (docs/physics.md)"),
+    "spectral_slope": (-2.9, -1.6, "-",
+                       "kinetic-energy spectrum ∝ k^slope of ocean-surface winds: QuikSCAT −1.6 to −2.9 "
+                       "(Xu, Fu & Tulloch 2011), near −5/3 to −2 from 1 to 1000 km (Wikle, Milliff & Large 1999)"),
     "cyclone_passages_per_box_year": (5.0, 40.0, "per yr",
                                       "passages per 300 km × 300 km box: 20 (5–40), Brümmer et al. 2000"),
     "cyclone_max_wind_mean_m_s": (8.0, 16.0, "m s-1", "storm winds of winter Arctic cyclones (docs/physics.md)"),
@@ -487,6 +539,7 @@ def wind_statistics(w: ClimatologyWind, *, seed=0, n_pairs=200_000, box_km=300.0
     out["spatial_efolding_km"] = _efold(np.concatenate([[0.0], mid[good]]), np.concatenate([[1.0], sc[good]]))
     out["spatial_distance_km"] = mid[good].tolist()
     out["spatial_correlation"] = sc[good].tolist()
+    out.update(spectral_slope(w))
     # cyclones
     years = (w.times_s[-1] - w.times_s[0]) / (365.25 * DAY_S)
     tt = np.arange(w.times_s[0], w.times_s[-1] + 1.0, 3 * HOUR_S)
@@ -522,6 +575,31 @@ def wind_statistics(w: ClimatologyWind, *, seed=0, n_pairs=200_000, box_km=300.0
                   "cyclone_depth_mean_hpa", "cyclone_lifetime_mean_days"):
             out[k] = float("nan")
     return out
+
+
+def spectral_slope(w: ClimatologyWind, r_min_km=75.0, r_max_km=300.0) -> dict:
+    """Slope of the kinetic-energy wavenumber spectrum E(k) ∝ k^slope of the records
+    inside the domain box, from the second-order structure function
+    D(r) = <|u(x + r) − u(x)|²> along the grid rows and columns: D ∝ r^ζ with
+    slope = −(1 + ζ) for 1 < −slope < 3 (a smooth field gives ζ = 2, slope −3).
+    ζ is the least-squares log-log slope of D over separations ``r_min_km`` to
+    ``r_max_km`` (scales the records resolve and a 1000-km basin contains)."""
+    xmin, xmax, ymin, ymax = w.domain_bbox
+    gx, gy = w.grid.x_m, w.grid.y_m
+    ix = np.flatnonzero((gx >= xmin) & (gx <= xmax))
+    iy = np.flatnonzero((gy >= ymin) & (gy <= ymax))
+    u = w.u[:, iy[0]:iy[-1] + 1, ix[0]:ix[-1] + 1]
+    v = w.v[:, iy[0]:iy[-1] + 1, ix[0]:ix[-1] + 1]
+    h_km = float(gx[1] - gx[0]) / 1e3
+    lags = np.arange(1, min(u.shape[1], u.shape[2]) // 2)
+    r = lags * h_km
+    D = np.array([0.5 * (np.mean((u[:, :, L:] - u[:, :, :-L]) ** 2 + (v[:, :, L:] - v[:, :, :-L]) ** 2)
+                         + np.mean((u[:, L:, :] - u[:, :-L, :]) ** 2 + (v[:, L:, :] - v[:, :-L, :]) ** 2))
+                  for L in lags])
+    sel = (r >= r_min_km) & (r <= r_max_km)
+    zeta = float(np.polyfit(np.log(r[sel]), np.log(D[sel]), 1)[0]) if sel.sum() >= 2 else float("nan")
+    return {"spectral_slope": -(1.0 + zeta), "structure_function_exponent": zeta,
+            "structure_distance_km": r.tolist(), "structure_function_m2_s2": D.tolist()}
 
 
 def generate_for_box(width_m=1000e3, height_m=1000e3, days=28.0, *, seed=0, spacing_m=25e3, **params):
