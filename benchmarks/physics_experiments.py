@@ -71,6 +71,10 @@ EXPERIMENTS = {
     "W20g": ("closed", ["forcing.wind.background_spectrum=gaussian"], 20e3, 28,
              "as W20 with the gaussian wind spectrum of the first generator"),
 }
+# the wind records on a 10 km grid (10 points per shortest 100 km wave instead of 4): is
+# the storm-window pattern of horizontal and vertical lines an imprint of the record grid?
+EXPERIMENTS["F10-g10"] = ("closed", ["forcing.grid_spacing_m=10e3"], 10e3, 28,
+                          "as F10, wind records on a 10 km grid instead of 25 km")
 # realisation spread of the recommended set (closed, 20 km): the same weather (wind seed
 # 2026) with another strength disorder (run.seed), and other weather (wind seed) with the
 # same disorder (run seed 2026); W20 is the member shared by both groups

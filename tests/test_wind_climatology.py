@@ -148,6 +148,27 @@ def test_scene_rejects_bad_climatology_before_meshing(monkeypatch):
         assert all(f in msg for f in frags), msg
 
 
+def test_scene_rejects_records_too_coarse_for_the_shortest_wave(monkeypatch):
+    """The record grid must give the shortest background wave 8 points: 25 km records
+    with the default 100 km cut-off fail before meshing, naming both keys; 10 km pass
+    the check, and so do 25 km records with a 200 km cut-off."""
+    from lagice.scenes import builder, config
+    from lagice.scenes.components import _check_climatology_resolution
+
+    def boom(*a, **k):
+        raise AssertionError("meshing must not start")
+
+    monkeypatch.setattr(builder, "generate_mesh", boom)
+    cfg = config.load_scene("winter_basin_pack", {"forcing.grid_spacing_m": 25e3})
+    with pytest.raises(ConfigError) as exc:
+        builder.build_model(cfg)
+    msg = str(exc.value)
+    assert "forcing.grid_spacing_m = 25000" in msg and "shortest_wavelength_m = 100000" in msg
+    _check_climatology_resolution({"kind": "climatology"}, 10e3)
+    _check_climatology_resolution({"shortest_wavelength_m": 200e3}, 25e3)
+    _check_climatology_resolution({"background_spectrum": "gaussian"}, 50e3)
+
+
 def test_scene_builds_climatology_wind():
     """The scene builder's wind for kind = "climatology" is the generator's field with
     the run seed."""

@@ -227,7 +227,8 @@ def validate(cfg: dict, duration_s: float) -> None:
         elif key == "air_temperature":
             _check_air_kwargs(t, kind, cfg["run"]["start_date"])
         elif kind == "climatology":
-            _climatology_kwargs(_generator_table(t, key, kind))
+            _check_climatology_resolution(_climatology_kwargs(_generator_table(t, key, kind)),
+                                          fc["grid_spacing_m"])
         else:
             _check_kwargs(t, key, kind)
         if kind in ("uniform", "random", "cyclones", "gyre", "synthetic"):
@@ -329,6 +330,30 @@ def _climatology_kwargs(t: dict) -> dict:
     except (ConfigError, TypeError) as exc:
         raise ConfigError(f"forcing.wind (kind 'climatology'): {exc}") from None
     return kw
+
+
+#: fewest record-grid points per wavelength of the shortest climatology wind wave: on
+#: coarser records bilinear interpolation puts kinks in the wind stress along the grid
+#: rows and columns (4 points per wave imprinted the 25 km grid on the flagship's
+#: deformation, docs/physics.md §4)
+CLIMATOLOGY_POINTS_PER_WAVE = 8
+
+
+def _check_climatology_resolution(kw: dict, grid_spacing_m: float) -> None:
+    """The forcing grid must resolve the shortest wave of the climatology's background
+    (exponential spectrum): ``forcing.grid_spacing_m`` ≤ ``shortest_wavelength_m`` / 8."""
+    from forcing.climatology import make_params
+
+    p = make_params(**{k: v for k, v in kw.items() if k not in ("seed", "interval_s", "kind")})
+    if p.background_spectrum != "exponential" or p.background_wind_std_m_s == 0.0:
+        return
+    limit = p.shortest_wavelength_m / CLIMATOLOGY_POINTS_PER_WAVE
+    if grid_spacing_m > limit:
+        raise ConfigError(
+            f"forcing.grid_spacing_m = {grid_spacing_m:g} m is too coarse for the wind climatology: its shortest "
+            f"wave (forcing.wind.shortest_wavelength_m = {p.shortest_wavelength_m:g} m) needs records at most "
+            f"{limit:g} m apart ({CLIMATOLOGY_POINTS_PER_WAVE} points per wave); lower grid_spacing_m or raise "
+            f"shortest_wavelength_m")
 
 
 def _constant_air(t: dict) -> None:
