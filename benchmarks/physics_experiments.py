@@ -71,8 +71,8 @@ EXPERIMENTS = {
     "W20g": ("closed", ["forcing.wind.background_spectrum=gaussian"], 20e3, 28,
              "as W20 with the gaussian wind spectrum of the first generator"),
 }
-# the wind records on a 10 km grid (10 points per shortest 100 km wave instead of 4): is
-# the storm-window pattern of horizontal and vertical lines an imprint of the record grid?
+# the wind records on a 10 km grid (10 points per shortest 100 km wave instead of 4; the
+# scenes' default since) with the spin-up state made on 25 km records
 EXPERIMENTS["F10-g10"] = ("closed", ["forcing.grid_spacing_m=10e3"], 10e3, 28,
                           "as F10, wind records on a 10 km grid instead of 25 km")
 # realisation spread of the recommended set (closed, 20 km): the same weather (wind seed

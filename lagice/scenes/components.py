@@ -334,8 +334,7 @@ def _climatology_kwargs(t: dict) -> dict:
 
 #: fewest record-grid points per wavelength of the shortest climatology wind wave: on
 #: coarser records bilinear interpolation puts kinks in the wind stress along the grid
-#: rows and columns (4 points per wave imprinted the 25 km grid on the flagship's
-#: deformation, docs/physics.md §4)
+#: rows and columns (docs/physics.md §4)
 CLIMATOLOGY_POINTS_PER_WAVE = 8
 
 
