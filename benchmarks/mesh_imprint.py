@@ -14,11 +14,13 @@ Runs through the scene builder and Simulation (``lagice run`` subprocesses):
   over the rupture block; damage created by the rupture) against the Mohr–Coulomb
   angle 45° − atan(μ)/2, and the imprint index of the rupture.
 
-Options (``--variants``): ``base``; ``jitter`` (interior nodes moved by up to 0.3 ×
-their edge length, ``domain.jitter``).
+Options (``--variants``): ``base`` (gmsh Frontal-Delaunay: one lattice over the whole
+domain); ``jitter`` (interior nodes moved by up to 0.3 × their edge length,
+``domain.jitter``); ``delaunay`` (gmsh's Delaunay algorithm, ``domain.mesh_algorithm = 5``:
+no domain-wide lattice direction).
 
-    python benchmarks/mesh_imprint.py cyclone --variants base jitter
-    python benchmarks/mesh_imprint.py compression --n-across 40 80 --variants base jitter
+    python benchmarks/mesh_imprint.py cyclone --variants base jitter delaunay
+    python benchmarks/mesh_imprint.py compression --n-across 40 80 --variants base jitter delaunay
     python benchmarks/mesh_imprint.py report          # figure + JSON from the runs in --out
 
 Runs one simulation at a time (``NUMBA_NUM_THREADS`` as set by the caller). Writes
@@ -39,7 +41,15 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 ROTATIONS = (0.0, 15.0, 30.0)
-VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"]}
+VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.mesh_algorithm=5"]}
+
+
+def _value(v: str):
+    """A --set value as the scene wants it: an integer stays an integer."""
+    try:
+        return int(v)
+    except ValueError:
+        return float(v)
 
 
 def variant_sets(name):
@@ -115,7 +125,7 @@ def run_compression(out: Path, n_across: int, variant: str, max_strain=1e-3, see
         sub.mkdir(parents=True, exist_ok=True)
         overrides = dict(s.split("=", 1) for s in variant_sets(variant))
         p = validate_compression(sub, n_across, max_strain, seed,
-                                 overrides={k: float(v) for k, v in overrides.items()})
+                                 overrides={k: _value(v) for k, v in overrides.items()})
         p.replace(path)
     res = analyse_compression(path)
     z = np.load(path)

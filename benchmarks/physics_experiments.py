@@ -78,6 +78,13 @@ EXPERIMENTS["F10-g10"] = ("closed", ["forcing.grid_spacing_m=10e3"], 10e3, 28,
 # realisation spread of the recommended set (closed, 20 km): the same weather (wind seed
 # 2026) with another strength disorder (run.seed), and other weather (wind seed) with the
 # same disorder (run seed 2026); W20 is the member shared by both groups
+# the ±50 % sensitivity at the flagship's resolution (10 km, wind records on a 10 km grid,
+# the current spin-up state); F10 is the baseline
+for _key, _lo, _hi, _what in (("str", "rheology.strength_lab_pa=1.4e6", "rheology.strength_lab_pa=4.2e6", "strength"),
+                              ("drag", "forcing.drag.air_drag=1.0e-3", "forcing.drag.air_drag=3.0e-3", "air drag"),
+                              ("wind", "forcing.wind.wind_scale=0.5", "forcing.wind.wind_scale=1.5", "winds")):
+    EXPERIMENTS[f"X10-{_key}-50"] = ("closed", [_lo], 10e3, 28, f"{_what} −50 %, 10 km")
+    EXPERIMENTS[f"X10-{_key}+50"] = ("closed", [_hi], 10e3, 28, f"{_what} +50 %, 10 km")
 ENSEMBLES = {"disorder": ["W20"] + [f"W20-d{i}" for i in (1, 2, 3)],
              "weather": ["W20"] + [f"W20-w{i}" for i in (1, 2, 3)]}
 for _i in (1, 2, 3):

@@ -677,11 +677,16 @@ def write_report(res: dict, md: Path, figs: dict):
     mi = res.get("mesh_imprint") or {}
     if mi:
         lines += ["## Mesh imprint (docs/physics.md §3)", "",
-                  "Imprint index (F − F0)/(1 − F0) of the fracture directions against the mesh directions "
-                  "(0: chance, 1: every band along a mesh direction):", ""]
+                  "Imprint index (F − F0)/(1 − F0) of the fracture directions against the mesh's domain-wide "
+                  "directions, and local index (F̄ − F0)/(F̄_max − F0) against the edges within three element "
+                  "sizes of each band (0: chance, 1: every band along the mesh):", ""]
         for k, v in (mi.get("basin_closed_maxwell_eb") or {}).items():
             if isinstance(v, dict) and "index" in v:
-                lines.append(f"* flagship closed basin, {k.replace('_', ' ')}: index {v['index']:.2f}")
+                loc = v.get("local_index")
+                lines.append(f"* flagship closed basin, {k.replace('_', ' ')}: index {v['index']:.2f}, local index "
+                             f"{loc if loc is None else f'{loc:.2f}'} (mesh: "
+                             f"{100 * v.get('mesh_lattice_fraction', float('nan')):.0f} % of the edge length in three "
+                             f"15° bins, chance 25 %)")
         rt = mi.get("rotation_test")
         if rt:
             lines.append(f"* rotation test ({rt.get('source', '')}): {rt.get('summary', '')}")

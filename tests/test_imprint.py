@@ -4,9 +4,11 @@ import numpy as np
 import pytest
 
 from lagice.diagnostics.imprint import (
+    edge_orientations,
     fracture_orientations,
     imprint_index,
     imprint_summary,
+    local_alignment,
     mesh_directions,
     mesh_edges,
     orientation_shift_deg,
@@ -188,3 +190,85 @@ def test_bad_jitter_fails_before_meshing(monkeypatch):
     monkeypatch.setattr(builder, "generate_mesh", boom)
     with pytest.raises(ConfigError, match=r"domain.jitter = 0.6 is out of range; expected a value in \[0, 0.45\]"):
         builder.build_model(load_scene("imprint_cyclone_disk", {"domain.jitter": 0.6}))
+
+
+# -- gmsh's Delaunay algorithm and the local imprint metric (issue 12) ---------------------
+@pytest.fixture(scope="module")
+def delaunay_mesh():
+    """gmsh Delaunay mesh (algorithm 5) of the same 300 km square at 5 km."""
+    poly, segs = rectangle_domain(300e3, 300e3)
+    return generate_mesh(poly, H, segments=segs, algorithm=5)
+
+
+def _sixfold_order(m):
+    """|mean of exp(6iθ)| over the edges: 1 for one lattice orientation everywhere, ≈ 0
+    when the local lattices point every way."""
+    ang, ln = edge_orientations(m.nodes, m.triangles)
+    return abs(np.average(np.exp(6j * np.radians(ang)), weights=ln))
+
+
+def test_delaunay_mesh_has_no_domain_wide_lattice(lattice_mesh, delaunay_mesh):
+    """Frontal-Delaunay: one lattice over the domain (six-fold order > 0.7, > 80 % of the
+    edge length in three 15° bins); Delaunay: near-equilateral triangles (smallest angle
+    ≥ 25°) with no domain-wide direction (order < 0.15, bins near the 25 % of chance)."""
+    from lagice.mesh import angles_deg
+
+    assert _sixfold_order(lattice_mesh) > 0.7
+    assert _sixfold_order(delaunay_mesh) < 0.15
+    assert mesh_directions(delaunay_mesh.nodes, delaunay_mesh.triangles).lattice_fraction < 0.4
+    assert angles_deg(delaunay_mesh.nodes, delaunay_mesh.triangles).min() > 25.0
+
+
+@pytest.mark.parametrize("mesh_name", ["lattice_mesh", "delaunay_mesh"])
+def test_local_index_chance_and_one(mesh_name, request):
+    """Local imprint index: ≈ 0 for straight bands of random directions on both meshes.
+    Bands drawn along chains of mesh edges: > 0.7 on the lattice mesh, whose neighbourhoods
+    have straight rows (> 30 % of the nearby edge length within one 15° window). The
+    Delaunay mesh has no such rows (< 20 %, chance 8.3 %): a chain of its edges zigzags,
+    and its direction at the scale of three elements is the one it was started in."""
+    m = request.getfixturevalue(mesh_name)
+    rng = np.random.default_rng(1)
+    lines = [(rng.uniform(30e3, 270e3), rng.uniform(30e3, 270e3), rng.uniform(0, 180), 80e3) for _ in range(60)]
+    loc = []
+    for k in range(0, 60, 20):
+        f = _line_field(m, lines[k:k + 20], 0.6 * H)
+        fo = fracture_orientations(_centroids(m), f, 4 * H, threshold=0.5)
+        loc.append(local_alignment(m.nodes, m.triangles, fo)["local_index"])
+    assert abs(np.mean(loc)) < 0.15, loc
+    chains = _edge_chains(m, rng.uniform(0.0, 180.0, 40), 40, 25, np.random.default_rng(2))
+    f = np.zeros(m.n_elements)
+    tri = np.sort(m.triangles, axis=1)
+    for a, b in chains:
+        a, b = min(a, b), max(a, b)
+        on = ((tri[:, 0] == a) | (tri[:, 1] == a) | (tri[:, 2] == a)) & \
+             ((tri[:, 0] == b) | (tri[:, 1] == b) | (tri[:, 2] == b))
+        f[on] = 1.0
+    s = imprint_summary(m.nodes, m.triangles, f, radius_m=3 * H, threshold=0.5)
+    if mesh_name == "lattice_mesh":
+        assert s["local_best_fraction"] > 0.3 and s["local_index"] > 0.7, s
+    else:
+        assert s["local_best_fraction"] < 0.2, s
+
+
+def test_bad_mesh_algorithm_fails_before_meshing(monkeypatch):
+    from lagice.errors import ConfigError
+    from lagice.scenes import builder
+    from lagice.scenes.config import load_scene
+
+    def boom(*a, **k):
+        raise AssertionError("meshing must not start")
+
+    monkeypatch.setattr(builder, "generate_mesh", boom)
+    with pytest.raises(ConfigError, match=r"domain.mesh_algorithm = 8: expected a gmsh triangle algorithm"):
+        builder.build_model(load_scene("imprint_cyclone_disk", {"domain.mesh_algorithm": 8}))
+
+
+def test_scene_mesh_algorithm_reaches_gmsh():
+    """[domain] mesh_algorithm = 5 gives the Delaunay mesh (no domain-wide lattice)."""
+    from lagice.scenes.builder import build_mesh
+    from lagice.scenes.config import load_scene
+
+    m6, _ = build_mesh(load_scene("imprint_cyclone_disk", {"domain.resolution_m": 20e3}))
+    m5, _ = build_mesh(load_scene("imprint_cyclone_disk", {"domain.resolution_m": 20e3,
+                                                           "domain.mesh_algorithm": 5}))
+    assert _sixfold_order(m6) > 0.6 and _sixfold_order(m5) < 0.2

@@ -22,6 +22,9 @@ along those rows instead of the directions the stress selects. This module measu
    directions uniform on [0°, 180°) (the windows' total width / 180°, 0.25 for three
    15°-wide windows); **index = (F − F0)/(1 − F0)**: 0 at chance (isotropic fractures),
    1 when every fracture runs along a mesh direction, negative when fractures avoid them.
+3b. :func:`local_alignment`: the same question against the edges near each segment
+   (for meshes without a domain-wide lattice, e.g. gmsh's Delaunay algorithm):
+   **local index** = (F̄ − F0)/(F̄_max − F0), 0 at chance, 1 along the local lattice.
 4. :func:`orientation_shift_deg`: the rotation test. For the same physical scene on
    meshes whose lattice is rotated by α, the shift δ that best maps the fracture
    direction histogram of the unrotated mesh onto the rotated one is ≈ 0 when physics
@@ -117,6 +120,7 @@ class FractureOrientations:
     n_fractured: int
     threshold: float
     radius_m: float
+    positions_xy_m: np.ndarray | None = None  # (k, 2) centroids of the kept segments [m]
 
 
 def fracture_orientations(centroids_xy_m, field, radius_m, *, threshold=None, quantile=0.9,
@@ -141,7 +145,8 @@ def fracture_orientations(centroids_xy_m, field, radius_m, *, threshold=None, qu
             raise ConfigError(f"quantile = {quantile!r} must be in (0, 1)")
         threshold = float(np.quantile(f, quantile))
     sel = np.flatnonzero((f >= threshold) & (f > 0))
-    empty = FractureOrientations(np.zeros(0), np.zeros(0), np.zeros(0), int(sel.size), float(threshold), r)
+    empty = FractureOrientations(np.zeros(0), np.zeros(0), np.zeros(0), int(sel.size), float(threshold), r,
+                                 np.zeros((0, 2)))
     if sel.size < min_neighbours:
         return empty
     p = xy[sel] - xy[sel].mean(axis=0)
@@ -162,7 +167,54 @@ def fracture_orientations(centroids_xy_m, field, radius_m, *, threshold=None, qu
         an = np.where(tr > 0, np.sqrt((cxx - cyy) ** 2 + 4 * cxy * cxy) / tr, 0.0)
     ang = _wrap180(np.degrees(0.5 * np.arctan2(2 * cxy, cxx - cyy)))
     keep = (cnt >= min_neighbours) & (an >= min_anisotropy)
-    return FractureOrientations(ang[keep], an[keep], an, int(n), float(threshold), r)
+    return FractureOrientations(ang[keep], an[keep], an, int(n), float(threshold), r, xy[sel][keep])
+
+
+def local_alignment(nodes_xy_m, triangles, fo: FractureOrientations, radius_m=None,
+                    half_width_deg=7.5) -> dict:
+    """Local mesh imprint: do fracture segments run along the edges *near them*?
+
+    The index of :func:`imprint_index` compares fracture directions with the mesh's
+    domain-wide dominant directions; a mesh without a domain-wide lattice (gmsh's
+    Delaunay algorithm) has none, yet bands can still follow its local edges. For each
+    kept segment of ``fo`` (direction θ, weight a), the edges whose midpoints lie within
+    ``radius_m`` (default ``fo.radius_m``) give, length-weighted, F = the fraction within
+    ±``half_width_deg`` of θ and F_max = the same fraction in the best direction. Over
+    the segments (weights a): **local index = (F̄ − F0)/(F̄_max − F0)**, F0 =
+    2 half_width/180 (the mean of F over uniformly random θ, for any edge set). 0: bands
+    cross the local edges at random; 1: every band runs along its neighbourhood's most
+    common edge direction."""
+    from scipy.spatial import cKDTree
+
+    nodes = as_points("nodes_xy_m", nodes_xy_m)
+    tri = as_triangles(triangles, nodes.shape[0])
+    r = positive("radius_m", fo.radius_m if radius_m is None else radius_m, "m")
+    f0 = 2.0 * half_width_deg / 180.0
+    if fo.angles_deg.size == 0 or fo.positions_xy_m is None:
+        return {"local_index": float("nan"), "local_fraction": float("nan"), "local_best_fraction": float("nan"),
+                "chance": f0, "n_segments": 0}
+    e = mesh_edges(tri)
+    mid = 0.5 * (nodes[e[:, 0]] + nodes[e[:, 1]])
+    ang, ln = edge_orientations(nodes, tri)
+    hw = int(round(half_width_deg))
+    kern = np.ones(2 * hw + 1)
+    near_lists = cKDTree(mid).query_ball_point(fo.positions_xy_m, r)
+    F = np.full(fo.angles_deg.size, np.nan)
+    Fmax = np.full(fo.angles_deg.size, np.nan)
+    for k, idx in enumerate(near_lists):  # over segments (a diagnostic, not a time step)
+        if not idx:
+            continue
+        a, w = ang[idx], ln[idx]
+        tot = w.sum()
+        F[k] = w[_circ_dist180(a, fo.angles_deg[k]) <= half_width_deg].sum() / tot
+        h, _ = np.histogram(a, bins=180, range=(0.0, 180.0), weights=w)
+        Fmax[k] = np.convolve(np.concatenate([h[-hw:], h, h[:hw]]), kern, mode="valid").max() / tot
+    ok = np.isfinite(F)
+    wt = fo.weights[ok]
+    fbar = float(np.average(F[ok], weights=wt))
+    fmax = float(np.average(Fmax[ok], weights=wt))
+    return {"local_index": (fbar - f0) / (fmax - f0) if fmax > f0 else float("nan"),
+            "local_fraction": fbar, "local_best_fraction": fmax, "chance": f0, "n_segments": int(ok.sum())}
 
 
 def imprint_index(angles_deg, weights, mesh_dirs_deg, half_width_deg=7.5) -> dict:
@@ -226,6 +278,8 @@ def imprint_summary(nodes_xy_m, triangles, field, radius_m=None, **kw) -> dict:
     md = mesh_directions(nodes, tri)
     fo = fracture_orientations(p.mean(axis=1), field, radius_m, **kw)
     idx = imprint_index(fo.angles_deg, fo.weights, md.directions_deg, md.half_width_deg)
+    loc = local_alignment(nodes, tri, fo, half_width_deg=md.half_width_deg)
+    idx.update({k: loc[k] for k in ("local_index", "local_fraction", "local_best_fraction")})
     centres, hist = orientation_histogram(fo.angles_deg, fo.weights) if fo.angles_deg.size else (None, None)
     return {"mesh_directions_deg": md.directions_deg.tolist(), "mesh_lattice_fraction": md.lattice_fraction,
             "radius_m": radius_m, "threshold": fo.threshold, "n_fractured": fo.n_fractured, **idx,

@@ -98,6 +98,19 @@ def _rings(polygon: Polygon):
         yield np.asarray(interior.coords)[:-1]
 
 
+#: gmsh 2-D algorithms that make triangles: 1 MeshAdapt, 2 Automatic, 5 Delaunay,
+#: 6 Frontal-Delaunay, 7 BAMG (the others make quadrangles)
+TRIANGLE_ALGORITHMS = {1: "MeshAdapt", 2: "Automatic", 5: "Delaunay", 6: "Frontal-Delaunay", 7: "BAMG"}
+
+
+def check_mesh_algorithm(algorithm, key: str = "algorithm") -> int:
+    """The gmsh 2-D algorithm, checked (ConfigError naming the key, the value and the choices)."""
+    if isinstance(algorithm, bool) or not isinstance(algorithm, int) or algorithm not in TRIANGLE_ALGORITHMS:
+        choices = ", ".join(f"{k} ({v})" for k, v in TRIANGLE_ALGORITHMS.items())
+        raise ConfigError(f"{key} = {algorithm!r}: expected a gmsh triangle algorithm, one of {choices}")
+    return algorithm
+
+
 def generate_mesh(polygon: Polygon, size, *, segments: dict | None = None,
                   exterior_tag: str = COAST, island_tag: str = COAST,
                   algorithm: int = 6) -> Mesh:
@@ -111,11 +124,15 @@ def generate_mesh(polygon: Polygon, size, *, segments: dict | None = None,
             and ``"open"`` have their special meaning (see :mod:`lagice.mesh.core`).
         exterior_tag: tag of outer-boundary edges not on any segment.
         island_tag: tag of island-boundary edges not on any segment.
-        algorithm: gmsh 2-D algorithm (6 = Frontal-Delaunay).
+        algorithm: gmsh 2-D algorithm (:data:`TRIANGLE_ALGORITHMS`). 6 = Frontal-Delaunay
+            gives near-equilateral triangles on one lattice over the whole domain (most
+            edges within three 15° bins 60° apart); 5 = Delaunay gives near-equilateral
+            triangles with no domain-wide lattice direction (docs/physics.md §3).
 
     Raises:
         MeshError: invalid polygon or gmsh failure; ConfigError: invalid size.
     """
+    check_mesh_algorithm(algorithm)
     polygon = validate_polygon(polygon)
     size_v = validate_size(size, polygon)
     segments = dict(segments or {})

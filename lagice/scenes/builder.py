@@ -206,7 +206,7 @@ def build_mesh(cfg: dict, with_order: bool = False):
     random draws can be made in gmsh's order and stay the same with or without it."""
     d = cfg["domain"]
     poly, segs, ext_tag, size = build_domain(d)
-    mesh = generate_mesh(poly, size, segments=segs, exterior_tag=ext_tag)
+    mesh = generate_mesh(poly, size, segments=segs, exterior_tag=ext_tag, algorithm=d["mesh_algorithm"])
     order = np.arange(mesh.n_elements)
     if d["jitter"]:  # mesh-imprint option (issue 12): break the lattice of gmsh's frontal meshes
         from ..mesh.perturb import jitter_mesh
@@ -274,9 +274,11 @@ def validate_config(cfg: dict) -> None:
     check_range("run.max_speed_m_s", cfg["run"]["max_speed_m_s"], 0.0, None, low_open=True, unit="m s-1")
     rheo = build_rheology(cfg)
     strength_law(cfg)
+    from ..mesh.generate import check_mesh_algorithm
     from ..mesh.perturb import check_jitter
 
     check_jitter(cfg["domain"]["jitter"], "domain.jitter")
+    check_mesh_algorithm(cfg["domain"]["mesh_algorithm"], "domain.mesh_algorithm")
     sv = cfg["solver"]
     want = SOLVER_RHEOLOGY.get(sv["name"], "?")
     if sv["name"] in SOLVERS and want is not None and rheo.name != want:

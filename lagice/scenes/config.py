@@ -39,6 +39,10 @@ SCHEMA = {
         "crs": (str, "EPSG:3413"), "file_crs": (str, None),
         # interior node jitter, a fraction of the local edge length (lagice.mesh.perturb; issue 12)
         "jitter": (NUM, 0.0),
+        # gmsh 2-D algorithm of the initial mesh (lagice.mesh.generate; issue 12): 6 =
+        # Frontal-Delaunay (one near-perfect lattice over the whole domain), 5 = Delaunay
+        # (locally near-equilateral, no domain-wide lattice direction), 1 = MeshAdapt
+        "mesh_algorithm": (int, 6),
     },
     "initial": {
         "thickness_m": (EXPR, 1.0), "concentration": (EXPR, 1.0), "damage": (EXPR, 0.0),
