@@ -75,6 +75,10 @@ EXPERIMENTS = {
 # scenes' default since) with the spin-up state made on 25 km records
 EXPERIMENTS["F10-g10"] = ("closed", ["forcing.grid_spacing_m=10e3"], 10e3, 28,
                           "as F10, wind records on a 10 km grid instead of 25 km")
+# α = 5 (neXtSIM BBM's exponent_relaxation_sigma): damaged ice 1/(1 − d) times less
+# viscous; started from the shipped (α = 4) spin-up state (docs/physics.md §4)
+EXPERIMENTS["F10-alpha5"] = ("closed", ["rheology.alpha=5"], 10e3, 28,
+                             "as F10 with alpha = 5 (neXtSIM BBM), from the alpha = 4 spin-up state")
 # realisation spread of the recommended set (closed, 20 km): the same weather (wind seed
 # 2026) with another strength disorder (run.seed), and other weather (wind seed) with the
 # same disorder (run seed 2026); W20 is the member shared by both groups
