@@ -210,6 +210,9 @@ def local_alignment(nodes_xy_m, triangles, fo: FractureOrientations, radius_m=No
         h, _ = np.histogram(a, bins=180, range=(0.0, 180.0), weights=w)
         Fmax[k] = np.convolve(np.concatenate([h[-hw:], h, h[:hw]]), kern, mode="valid").max() / tot
     ok = np.isfinite(F)
+    if not ok.any():  # no edge within radius_m of any segment
+        return {"local_index": float("nan"), "local_fraction": float("nan"), "local_best_fraction": float("nan"),
+                "chance": f0, "n_segments": 0}
     wt = fo.weights[ok]
     fbar = float(np.average(F[ok], weights=wt))
     fmax = float(np.average(Fmax[ok], weights=wt))
