@@ -99,13 +99,8 @@ def _edge_chains(m, directions, n_chains, steps, rng):
     return chains
 
 
-def test_fractures_along_mesh_edges_give_one(lattice_mesh):
-    """Bands made of the elements on both sides of chains of mesh edges along the
-    lattice directions: index ≈ 1 (> 0.8). (Where bands cross, the local direction is
-    a mix: a dense network of crossing mesh-aligned bands scores lower.)"""
-    m = lattice_mesh
-    md = mesh_directions(m.nodes, m.triangles)
-    chains = _edge_chains(m, md.directions_deg, 12, 25, np.random.default_rng(2))
+def _chain_field(m, chains):
+    """1 on the elements on both sides of the chain edges (a, b), else 0."""
     f = np.zeros(m.n_elements)
     tri = np.sort(m.triangles, axis=1)
     for a, b in chains:
@@ -113,6 +108,17 @@ def test_fractures_along_mesh_edges_give_one(lattice_mesh):
         on = ((tri[:, 0] == a) | (tri[:, 1] == a) | (tri[:, 2] == a)) & \
              ((tri[:, 0] == b) | (tri[:, 1] == b) | (tri[:, 2] == b))
         f[on] = 1.0
+    return f
+
+
+def test_fractures_along_mesh_edges_give_one(lattice_mesh):
+    """Bands made of the elements on both sides of chains of mesh edges along the
+    lattice directions: index ≈ 1 (> 0.8). (Where bands cross, the local direction is
+    a mix: a dense network of crossing mesh-aligned bands scores lower.)"""
+    m = lattice_mesh
+    md = mesh_directions(m.nodes, m.triangles)
+    chains = _edge_chains(m, md.directions_deg, 12, 25, np.random.default_rng(2))
+    f = _chain_field(m, chains)
     s = imprint_summary(m.nodes, m.triangles, f, radius_m=3 * H, threshold=0.5)
     assert s["n_segments"] > 200
     assert s["index"] > 0.8, s["index"]
@@ -179,7 +185,11 @@ def test_jitter_breaks_the_lattice_and_keeps_the_mesh_valid(lattice_mesh):
     assert f0 > 0.85 and f1 < 0.6
 
 
-def test_bad_jitter_fails_before_meshing(monkeypatch):
+@pytest.mark.parametrize("key, value, message", [
+    ("domain.jitter", 0.6, r"domain.jitter = 0.6 is out of range; expected a value in \[0, 0.45\]"),
+    ("domain.mesh_algorithm", 8, r"domain.mesh_algorithm = 8: expected a gmsh triangle algorithm"),
+])
+def test_bad_mesh_option_fails_before_meshing(monkeypatch, key, value, message):
     from lagice.errors import ConfigError
     from lagice.scenes import builder
     from lagice.scenes.config import load_scene
@@ -188,8 +198,8 @@ def test_bad_jitter_fails_before_meshing(monkeypatch):
         raise AssertionError("meshing must not start")
 
     monkeypatch.setattr(builder, "generate_mesh", boom)
-    with pytest.raises(ConfigError, match=r"domain.jitter = 0.6 is out of range; expected a value in \[0, 0.45\]"):
-        builder.build_model(load_scene("imprint_cyclone_disk", {"domain.jitter": 0.6}))
+    with pytest.raises(ConfigError, match=message):
+        builder.build_model(load_scene("imprint_cyclone_disk", {key: value}))
 
 
 # -- gmsh's Delaunay algorithm and the local imprint metric (issue 12) ---------------------
@@ -236,31 +246,12 @@ def test_local_index_chance_and_one(mesh_name, request):
         loc.append(local_alignment(m.nodes, m.triangles, fo)["local_index"])
     assert abs(np.mean(loc)) < 0.15, loc
     chains = _edge_chains(m, rng.uniform(0.0, 180.0, 40), 40, 25, np.random.default_rng(2))
-    f = np.zeros(m.n_elements)
-    tri = np.sort(m.triangles, axis=1)
-    for a, b in chains:
-        a, b = min(a, b), max(a, b)
-        on = ((tri[:, 0] == a) | (tri[:, 1] == a) | (tri[:, 2] == a)) & \
-             ((tri[:, 0] == b) | (tri[:, 1] == b) | (tri[:, 2] == b))
-        f[on] = 1.0
+    f = _chain_field(m, chains)
     s = imprint_summary(m.nodes, m.triangles, f, radius_m=3 * H, threshold=0.5)
     if mesh_name == "lattice_mesh":
         assert s["local_best_fraction"] > 0.3 and s["local_index"] > 0.7, s
     else:
         assert s["local_best_fraction"] < 0.2, s
-
-
-def test_bad_mesh_algorithm_fails_before_meshing(monkeypatch):
-    from lagice.errors import ConfigError
-    from lagice.scenes import builder
-    from lagice.scenes.config import load_scene
-
-    def boom(*a, **k):
-        raise AssertionError("meshing must not start")
-
-    monkeypatch.setattr(builder, "generate_mesh", boom)
-    with pytest.raises(ConfigError, match=r"domain.mesh_algorithm = 8: expected a gmsh triangle algorithm"):
-        builder.build_model(load_scene("imprint_cyclone_disk", {"domain.mesh_algorithm": 8}))
 
 
 def test_scene_mesh_algorithm_reaches_gmsh():
