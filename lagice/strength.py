@@ -170,10 +170,25 @@ class NextsimHealing:
     ``thermo.zero_layer.ThermoParams``). Thin snow-free ice heals as
     th0 ΔT0/(Tf − Ta); open, low-concentration ice heals slowly (e^(−20·0.08) = 0.2 at
     A = 0.92). Returns the rate [s-1] per element for the solver's d ← d − H dt.
+
+    ``form`` picks what heals at that rate:
+
+    * ``"damage"`` (default; neXtSIM since January 2017): d ← d − H dt, so ice heals
+      from d = 1 to 0 in T_h whatever its damage;
+    * ``"compliance"`` (neXtSIM's code before commit 19db09fe, January 2017, which
+      wrote it ``tmp = 1/(1 − d); tmp −= 1000 dt/T_h``): the element's compliance
+      ratio χ = 1/(1 − d) = E0/E decreases linearly, χ ← χ − K H dt with
+      K = ``compliance_factor`` (1000 there). Lightly damaged ice heals fast (d = 0.5
+      in T_h/1000), nearly broken ice slowly (d = 0.999 to 0.99 in 0.9 T_h): cracks
+      stay soft while the pack between them recovers. The returned rate is then
+      negative, −K H (the sign convention of :func:`lagice.rheology.damage_step`).
     """
 
+    FORMS = ("damage", "compliance")
+
     def __init__(self, air_temperature, th0_s=25.0 * 86400.0, delta_t0_k=20.0, concentration_c=20.0,
-                 freezing_point_c=-1.8, conductivity_ice_w_m_k=2.0, conductivity_snow_w_m_k=0.31):
+                 freezing_point_c=-1.8, conductivity_ice_w_m_k=2.0, conductivity_snow_w_m_k=0.31,
+                 form="damage", compliance_factor=1000.0):
         from forcing.base import SCALAR, as_field
 
         self.air_temperature = as_field(air_temperature, SCALAR, "degC")
@@ -188,6 +203,10 @@ class NextsimHealing:
                               low_open=True)
         self.ks = check_range("healing.params.conductivity_snow_w_m_k", conductivity_snow_w_m_k, 0.0, None,
                               low_open=True)
+        if form not in self.FORMS:
+            raise ConfigError(f"healing.params.form = {form!r}; expected one of {list(self.FORMS)}")
+        self.form = form
+        self.compliance_factor = check_range("healing.params.compliance_factor", compliance_factor, 1.0, 1.0e6)
 
     def rate(self, air_temperature_c, thickness_m, concentration, snow_m=None):
         """H [s-1] per element."""
@@ -195,8 +214,11 @@ class NextsimHealing:
         hs = 0.0 if snow_m is None else np.asarray(snow_m, np.float64)
         dT = np.maximum(self.freezing_point_c - np.asarray(air_temperature_c, np.float64), 0.0)
         dT = dT / (1.0 + self.ki * hs / (self.ks * h))
-        return np.exp(-self.concentration_c * (1.0 - np.asarray(concentration, np.float64))) * dT / (
+        rate = np.exp(-self.concentration_c * (1.0 - np.asarray(concentration, np.float64))) * dT / (
             self.th0_s * self.delta_t0_k)
+        if self.form == "compliance":
+            rate *= -self.compliance_factor  # χ = 1/(1 − d) heals at K H (damage_step's sign convention)
+        return rate
 
     def element_rate(self, state, t_s):
         """H [s-1] per element of ``state`` at time ``t_s`` [s] (air temperature at the centroids)."""
@@ -222,7 +244,7 @@ class NextsimHealingComponent(RateComponent):
 
 #: keyword parameters of ``[healing.params]`` for ``law = "nextsim"``
 NEXTSIM_HEALING_PARAMS = ("th0_s", "delta_t0_k", "concentration_c", "freezing_point_c", "conductivity_ice_w_m_k",
-                          "conductivity_snow_w_m_k")
+                          "conductivity_snow_w_m_k", "form", "compliance_factor")
 
 
 def check_nextsim_healing_params(params: dict) -> None:

@@ -101,14 +101,27 @@ def damage_step(d, dc, dt, td, heal_rate, max_damage):
 
     Returns ``(d_new, f, capped)``: r = min(1, dt/td)(1 − dc), 1 − d ← (1 − d)(1 − r)
     where dc < 1; the stress factor f = 1 − r (1 without a damage event); then
-    healing d ← d − dt·heal_rate floored at 0 and the cap at ``max_damage``
-    (capped = 1 when it acted)."""
+    healing, floored at d = 0 (a fully healed element), and the cap at ``max_damage``
+    (capped = 1 when it acted).
+
+    The sign of ``heal_rate`` [s-1] selects the healing form (one array per element,
+    so the kernels' signatures serve both):
+
+    * ``heal_rate >= 0``: damage form, d ← d − dt·H (neXtSIM since 2017);
+    * ``heal_rate < 0``: compliance form, χ = 1/(1 − d) ← χ − dt·|H| (neXtSIM before
+      2017, :class:`lagice.strength.NextsimHealing` ``form = "compliance"``): the
+      compliance excess of a cracked element shrinks at a constant rate, so nearly
+      broken ice (χ ≫ 1) heals slowly and lightly damaged ice quickly."""
     f = 1.0
     if dc < 1.0:
         r = min(1.0, dt / td) * (1.0 - dc)
         d = 1.0 - (1.0 - d) * (1.0 - r)
         f = 1.0 - r
-    d -= dt * heal_rate
+    if heal_rate >= 0.0:
+        d -= dt * heal_rate
+    elif d < 1.0:
+        chi = 1.0 / (1.0 - d) + dt * heal_rate
+        d = 1.0 - 1.0 / chi if chi > 1.0 else 0.0
     if d < 0.0:
         d = 0.0
     capped = 0

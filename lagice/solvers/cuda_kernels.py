@@ -95,7 +95,11 @@ def damage_step_dev(d, dc, dt, td, heal_rate, max_damage):
         r = min2(1.0, dt / td) * (1.0 - dc)
         d = 1.0 - (1.0 - d) * (1.0 - r)
         f = 1.0 - r
-    d -= dt * heal_rate
+    if heal_rate >= 0.0:  # damage form (sign convention of rheology.damage_step)
+        d -= dt * heal_rate
+    elif d < 1.0:  # compliance form: 1/(1 − d) ← 1/(1 − d) − dt·|H|
+        chi = 1.0 / (1.0 - d) + dt * heal_rate
+        d = 1.0 - 1.0 / chi if chi > 1.0 else 0.0
     if d < 0.0:  # noqa: PLR1730 - no builtin max on CUDA (numba 0.68)
         d = 0.0
     capped = 0
