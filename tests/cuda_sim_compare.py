@@ -100,8 +100,15 @@ def heal_callable(state, t_s):
     return 5e-4 * (1.0 + state.damage)
 
 
+def heal_compliance(state, t_s):
+    """Compliance-form healing (negative rate: 1/(1 − d) decreases at |H|; the sign
+    convention of rheology.damage_step)."""
+    return -2e-2 * (1.0 + state.damage)
+
+
 def stepper(kind, mesh, rheo, forces, bcs, heal=False, **opts):
-    kw = {"bcs": bcs, "forces": forces, "heal_rate": heal_callable if heal else None}
+    kw = {"bcs": bcs, "forces": forces,
+          "heal_rate": heal if callable(heal) else (heal_callable if heal else None)}
     if kind == "cpu":
         return ExplicitSolver(rheo, mesh, parallel=False, **kw)
     if kind == "cpu_parallel":
@@ -328,6 +335,10 @@ def main():
     rep["cuda_explicit_sync_launches"] = compare(ref, run(model("cuda", sync="explicit", launch="launches")))
     rep["heal_callable_explicit_sync"] = compare(run(model("cpu", heal=True)),
                                                  run(model("cuda", heal=True, sync="explicit")))
+    cpu_compliance = run(model("cpu", heal=heal_compliance))
+    rep["heal_compliance_explicit_sync"] = compare(cpu_compliance,
+                                                   run(model("cuda", heal=heal_compliance, sync="explicit")))
+    rep["heal_compliance_damage_mean"] = [float(ref["damage"].mean()), float(cpu_compliance["damage"].mean())]
     rep["remesh_explicit_sync"] = compare(run(model("cpu", remesh=True)),
                                           run(model("cuda", remesh=True, sync="explicit")))
     host = model("cuda", variant="host", sync="explicit")

@@ -161,7 +161,7 @@ def test_cpu_serial_parallel_and_gpu_agree_on_a_damaging_run(sim_report):
     """Record wind and current (device interpolation), drag, Coriolis, a prescribed
     moving edge, damage, healing, the damage cap and mesh motion, 4 steps through
     Model and Simulation: the CPU parallel kernels and the simulated GPU (both launch
-    modes, both sync modes, a heal-rate callable, remeshing every step, host-evaluated
+    modes, both sync modes, heal-rate callables of both healing forms, remeshing every step, host-evaluated
     wind) give the CPU serial result to TOL, with the same sub-step, capped and damaged
     counts."""
     r = sim_report
@@ -173,8 +173,10 @@ def test_cpu_serial_parallel_and_gpu_agree_on_a_damaging_run(sim_report):
     assert r["damaged_fraction"] > 0.2 and r["damage_max"] == 0.3
     assert r["cpu_parallel"]["velocity"] == 0.0 and r["cpu_parallel"]["damage"] == 0.0  # bit-identical
     for case in ("cpu_parallel", "cuda_step_sync", "cuda_explicit_sync_launches", "heal_callable_explicit_sync",
-                 "remesh_explicit_sync", "host_fields"):
+                 "heal_compliance_explicit_sync", "remesh_explicit_sync", "host_fields"):
         _agree(case, r[case])
+    constant, compliance = r["heal_compliance_damage_mean"]
+    assert compliance < 0.9 * constant  # the compliance branch heals (faster than the constant law here)
     assert r["remesh_explicit_sync"]["remeshes"][0] == r["remesh_explicit_sync"]["remeshes"][1] >= 2
 
 

@@ -192,7 +192,34 @@ def test_nextsim_healing_rate():
         NextsimHealing(-20.0, th0_s=-1.0)
 
 
+def test_compliance_healing_form():
+    """form = "compliance" (neXtSIM before 2017): the rate is −K times the damage form's,
+    and damage_step then heals χ = 1/(1 − d) linearly in time, exactly over any number of
+    sub-steps: nearly broken ice heals slowly, lightly damaged ice fast."""
+    from lagice.rheology import damage_step
+    from lagice.strength import NextsimHealing
+
+    args = (np.array([-21.8, -11.8]), np.array([1.0, 2.0]), np.array([1.0, 0.95]), np.array([0.0, 0.3]))
+    lin = NextsimHealing(-21.8).rate(*args)
+    com = NextsimHealing(-21.8, form="compliance").rate(*args)
+    np.testing.assert_allclose(com, -1000.0 * lin, rtol=1e-15)
+    h = -1000.0 / (25 * 86400.0)  # |H| = K/th0 at ΔT = ΔT0
+    dt, n = 600.0, 144  # one day in 10-minute steps
+    for d0 in (0.999, 0.99):
+        d = d0
+        for _ in range(n):
+            d = damage_step(d, 1.0, dt, 1.0, h, 1.0 - 1e-6)[0]
+        assert 1.0 / (1.0 - d) == pytest.approx(1.0 / (1.0 - d0) + h * n * dt, rel=1e-9)
+    # d = 0.999 is still 0.9990 after a day; d = 0.5 (χ = 2) is fully healed after 1/|H| = 36 min
+    assert damage_step(0.5, 1.0, 1.0 / -h, 1.0, h, 1.0 - 1e-6)[0] == 0.0
+    assert damage_step(0.5, 1.0, 0.5 / -h, 1.0, h, 1.0 - 1e-6)[0] == pytest.approx(1.0 / 3.0, rel=1e-12)
+    # the damage form with the same |H| would take d = 0.999 to 0.0 within that day
+    assert damage_step(0.999, 1.0, n * dt, 1.0, -h, 1.0 - 1e-6)[0] == 0.0
+
+
 @pytest.mark.parametrize("params,fragment", [
+    ({"form": "exponential"}, "healing.params.form = 'exponential'; expected one of ['damage', 'compliance']"),
+    ({"form": "compliance", "compliance_factor": 0.5}, "healing.params.compliance_factor = 0.5 is out of range"),
     ({"th0_s": -1.0}, "healing.params.th0_s = -1.0 s is out of range"),
     ({"concentration_c": 500.0}, "healing.params.concentration_c = 500.0 is out of range; expected a value in "
                                  "[0, 100]"),

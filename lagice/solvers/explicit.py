@@ -133,7 +133,8 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
         sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * g
         syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * g
         sxy = (sigma[e, 2] + ed * (kss * exy)) * g
-        # damage and stress correction: rheology.damage_step, as in rheology.damage_update_kernel.
+        # damage and stress correction: rheology.damage_step (both healing forms, by the sign of
+        # heal_rate), as in rheology.damage_update_kernel.
         # Cheap test first: strictly inside the envelope (s1 < σT and q s1 − s2 < σc, with
         # σc = 2C/denom, σT = σc/q precomputed) _dcrit returns exactly 1.
         mm = 0.5 * (sxx + syy)
