@@ -89,6 +89,14 @@ for _key, _lo, _hi, _what in (("str", "rheology.strength_lab_pa=1.4e6", "rheolog
                               ("wind", "forcing.wind.wind_scale=0.5", "forcing.wind.wind_scale=1.5", "winds")):
     EXPERIMENTS[f"X10-{_key}-50"] = ("closed", [_lo], 10e3, 28, f"{_what} −50 %, 10 km")
     EXPERIMENTS[f"X10-{_key}+50"] = ("closed", [_hi], 10e3, 28, f"{_what} +50 %, 10 km")
+# the ocean is not at rest: a steady anticyclonic (Beaufort-like) gyre of 5 cm/s at most
+# (surface geostrophic currents of a few cm/s, Armitage et al. 2017, "Arctic Ocean surface
+# geostrophic circulation 2003-2014", The Cryosphere 11), from the shipped spin-up state
+EXPERIMENTS["F10-gyre"] = ("closed", ["forcing.ocean.kind=gyre", "forcing.ocean.max_speed_m_s=0.05"], 10e3, 28,
+                           "as F10 with a 5 cm/s anticyclonic ocean gyre instead of an ocean at rest")
+# diagnostic, not a candidate (neXtSIM heals): how much of the quiet-weather locking is healing
+EXPERIMENTS["F10-noheal"] = ("closed", ["healing.law=none"], 10e3, 28,
+                             "as F10 without healing (diagnostic), from the shipped spin-up state")
 ENSEMBLES = {"disorder": ["W20"] + [f"W20-d{i}" for i in (1, 2, 3)],
              "weather": ["W20"] + [f"W20-w{i}" for i in (1, 2, 3)]}
 for _i in (1, 2, 3):

@@ -319,6 +319,9 @@ def run_compression(out: Path, n_across: int, max_strain: float, seed: int = 0, 
         "output.timeseries": None, **(overrides or {})})
     rec = BlockRecorder(sim, n_steps, block)
     wall = timed_run(sim)
+    if not sim.finished:  # stopped by a signal: a partial record must not pass for a finished run
+        raise SystemExit(f"validate: compression N = {n_across} stopped at step {sim.model.clock.iteration} of "
+                         f"{n_steps} ({sim.stop_reason}); nothing saved")
     m = sim.model
     path = out / f"compression_N{n_across}.npz"
     np.savez_compressed(path, stress_pa=rec.stress, mean_damage=rec.mean_damage, velocity_block_mean=rec.vel_mean,
