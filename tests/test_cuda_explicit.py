@@ -161,9 +161,9 @@ def test_cpu_serial_parallel_and_gpu_agree_on_a_damaging_run(sim_report):
     """Record wind and current (device interpolation), drag, Coriolis, a prescribed
     moving edge, damage, healing, the damage cap and mesh motion, 4 steps through
     Model and Simulation: the CPU parallel kernels and the simulated GPU (both launch
-    modes, both sync modes, heal-rate callables of both healing forms, remeshing every step, host-evaluated
-    wind) give the CPU serial result to TOL, with the same sub-step, capped and damaged
-    counts."""
+    modes, both sync modes, heal-rate callables of both healing forms, remeshing every
+    step, host-evaluated wind) give the CPU serial result to TOL, with the same
+    sub-step, capped and damaged counts."""
     r = sim_report
     assert r["simulator"] is True
     assert r["paths"] == {"wind": "device", "ocean": "device"}
