@@ -16,6 +16,7 @@ largest displacement of the nodes that exist at the start and at the end).
     python benchmarks/physics_experiments.py run W20-d1 W20-d2 ...  # realisation ensembles (ENSEMBLES)
     python benchmarks/physics_experiments.py spread               # their mean and [min, max]
     python benchmarks/physics_experiments.py spinup               # remake data_stubs/winter_basin_spinup.npz
+    python benchmarks/physics_experiments.py spinup K50           # an experiment's own spin-up state (SPINUPS)
 
 Runs go to ``benchmarks/out/physics/NAME`` (logs NAME.log); results accumulate in
 ``benchmarks/out/physics/experiments.json`` and ``docs/figures/physics_experiments.json``.
@@ -97,6 +98,31 @@ EXPERIMENTS["F10-gyre"] = ("closed", ["forcing.ocean.kind=gyre", "forcing.ocean.
 # diagnostic, not a candidate (neXtSIM heals): how much of the quiet-weather locking is healing
 EXPERIMENTS["F10-noheal"] = ("closed", ["healing.law=none"], 10e3, 28,
                              "as F10 without healing (diagnostic), from the shipped spin-up state")
+# spin-up states: name -> (overrides of examples/winter_basin_spinup.toml, output file).
+# "shipped" is the flagship's (data_stubs of this checkout); the others are experiments'
+# own states, under benchmarks/out/physics, read by their runs with initial.state_file.
+COMPLIANCE50 = ["healing.params.form=compliance", "healing.params.compliance_factor=50"]
+SPINUPS = {"shipped": ([], ROOT / "data_stubs" / "winter_basin_spinup.npz"),
+           "K50": (COMPLIANCE50, OUT / "spinup-K50.npz")}
+
+
+def from_spinup(name: str) -> list:
+    """The override that starts a run from spin-up state ``name`` (see SPINUPS)."""
+    return [f"initial.state_file={SPINUPS[name][1]}"]
+
+
+# compliance healing (neXtSIM before 2017) with the calibrated K = 50 (docs/physics.md
+# §4), each from its own spin-up state made with the same healing (`spinup K50` first)
+EXPERIMENTS["F10-heal-K50"] = ("closed", COMPLIANCE50 + from_spinup("K50"), 10e3, 28,
+                               "as F10 with compliance healing K = 50, from the K50 spin-up state")
+EXPERIMENTS["F10s-heal-K50"] = ("strait", COMPLIANCE50 + from_spinup("K50"), 10e3, 28,
+                                "as F10s with compliance healing K = 50, from the K50 spin-up state")
+# a second realisation of the weather (wind seed 2027: another January; the spin-up
+# state and the strength disorder unchanged) for the flagship and for K = 50
+EXPERIMENTS["F10-w2027"] = ("closed", ["forcing.wind.seed=2027"], 10e3, 28,
+                            "as F10, the weather of wind seed 2027 (second realisation)")
+EXPERIMENTS["F10-heal-K50-w2027"] = ("closed", COMPLIANCE50 + from_spinup("K50") + ["forcing.wind.seed=2027"],
+                                     10e3, 28, "as F10-heal-K50, the weather of wind seed 2027")
 ENSEMBLES = {"disorder": ["W20"] + [f"W20-d{i}" for i in (1, 2, 3)],
              "weather": ["W20"] + [f"W20-w{i}" for i in (1, 2, 3)]}
 for _i in (1, 2, 3):
@@ -254,17 +280,24 @@ def spread() -> str:
     return "\n".join(lines)
 
 
-def spinup(days=14, res=10e3):
-    """The spin-up: ``examples/winter_basin_spinup.toml`` (pristine ice, seed 2025) for
-    ``days``, then its last snapshot → data_stubs/winter_basin_spinup.npz."""
-    from lagice.spinup import WINTER_BASIN, save_spinup
+def spinup(name="shipped", days=14, res=10e3):
+    """Spin-up state ``name`` (SPINUPS): ``examples/winter_basin_spinup.toml`` (pristine
+    ice, seed 2025) with its overrides for ``days``, then its last snapshot → its file
+    (for "shipped": data_stubs/winter_basin_spinup.npz of this checkout)."""
+    from lagice.spinup import save_spinup
 
-    out = OUT / "spinup"
+    if name not in SPINUPS:
+        raise SystemExit(f"physics: unknown spin-up {name!r}; known: {list(SPINUPS)}")
+    overrides, target = SPINUPS[name]
+    out = OUT / ("spinup" if name == "shipped" else f"spinup-{name}")
     cmd = [sys.executable, "-m", "lagice.cli", "run", str(ROOT / "examples" / "winter_basin_spinup.toml"), "--out",
            str(out), "--set", f"run.duration={days:g}d", "--set", f"domain.resolution_m={res:g}"]
+    for o in overrides:
+        cmd += ["--set", o]
     print("physics: spin-up: " + " ".join(cmd), flush=True)
     subprocess.run(cmd + (["--overwrite"] if out.exists() else []), check=True, cwd=ROOT)
-    print(f"physics: wrote {save_spinup(out, WINTER_BASIN)}")
+    target.parent.mkdir(parents=True, exist_ok=True)
+    print(f"physics: wrote {save_spinup(out, target)}")
 
 
 def main(argv=None):
@@ -282,7 +315,8 @@ def main(argv=None):
                 raise SystemExit(f"physics: unknown experiment {n!r}; known: {list(EXPERIMENTS)}")
             run_experiment(n, force=args.force, run=args.what == "run")
     elif args.what == "spinup":
-        spinup()
+        for n in args.names or ["shipped"]:
+            spinup(n)
     elif args.what == "spread":
         print(spread())
     else:

@@ -7,7 +7,10 @@ damage, thickness, concentration; float32) in a small ``.npz``; the scene hooks
 :func:`winter_basin_damage`, :func:`winter_basin_thickness`,
 :func:`winter_basin_concentration` read ``data_stubs/winter_basin_spinup.npz`` and give
 each new element the value of the nearest spin-up centroid, so they serve any
-resolution (``[initial] damage = "lagice.spinup:winter_basin_damage"``).
+resolution (``[initial] damage = "lagice.spinup:winter_basin_damage"``). Scenes name
+the file instead: ``[initial] state_file = "data_stubs/winter_basin_spinup.npz"`` with
+``damage = "from_state"`` (and ``thickness_m``, ``concentration``), so that a run can
+start from another spin-up (``--set initial.state_file=...``).
 
     python -m lagice.spinup RUN_DIR OUT.npz        # save the last snapshot of a run
 """
@@ -45,25 +48,65 @@ def save_spinup(run_dir, out_path) -> Path:
     return out
 
 
+#: valid range of each field of a state file (inclusive)
+RANGES = {"damage": (0.0, 1.0), "thickness": (0.0, 100.0), "concentration": (0.0, 1.0)}
+
+
+def resolve_state_path(spec) -> Path:
+    """A state file's path: absolute, else relative to the working directory when it
+    exists there, else to the lagice checkout (as ``domain.file``)."""
+    p = Path(spec)
+    if not p.is_absolute() and not p.exists():
+        p = ROOT / p
+    return p
+
+
+def load_state_file(spec, key: str = "initial.state_file"):
+    """(centroid tree, {field: float64 values}) of a spin-up state, checked: the file
+    exists and holds the centroids and FIELDS, finite and inside RANGES (a ConfigError
+    names ``key``, the file, the field, the bad value and the range)."""
+    p = resolve_state_path(spec)
+    if not p.exists():
+        raise ConfigError(f"{key} = {str(spec)!r}: spin-up state {p} does not exist; make it with "
+                          "`python benchmarks/physics_experiments.py spinup`")
+    return _load(str(p.resolve()), p.stat().st_mtime_ns, key)
+
+
 @lru_cache(maxsize=4)
-def _load(path: str):
+def _load(path: str, mtime_ns: int, key: str):
     from scipy.spatial import cKDTree
 
-    p = Path(path)
-    if not p.exists():
-        raise ConfigError(f"spin-up state {p} does not exist; make it with "
-                          "`python benchmarks/physics_experiments.py spinup`")
-    z = np.load(p)
+    try:
+        z = np.load(path)
+        names = set(z.files)
+    except Exception as exc:  # noqa: BLE001
+        raise ConfigError(f"{key}: cannot read {path} as an .npz spin-up state: {exc}") from exc
+    need = {"centroid_x_m", "centroid_y_m", *FIELDS}
+    if need - names:
+        raise ConfigError(f"{key}: {path} lacks {sorted(need - names)} (a spin-up state holds {sorted(need)})")
     xy = np.column_stack([z["centroid_x_m"], z["centroid_y_m"]]).astype(np.float64)
-    return cKDTree(xy), {k: z[k].astype(np.float64) for k in FIELDS}
+    if len(xy) == 0 or not np.isfinite(xy).all():
+        raise ConfigError(f"{key}: {path}: centroids are empty or not finite")
+    fields = {}
+    for k in FIELDS:
+        v = z[k].astype(np.float64)
+        lo, hi = RANGES[k]
+        if v.shape != (len(xy),):
+            raise ConfigError(f"{key}: {path}: field {k!r} has shape {v.shape}, expected ({len(xy)},)")
+        bad = ~np.isfinite(v) | (v < lo) | (v > hi)
+        if bad.any():
+            raise ConfigError(f"{key}: {path}: field {k!r} has {int(bad.sum())} values outside [{lo:g}, {hi:g}] "
+                              f"(first: {v[bad][0]!r})")
+        fields[k] = v
+    return cKDTree(xy), fields
 
 
 def field_from_spinup(path, name, x, y) -> np.ndarray:
     """Value of spin-up field ``name`` at the nearest spin-up centroid of each (x, y)."""
-    tree, fields = _load(str(path))
+    tree, fields = load_state_file(path)
     _, i = tree.query(np.column_stack([np.asarray(x, np.float64), np.asarray(y, np.float64)]))
     v = fields[name][i]
-    if name == "damage":  # float32 storage may round 0.9999999 up to 1
+    if name == "damage":  # float32 storage may round 0.9999999 up to 1 (the rheology's cap)
         v = np.minimum(v, 1.0 - 1e-6)
     return v
 
@@ -80,7 +123,7 @@ def winter_basin_thickness(x, y):
 
 def winter_basin_concentration(x, y):
     """Concentration of the winter_basin spin-up (scene hook)."""
-    return np.clip(field_from_spinup(WINTER_BASIN, "concentration", x, y), 0.0, 1.0)
+    return field_from_spinup(WINTER_BASIN, "concentration", x, y)
 
 
 if __name__ == "__main__":

@@ -77,3 +77,59 @@ def test_short_coarse_run_breaks_the_pack_in_the_interior(tmp_path):
     rate_in = r.total_s[inner].mean() * DAY
     assert rate_in > 0.005
     assert rate_in > r.total_s.mean() * DAY / 3.0
+
+
+def _state_npz(path, damage=0.42, thickness=2.0, concentration=0.9, drop=None):
+    """A spin-up state file on a 10 km grid over the basin, uniform fields."""
+    g = np.arange(-700e3, 700e3, 10e3)
+    x, y = (a.ravel().astype(np.float32) for a in np.meshgrid(g, g))
+    f = {"damage": np.full(x.size, damage, np.float32), "thickness": np.full(x.size, thickness, np.float32),
+         "concentration": np.full(x.size, concentration, np.float32)}
+    if drop:
+        f.pop(drop)
+    np.savez(path, centroid_x_m=x, centroid_y_m=y, time_s=np.float64(0.0), **f)
+    return path
+
+
+def test_state_file_sets_the_initial_state(tmp_path):
+    """``--set initial.state_file=PATH`` starts the flagship from another spin-up state:
+    every element takes that file's fields, not the shipped state's."""
+    from lagice.scenes.builder import build_model
+    from lagice.scenes.config import load_scene
+
+    npz = _state_npz(tmp_path / "other.npz")
+    st = build_model(load_scene("winter_basin_pack", {"domain.resolution_m": 60e3, "run.duration": "1h",
+                                                      "solver.dt": "1h", "initial.state_file": str(npz)})).state
+    np.testing.assert_allclose(st.damage, 0.42, rtol=1e-6)
+    np.testing.assert_allclose(st.thickness, 2.0, rtol=1e-6)
+    np.testing.assert_allclose(st.concentration, 0.9, rtol=1e-6)
+    shipped = np.load(WINTER_BASIN)["damage"]
+    assert shipped.std() > 0.05  # so the shipped state would not have given a uniform 0.42
+
+
+@pytest.mark.parametrize("scene,sets,fragment", [
+    ("winter_basin_pack", {"initial.state_file": "nowhere/missing.npz"},
+     "initial.state_file = 'nowhere/missing.npz': spin-up state"),
+    ("winter_basin_pack", {"initial.state_file": "BAD_DAMAGE"}, "field 'damage' has 1"),
+    ("winter_basin_pack", {"initial.state_file": "NO_THICKNESS"}, "lacks ['thickness']"),
+    ("winter_basin_pack", {"initial.state_file": ""}, "initial.thickness_m = 'from_state' needs initial.state_file"),
+    ("winter_basin_spinup", {"initial.state_file": "GOOD"}, "is set but no initial field uses it"),
+    ("winter_basin_spinup", {"initial.snow_m": "from_state"}, "initial.snow_m = 'from_state': only"),
+])
+def test_bad_state_file_fails_before_meshing(monkeypatch, tmp_path, scene, sets, fragment):
+    """A missing or invalid spin-up state, or a state file and ``from_state`` fields that
+    do not go together, fail before any meshing with the key, file and field named."""
+    from lagice.errors import ConfigError
+    from lagice.scenes import builder, config
+
+    files = {"BAD_DAMAGE": lambda p: _state_npz(p, damage=1.5),
+             "NO_THICKNESS": lambda p: _state_npz(p, drop="thickness"), "GOOD": _state_npz}
+    sets = {k: (str(files[v](tmp_path / f"{v}.npz")) if v in files else v) for k, v in sets.items()}
+
+    def boom(*a, **k):
+        raise AssertionError("meshing must not start")
+
+    monkeypatch.setattr(builder, "generate_mesh", boom)
+    with pytest.raises(ConfigError) as exc:
+        builder.build_model(config.load_scene(scene, sets))
+    assert fragment in str(exc.value)

@@ -23,6 +23,7 @@ from ..rheology import MaxwellEB, ViscousPlastic, ViscousPlasticParams, draw_coh
 from ..schedule import parse_duration, parse_schedule
 from ..simulation import Simulation
 from ..solvers import SOLVER_RHEOLOGY, SOLVERS, VelocityBC
+from ..spinup import field_from_spinup, load_state_file
 from ..state import IceState
 from . import components
 from .components import time_step_s  # noqa: F401 - part of the builder API
@@ -321,8 +322,9 @@ def validate_config(cfg: dict) -> None:
             if bc[comp] is not None:
                 time_space_callable(bc[comp], f"boundary.{tag}.{comp}")
     probe = np.array([0.5 * (d.get("width_m") or 1.0)]), np.array([0.5 * (d.get("height_m") or 1.0)])
+    state_fields = check_initial_state_file(cfg["initial"])
     for key, val in cfg["initial"].items():
-        if val is None or (key == "cohesion_pa" and val == "random"):
+        if val is None or (key == "cohesion_pa" and val == "random") or key == "state_file" or key in state_fields:
             continue
         if key == "stress_pa" and isinstance(val, str) and ":" in val:
             resolve_hook(val, "initial.stress_pa")
@@ -422,6 +424,30 @@ def solver_options(cfg: dict) -> dict:
 
 
 # -- the model -----------------------------------------------------------------------
+#: initial fields a spun-up state file provides (``[initial] KEY = "from_state"``)
+FROM_STATE = {"thickness_m": "thickness", "concentration": "concentration", "damage": "damage"}
+
+
+def check_initial_state_file(ini: dict) -> list[str]:
+    """The ``[initial]`` keys set to ``"from_state"``, after checking that they and
+    ``initial.state_file`` go together and that the file holds valid fields (before any
+    meshing)."""
+    keys = [k for k in FROM_STATE if ini.get(k) == "from_state"]
+    other = [k for k, v in ini.items() if v == "from_state" and k not in FROM_STATE]
+    if other:
+        raise ConfigError(f"initial.{other[0]} = 'from_state': only {sorted(FROM_STATE)} can come from "
+                          f"initial.state_file")
+    if keys and not ini.get("state_file"):
+        raise ConfigError(f"initial.{keys[0]} = 'from_state' needs initial.state_file (a spin-up state .npz, "
+                          f"`python benchmarks/physics_experiments.py spinup`)")
+    if ini.get("state_file") and not keys:
+        raise ConfigError(f"initial.state_file = {ini['state_file']!r} is set but no initial field uses it: set "
+                          f"some of {sorted(FROM_STATE)} to 'from_state', or remove initial.state_file")
+    if keys:
+        load_state_file(ini["state_file"], "initial.state_file")
+    return keys
+
+
 def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
     """The scene's initial state on ``mesh``; ``order`` (see :func:`build_mesh`): random
     cohesion is drawn in the mesh generator's element order, then permuted, so the
@@ -442,10 +468,13 @@ def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
                 cohesion = cohesion[order]
     else:
         cohesion = spatial_values(coh, x, y, "initial.cohesion_pa")
-    state = IceState.uniform(
-        mesh, thickness_m=spatial_values(ini["thickness_m"], x, y, "initial.thickness_m"),
-        concentration=spatial_values(ini["concentration"], x, y, "initial.concentration"),
-        damage=spatial_values(ini["damage"], x, y, "initial.damage"), cohesion_pa=cohesion)
+    def field(key):
+        if ini[key] == "from_state":
+            return field_from_spinup(ini["state_file"], FROM_STATE[key], x, y)
+        return spatial_values(ini[key], x, y, f"initial.{key}")
+
+    state = IceState.uniform(mesh, thickness_m=field("thickness_m"), concentration=field("concentration"),
+                             damage=field("damage"), cohesion_pa=cohesion)
     if ini["snow_m"] is not None:
         state.snow = spatial_values(ini["snow_m"], x, y, "initial.snow_m")
     sp = ini["stress_pa"]

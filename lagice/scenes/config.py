@@ -47,6 +47,9 @@ SCHEMA = {
     "initial": {
         "thickness_m": (EXPR, 1.0), "concentration": (EXPR, 1.0), "damage": (EXPR, 0.0),
         "snow_m": (EXPR, None), "cohesion_pa": (EXPR, "random"), "stress_pa": (EXPR, 0.0),
+        # a spun-up state (.npz of lagice.spinup.save_spinup): thickness_m, concentration,
+        # damage = "from_state" take the value of its nearest element centroid (issue 12)
+        "state_file": (str, None),
     },
     "rheology": {
         "law": (str, "maxwell_eb"),
