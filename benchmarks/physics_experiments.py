@@ -98,12 +98,18 @@ EXPERIMENTS["F10-gyre"] = ("closed", ["forcing.ocean.kind=gyre", "forcing.ocean.
 # diagnostic, not a candidate (neXtSIM heals): how much of the quiet-weather locking is healing
 EXPERIMENTS["F10-noheal"] = ("closed", ["healing.law=none"], 10e3, 28,
                              "as F10 without healing (diagnostic), from the shipped spin-up state")
-# spin-up states: name -> (overrides of examples/winter_basin_spinup.toml, output file).
-# "shipped" is the flagship's (data_stubs of this checkout); the others are experiments'
-# own states, under benchmarks/out/physics, read by their runs with initial.state_file.
+# spin-up states: name -> (overrides of examples/winter_basin_spinup.toml, output file,
+# resolution [m]). "shipped" is the flagship's (data_stubs of this checkout); the others
+# are experiments' own states, under benchmarks/out/physics, read by their runs with
+# initial.state_file.
 COMPLIANCE50 = ["healing.params.form=compliance", "healing.params.compliance_factor=50"]
-SPINUPS = {"shipped": ([], ROOT / "data_stubs" / "winter_basin_spinup.npz"),
-           "K50": (COMPLIANCE50, OUT / "spinup-K50.npz")}
+#: the basin twice as wide (radius 1000 km instead of 500 km; the coastline and island
+#: scaled): written by :func:`prepare_inputs`, not shipped
+BASIN_X2 = OUT / "winter_basin_coast_x2.geojson"
+SPINUPS = {"shipped": ([], ROOT / "data_stubs" / "winter_basin_spinup.npz", 10e3),
+           "K50": (COMPLIANCE50, OUT / "spinup-K50.npz", 10e3),
+           "S20": ([], OUT / "spinup-S20.npz", 20e3),
+           "S20x2": ([f"domain.file={BASIN_X2}"], OUT / "spinup-S20x2.npz", 20e3)}
 
 
 def from_spinup(name: str) -> list:
@@ -111,6 +117,24 @@ def from_spinup(name: str) -> list:
     return [f"initial.state_file={SPINUPS[name][1]}"]
 
 
+def prepare_inputs():
+    """Write the inputs that experiments make rather than ship (BASIN_X2)."""
+    if not BASIN_X2.exists():
+        g = json.loads((ROOT / "data_stubs" / "winter_basin_coast.geojson").read_text())
+        geom = g["features"][0]["geometry"]
+        geom["coordinates"] = [[[2.0 * x, 2.0 * y] for x, y in ring] for ring in geom["coordinates"]]
+        g["features"][0]["properties"]["made_by"] = "benchmarks/physics_experiments.py (x2)"
+        OUT.mkdir(parents=True, exist_ok=True)
+        BASIN_X2.write_text(json.dumps(g))
+
+
+# basin size (closed, 20 km, each from its own 20 km spin-up state): the wind stress that
+# a closed basin integrates grows with its width, and the Arctic pack is 2-3 times wider
+# than the 1000 km basin. Same physics, same seeds; only the coastline is scaled x2.
+EXPERIMENTS["B20"] = ("closed", from_spinup("S20"), 20e3, 28,
+                      "recommended set, 20 km, from its own 20 km spin-up state (basin-size baseline)")
+EXPERIMENTS["B20x2"] = ("closed", [f"domain.file={BASIN_X2}"] + from_spinup("S20x2"), 20e3, 28,
+                        "as B20 in a basin twice as wide (radius 1000 km), from its own spin-up state")
 # compliance healing (neXtSIM before 2017) with the calibrated K = 50 (docs/physics.md
 # §4), each from its own spin-up state made with the same healing (`spinup K50` first)
 EXPERIMENTS["F10-heal-K50"] = ("closed", COMPLIANCE50 + from_spinup("K50"), 10e3, 28,
@@ -280,7 +304,7 @@ def spread() -> str:
     return "\n".join(lines)
 
 
-def spinup(name="shipped", days=14, res=10e3):
+def spinup(name="shipped", days=14):
     """Spin-up state ``name`` (SPINUPS): ``examples/winter_basin_spinup.toml`` (pristine
     ice, seed 2025) with its overrides for ``days``, then its last snapshot → its file
     (for "shipped": data_stubs/winter_basin_spinup.npz of this checkout)."""
@@ -288,7 +312,7 @@ def spinup(name="shipped", days=14, res=10e3):
 
     if name not in SPINUPS:
         raise SystemExit(f"physics: unknown spin-up {name!r}; known: {list(SPINUPS)}")
-    overrides, target = SPINUPS[name]
+    overrides, target, res = SPINUPS[name]
     out = OUT / ("spinup" if name == "shipped" else f"spinup-{name}")
     cmd = [sys.executable, "-m", "lagice.cli", "run", str(ROOT / "examples" / "winter_basin_spinup.toml"), "--out",
            str(out), "--set", f"run.duration={days:g}d", "--set", f"domain.resolution_m={res:g}"]
@@ -306,6 +330,8 @@ def main(argv=None):
     ap.add_argument("names", nargs="*")
     ap.add_argument("--force", action="store_true", help="run again even if the run finished")
     args = ap.parse_args(argv)
+    if args.what in ("run", "spinup"):
+        prepare_inputs()
     if args.what == "list":
         for k, (sc, ov, res, days, what) in EXPERIMENTS.items():
             print(f"{k}: {SCENES[sc]} {res / 1e3:g} km {days} d: {what}\n    {' '.join(ov)}")
