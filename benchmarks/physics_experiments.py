@@ -109,7 +109,8 @@ BASIN_X2 = OUT / "winter_basin_coast_x2.geojson"
 SPINUPS = {"shipped": ([], ROOT / "data_stubs" / "winter_basin_spinup.npz", 10e3),
            "K50": (COMPLIANCE50, OUT / "spinup-K50.npz", 10e3),
            "S20": ([], OUT / "spinup-S20.npz", 20e3),
-           "S20x2": ([f"domain.file={BASIN_X2}"], OUT / "spinup-S20x2.npz", 20e3)}
+           "S20x2": ([f"domain.file={BASIN_X2}"], OUT / "spinup-S20x2.npz", 20e3),
+           "S10x2": ([f"domain.file={BASIN_X2}"], OUT / "spinup-S10x2.npz", 10e3)}
 
 
 def from_spinup(name: str) -> list:
@@ -133,6 +134,8 @@ def prepare_inputs():
 # than the 1000 km basin. Same physics, same seeds; only the coastline is scaled x2.
 EXPERIMENTS["B20"] = ("closed", from_spinup("S20"), 20e3, 28,
                       "recommended set, 20 km, from its own 20 km spin-up state (basin-size baseline)")
+EXPERIMENTS["F10x2"] = ("closed", [f"domain.file={BASIN_X2}"] + from_spinup("S10x2"), 10e3, 28,
+                        "as F10 in a basin twice as wide (radius 1000 km), from its own 10 km spin-up state")
 EXPERIMENTS["B20x2"] = ("closed", [f"domain.file={BASIN_X2}"] + from_spinup("S20x2"), 20e3, 28,
                         "as B20 in a basin twice as wide (radius 1000 km), from its own spin-up state")
 # compliance healing (neXtSIM before 2017) with the calibrated K = 50 (docs/physics.md
