@@ -17,7 +17,9 @@ Runs through the scene builder and Simulation (``lagice run`` subprocesses):
 Options (``--variants``): ``base`` (gmsh Frontal-Delaunay: one lattice over the whole
 domain); ``jitter`` (interior nodes moved by up to 0.3 × their edge length,
 ``domain.jitter``); ``delaunay`` (gmsh's Delaunay algorithm, ``domain.mesh_algorithm = 5``:
-no domain-wide lattice direction).
+no domain-wide lattice direction); ``meanstress`` (``rheology.stress_correction =
+"mean_stress"``: the damage correction keeps the mean normal stress; combine with ``+``,
+e.g. ``delaunay+meanstress``).
 
     python benchmarks/mesh_imprint.py cyclone --variants base jitter delaunay
     python benchmarks/mesh_imprint.py compression --n-across 40 80 --variants base jitter delaunay
@@ -41,15 +43,18 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 ROTATIONS = (0.0, 15.0, 30.0)
-VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.mesh_algorithm=5"]}
+VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.mesh_algorithm=5"],
+            "meanstress": ["rheology.stress_correction=mean_stress"]}
 
 
 def _value(v: str):
-    """A --set value as the scene wants it: an integer stays an integer."""
-    try:
-        return int(v)
-    except ValueError:
-        return float(v)
+    """A --set value as the scene wants it: an integer stays an integer, a word a string."""
+    for kind in (int, float):
+        try:
+            return kind(v)
+        except ValueError:
+            pass
+    return v
 
 
 def variant_sets(name):

@@ -138,6 +138,9 @@ EXPERIMENTS["F10x2"] = ("closed", [f"domain.file={BASIN_X2}"] + from_spinup("S10
                         "as F10 in a basin twice as wide (radius 1000 km), from its own 10 km spin-up state")
 EXPERIMENTS["B20x2"] = ("closed", [f"domain.file={BASIN_X2}"] + from_spinup("S20x2"), 20e3, 28,
                         "as B20 in a basin twice as wide (radius 1000 km), from its own spin-up state")
+EXPERIMENTS["F10x2-w2027"] = ("closed", [f"domain.file={BASIN_X2}", "forcing.wind.seed=2027"]
+                              + from_spinup("S10x2"), 10e3, 28,
+                              "as F10x2 with the weather of wind seed 2027 (second realisation)")
 # compliance healing (neXtSIM before 2017) with the calibrated K = 50 (docs/physics.md
 # §4), each from its own spin-up state made with the same healing (`spinup K50` first)
 EXPERIMENTS["F10-heal-K50"] = ("closed", COMPLIANCE50 + from_spinup("K50"), 10e3, 28,
@@ -185,6 +188,8 @@ def analyse(name: str, run: Path, days: float, buffer_m: float = 100e3) -> dict:
     """Window statistics of one run (as benchmarks/validate.py), drift, remeshing, wall time."""
     from validate import analyse_run
 
+    from lagice.diagnostics.scaling import MIN_FIT_BOXES
+
     r = analyse_run(run, days, buffer_m)
     med = dict(r["median"])
     rates = [w["interior"]["mean_total_s"] * DAY for w in r["windows"]]
@@ -204,7 +209,10 @@ def analyse(name: str, run: Path, days: float, buffer_m: float = 100e3) -> dict:
                                                            "localisation_half_shear_area_fraction",
                                                            "shear_divergence_r2", "mean_total_s")}
                            | {"start_day": w["start_day"]} for w in r["windows"]],
-            "inside": {k: bool(TARGETS[k][0] <= med[k] <= TARGETS[k][1]) for k in TARGETS}}
+            "inside": {k: bool(TARGETS[k][0] <= med[k] <= TARGETS[k][1]) for k in TARGETS},
+            # boxes a width needs to enter the β fit (entries without this key: every width,
+            # the estimator before 2026-11-24; docs/physics.md "How β was estimated")
+            "beta_min_boxes": MIN_FIT_BOXES}
 
 
 def _store(res: dict):
@@ -251,7 +259,8 @@ def run_experiment(name: str, force: bool = False, run: bool = True) -> dict:
             raise SystemExit(f"physics: {name} failed; log {OUT / (name + '.log')}")
         print(f"physics: {name} done in {time.perf_counter() - t0:.0f} s", flush=True)
     r = analyse(name, out, days)
-    command_line = "NUMBA_NUM_THREADS=1 lagice run " + " ".join(shlex.quote(str(c)) for c in cmd[4:])
+    threads = os.environ.get("NUMBA_NUM_THREADS", "1")
+    command_line = f"NUMBA_NUM_THREADS={threads} lagice run " + " ".join(shlex.quote(str(c)) for c in cmd[4:])
     r.update({"scene": SCENES[scene], "overrides": overrides, "resolution_m": res, "days": days, "what": what,
               "command": command_line.replace(str(ROOT) + "/", "")})
     _store(r)

@@ -16,6 +16,10 @@ RHO_WATER = 1025.0  # kg m-3, Girard et al. 2011
 OMEGA_EARTH = 7.2921e-5  # rad s-1
 
 
+#: stress-correction paths of :class:`MaxwellEBParams` (``rheology.stress_correction``)
+STRESS_CORRECTIONS = ("origin", "mean_stress")
+
+
 @dataclass(frozen=True)
 class MaxwellEBParams:
     """Maxwell-Elasto-Brittle rheology parameters (Dansereau et al. 2016 Table 1).
@@ -32,6 +36,10 @@ class MaxwellEBParams:
         healing_time_s: th of constant-rate healing [s] (None or inf: no healing)
         concentration_c: c* of exp(-c*(1-A)) [-]
         max_damage: damage cap below 1 keeping E > 0 [-]
+        stress_correction: path that brings a super-critical stress back to the envelope:
+            ``"origin"`` (Dansereau et al. 2016, neXtSIM: the whole tensor scaled towards 0)
+            or ``"mean_stress"`` (only the deviatoric part scaled, the mean normal stress
+            kept; implicit solver only; docs/physics.md, compression test)
     """
 
     poisson: float = 0.3
@@ -46,6 +54,7 @@ class MaxwellEBParams:
     healing_time_s: float | None = 1.0e5
     concentration_c: float = 20.0
     max_damage: float = 1.0 - 1.0e-6
+    stress_correction: str = "origin"
 
     def __post_init__(self):
         check_range("poisson (ν)", self.poisson, 0.0, 0.5, high_open=True)
@@ -62,6 +71,9 @@ class MaxwellEBParams:
             check_range("healing_time_s (th)", self.healing_time_s, 0.0, None, low_open=True, unit="s")
         check_range("concentration_c (c*)", self.concentration_c, 0.0, None)
         check_range("max_damage", self.max_damage, 0.0, 1.0, high_open=True)
+        if self.stress_correction not in STRESS_CORRECTIONS:
+            raise ConfigError(f"rheology.stress_correction = {self.stress_correction!r}: expected one of "
+                              f"{list(STRESS_CORRECTIONS)}")
 
     @property
     def E0(self) -> float:

@@ -48,7 +48,7 @@ def test_slip_lines_with_time_series(tmp_path):
     series = np.repeat(xy0[None], 10, axis=0)
     series[1::2] = xy1
     out = diagnose_arrays(xy0, xy1, tri, DT_S, tmp_path, box_sizes_m=[3e3, 9e3, 27e3, 81e3],
-                          fit_range_m=(8e3, 82e3), include_element_scale=False,
+                          fit_range_m=(8e3, 82e3), include_element_scale=False, min_boxes=1,
                           nodes_xy_series=series, series_dt_s=DT_S, window_steps=[1, 3, 9], min_tail=20)
     for key in REQUIRED:
         assert key in out

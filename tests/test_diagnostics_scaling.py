@@ -62,7 +62,7 @@ def mesh():
 def test_same_sense_slip_lines_mean_is_scale_invariant(mesh):
     xy, tri = mesh
     rates = velocity_gradients(xy, tri, slip_line_velocity(xy, S_M, DU))
-    sp = spatial_scaling(rates, W_M, include_element_scale=False)
+    sp = spatial_scaling(rates, W_M, include_element_scale=False, min_boxes=1)  # exact field: 1 box suffices
     assert list(sp.coarse.n_boxes) == [6561, 729, 81, 9, 1]
     np.testing.assert_allclose(sp.coarse.scale_m, W_M, rtol=1e-3)
     np.testing.assert_allclose(sp.mean_total_s, DU / S_M, rtol=0.02)
@@ -91,7 +91,7 @@ def test_same_sense_slip_lines_conditional_mean_L_minus_one_then_plateau(mesh):
 def test_alternating_slip_lines_plateau_then_L_minus_one(mesh):
     xy, tri = mesh
     rates = velocity_gradients(xy, tri, slip_line_velocity(xy, S_M, DU, alternating=True))
-    sp = spatial_scaling(rates, W_M, include_element_scale=False, fit_range_m=(0.99 * S_M, L_M))
+    sp = spatial_scaling(rates, W_M, include_element_scale=False, fit_range_m=(0.99 * S_M, L_M), min_boxes=1)
     expected = np.where(W_M <= S_M, DU / S_M, DU / W_M)
     np.testing.assert_allclose(sp.mean_total_s, expected, rtol=0.02)
     assert sp.fit.exponent == pytest.approx(1.0, abs=0.02)
@@ -106,8 +106,30 @@ def test_lagrangian_slip_lines_give_same_scaling(mesh):
     dt = 3 * 86400.0
     uv = slip_line_velocity(xy, S_M, 1e-4, alternating=True)  # 26 m in 3 days, << element size
     rates = lagrangian_velocity_gradients(xy, xy + dt * uv, tri, dt)
-    sp = spatial_scaling(rates, W_M, include_element_scale=False, fit_range_m=(0.99 * S_M, L_M))
+    sp = spatial_scaling(rates, W_M, include_element_scale=False, fit_range_m=(0.99 * S_M, L_M), min_boxes=1)
     assert sp.fit.exponent == pytest.approx(1.0, abs=0.02)
+
+
+def test_scales_with_few_boxes_stay_out_of_the_fit(mesh):
+    """Default: a width enters the β fit only with >= 10 counted boxes (MIN_FIT_BOXES).
+
+    Alternating slip lines: with every width the fit sees the plateau (1, 3, 9 km),
+    the 9-box 27 km and the 1-box 81 km widths (β = 1 there) and gets a slope in
+    between; with the default the 27 and 81 km widths are left out and β is the
+    plateau's 0. The curve itself still lists every width."""
+    xy, tri = mesh
+    rates = velocity_gradients(xy, tri, slip_line_velocity(xy, S_M, DU, alternating=True))
+    every = spatial_scaling(rates, W_M, include_element_scale=False, min_boxes=1)
+    default = spatial_scaling(rates, W_M, include_element_scale=False)
+    assert every.fit.n_points == 5 and every.fit.exponent > 0.3
+    assert default.fit.n_points == 3
+    assert default.fit.fit_range == pytest.approx((W_M[0], S_M), rel=1e-3)
+    assert abs(default.fit.exponent) < 0.02
+    np.testing.assert_array_equal(default.mean_total_s, every.mean_total_s)
+    assert spatial_scaling(rates, W_M, include_element_scale=False, min_boxes=9).fit.n_points == 4
+    for bad in (0, -3, 2.5, True):
+        with pytest.raises(ConfigError, match="min_boxes"):
+            spatial_scaling(rates, W_M, min_boxes=bad)
 
 
 def test_uniform_strain_has_no_scale_dependence():

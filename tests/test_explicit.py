@@ -211,3 +211,10 @@ def test_implicit_limit_named_when_measured(monkeypatch):
     with pytest.warns(StabilityWarning, match="dt <= 4 td"):
         stab.check_implicit_step(100.0, 10e3, allow_unstable=True)
     assert stab.check_implicit_step(50.0, 10e3) == pytest.approx(80.0)
+
+
+def test_explicit_stepper_refuses_the_mean_stress_correction():
+    """The mean-stress damage correction is in the implicit solver only; the explicit
+    stepper must not silently correct towards the origin instead."""
+    with pytest.raises(ConfigError, match="stress_correction = 'mean_stress': the explicit stepper"):
+        ExplicitSolver(MaxwellEB(stress_correction="mean_stress"), mesh=None)

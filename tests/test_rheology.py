@@ -131,10 +131,61 @@ def test_cohesion_field_seeded(rng):
     assert abs(a.mean() - 37.5e3) < 1.5e3
 
 
+def test_mean_stress_correction_keeps_the_mean_and_lands_on_the_envelope(rng):
+    """rheology.stress_correction = "mean_stress": with dt = td a super-critical stress is
+    brought onto the envelope (d_crit 1 after the update) by scaling its deviatoric part
+    only, so the mean normal stress is unchanged; the origin path scales both. Damage
+    grows by the factor that path needs: 1 − d = d_crit (Dansereau et al. 2016 with d0 = 0)."""
+    C, mu = 30e3, 0.7
+    q, sc, st = envelope(C, mu)
+    n = 200
+    # compressive mean, a deviatoric radius 1.05-3 times the envelope's at that mean
+    m = -rng.uniform(0.0, 2.0, n) * sc
+    r_env = (sc - (q - 1.0) * m) / (q + 1.0)
+    r = r_env * rng.uniform(1.05, 3.0, n)
+    sig = rotate(m + r, m - r, rng.uniform(0, np.pi, n))
+    for path in ("origin", "mean_stress"):
+        rh = MaxwellEB(cohesion_min_pa=C, cohesion_max_pa=C, friction=mu, stress_correction=path)
+        s = sig.copy()
+        d = np.zeros(n)
+        dc = rh.damage_update(s, d, np.full(n, C), 1.0, np.ones(n), np.zeros(n))
+        np.testing.assert_allclose(dcrit(s, C, mu), 1.0, rtol=0, atol=1e-9)  # on the envelope
+        s1, s2 = principal_stresses(s)
+        np.testing.assert_allclose(q * s1 - s2, sc, rtol=1e-9)
+        np.testing.assert_allclose(1.0 - d, dc, rtol=1e-12)
+        mean_after = 0.5 * (s[:, 0] + s[:, 1])
+        if path == "mean_stress":
+            np.testing.assert_allclose(mean_after, m, rtol=1e-12)
+            np.testing.assert_allclose(dc, r_env / r, rtol=1e-9)
+        else:
+            assert np.all(np.abs(mean_after) < np.abs(m) - 1.0)  # moved towards zero
+            dc_origin = dc
+    # keeping the mean costs less damage than scaling the whole tensor (the mean is compressive)
+    assert np.all(dc > dc_origin)
+
+
+def test_mean_stress_correction_falls_back_to_the_origin_beyond_the_tensile_strength():
+    """Isotropic tension above σT cannot be fixed by the deviatoric part: the origin path acts."""
+    C, mu = 30e3, 0.7
+    _, _, st = envelope(C, mu)
+    s_mean = MaxwellEB(cohesion_min_pa=C, cohesion_max_pa=C, stress_correction="mean_stress")
+    s_origin = MaxwellEB(cohesion_min_pa=C, cohesion_max_pa=C)
+    out = []
+    for rh in (s_mean, s_origin):
+        s = np.array([[2.0 * st, 2.0 * st, 0.0], [1.5 * st, 1.2 * st, 0.1 * st]])
+        d = np.zeros(2)
+        rh.damage_update(s, d, np.full(2, C), 1.0, np.ones(2), np.zeros(2))
+        out.append((s, d))
+    np.testing.assert_array_equal(out[0][0], out[1][0])
+    np.testing.assert_array_equal(out[0][1], out[1][1])
+    np.testing.assert_allclose(principal_stresses(out[0][0])[0], st, rtol=1e-12)
+
+
 @pytest.mark.parametrize("kw,name", [
     ({"poisson": 0.5}, "poisson"), ({"poisson": 0.7}, "poisson"), ({"alpha": 1.0}, "alpha"),
     ({"alpha": 0.5}, "alpha"), ({"cohesion_min_pa": -1.0}, "cohesion_min_pa"),
     ({"cohesion_max_pa": 1.0}, "cohesion_max_pa"), ({"relaxation_time_s": 0}, "relaxation_time_s"),
+    ({"stress_correction": "normal"}, "stress_correction"),
 ])
 def test_bad_parameters_name_the_parameter(kw, name):
     with pytest.raises(ConfigError, match=name) as e:

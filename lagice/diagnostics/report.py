@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from lagice.diagnostics._checks import as_points, as_triangles, choice, positive
-from lagice.diagnostics.scaling import spatial_scaling, temporal_scaling
+from lagice.diagnostics.scaling import MIN_FIT_BOXES, spatial_scaling, temporal_scaling
 from lagice.diagnostics.statistics import (
     fit_power_law_tail,
     localisation_area_fraction,
@@ -38,7 +38,7 @@ JSON_KEYS = {
     "beta_space": "β of ⟨ε̇tot⟩ ∝ L^−β (coarse-graining, least squares in log–log)",
     "beta_space_stderr": "standard error of β",
     "beta_space_r2": "R² of the log–log fit",
-    "beta_space_fit_range_m": "[L_min, L_max] (m) of the scales used in the β fit",
+    "beta_space_fit_range_m": "[L_min, L_max] (m) of the scales used in the β fit (scales with >= min_boxes boxes)",
     "scaling_space": "{box_size_m, scale_m, mean_total_s, n_boxes} per scale (element scale first, box_size_m null)",
     "min_box_coverage": "minimum covered fraction of a box's W² for it to count",
     "alpha_time": "α of ⟨ε̇tot⟩ ∝ T^−α (null without a position time series)",
@@ -64,7 +64,7 @@ JSON_KEYS = {
 
 
 def summarise(nodes_xy0, nodes_xy1, triangles, dt_s, *, geometry="mid", box_sizes_m=None,
-              min_coverage=0.75, fit_range_m=None, include_element_scale=True,
+              min_coverage=0.75, fit_range_m=None, include_element_scale=True, min_boxes=MIN_FIT_BOXES,
               nodes_xy_series=None, series_dt_s=None, window_steps=None, fit_range_s=None,
               tail_x_min_shear_s=None, tail_x_min_divergence_s=None, min_tail=50,
               pdf_dynamic_range=1e6, pdf_bins_per_decade=10):
@@ -86,8 +86,9 @@ def summarise(nodes_xy0, nodes_xy1, triangles, dt_s, *, geometry="mid", box_size
         Window length (s), > 0.
     geometry : {"mid", "start", "end"}
         Geometry of the gradients (default mid-window).
-    box_sizes_m, min_coverage, fit_range_m, include_element_scale
-        Passed to :func:`spatial_scaling`.
+    box_sizes_m, min_coverage, fit_range_m, include_element_scale, min_boxes
+        Passed to :func:`spatial_scaling` (``min_boxes``: boxes a scale needs to
+        enter the β fit, default 10).
     nodes_xy_series : array_like (k+1, n, 2), optional
         Positions (m) every ``series_dt_s`` for the temporal scaling.
     series_dt_s : float, optional
@@ -121,7 +122,8 @@ def summarise(nodes_xy0, nodes_xy1, triangles, dt_s, *, geometry="mid", box_size
     rates = _lagrangian(x0, x1, tri, dt, geometry)
     div, shear, tot = rates.divergence_s, rates.shear_s, rates.total_s
 
-    sp = spatial_scaling(rates, box_sizes_m, min_coverage, fit_range_m, include_element_scale)
+    sp = spatial_scaling(rates, box_sizes_m, min_coverage, fit_range_m, include_element_scale,
+                         min_boxes=min_boxes)
     box_sizes = list(sp.coarse.box_size_m[np.isfinite(sp.coarse.mean_total_s)])
     n_boxes = list(sp.coarse.n_boxes[np.isfinite(sp.coarse.mean_total_s)])
     if include_element_scale:

@@ -254,8 +254,18 @@ class SpatialScaling:
     fit: PowerLawFit
 
 
+MIN_FIT_BOXES = 10
+"""Default minimum number of counted boxes for a scale to enter the β fit.
+
+⟨ε̇tot⟩ at a scale is a mean over its boxes, and box rates are heavy-tailed (their
+coefficient of variation is about 1 in the model's runs), so a mean over n boxes is
+uncertain by about 1/√n: ±100 % for the one box a 300 km width leaves inside a
+1000 km basin, ±30 % for 10 boxes. One box at the widest scale carries the whole
+fit's lever arm, so it used to decide β (docs/physics.md, "How β was estimated")."""
+
+
 def spatial_scaling(rates, box_sizes_m=None, min_coverage=0.75, fit_range_m=None,
-                    include_element_scale=True, origin_xy_m=None):
+                    include_element_scale=True, origin_xy_m=None, min_boxes=MIN_FIT_BOXES):
     """⟨ε̇tot⟩(L) by coarse-graining and the exponent β of ⟨ε̇tot⟩ ∝ L^−β (Girard 2010 §3.5).
 
     Parameters
@@ -269,21 +279,29 @@ def spatial_scaling(rates, box_sizes_m=None, min_coverage=0.75, fit_range_m=None
     include_element_scale : bool
         Prepend the element scale (L = mean sqrt(A_e), ⟨ε̇tot⟩ = mean over
         elements), "the smallest scale" of Girard 2010 §3.5.
+    min_boxes : int
+        A box width enters the fit only if at least this many boxes are counted
+        at it (default :data:`MIN_FIT_BOXES` = 10; 1 keeps every width with a
+        box). Widths with fewer boxes stay in ``scale_m``/``mean_total_s``.
 
     Returns
     -------
     SpatialScaling
         ``fit.exponent`` is β, ``fit.fit_range`` the scales (m) used.
     """
+    if isinstance(min_boxes, bool) or not isinstance(min_boxes, (int, np.integer)) or min_boxes < 1:
+        raise ConfigError(f"min_boxes = {min_boxes!r}; expected an integer >= 1 (boxes per scale in the β fit)")
     cg = coarse_grain(rates, box_sizes_m, min_coverage, origin_xy_m)
     el_scale = float(np.mean(np.sqrt(rates.area_m2)))
     el_mean = float(np.mean(rates.total_s))
     ok = np.isfinite(cg.mean_total_s)
     scale, mean = cg.scale_m[ok], cg.mean_total_s[ok]
+    used = cg.n_boxes[ok] >= min_boxes
     if include_element_scale:
         scale = np.concatenate([[el_scale], scale])
         mean = np.concatenate([[el_mean], mean])
-    fit = fit_power_law(scale, mean, fit_range_m)
+        used = np.concatenate([[rates.total_s.size >= min_boxes], used])
+    fit = fit_power_law(scale[used], mean[used], fit_range_m)
     return SpatialScaling(cg, el_scale, el_mean, scale, mean, fit)
 
 

@@ -131,9 +131,34 @@ def damage_step(d, dc, dt, td, heal_rate, max_damage):
     return d, f, capped
 
 
+@njit(cache=True, inline="always")
+def _dcrit_mean_stress(sxx, syy, sxy, cohesion, q, denom):
+    """The factor f ∈ [0, 1] that brings a stress onto the envelope by scaling only its
+    deviatoric part (the mean normal stress m = (σ1 + σ2)/2 kept): with σ1,2 = m ± f r,
+    f = min(1, (σT − m)/r, (σc − (q − 1) m)/((q + 1) r)) (tensile cut-off and
+    q σ1 − σ2 = σc). Returns −1 where no such f exists (m beyond the tensile strength or
+    the envelope's apex, or r = 0); the caller then corrects towards the origin."""
+    m = 0.5 * (sxx + syy)
+    r = math.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
+    sigma_c = 2.0 * cohesion / denom
+    sigma_t = sigma_c / q
+    if r <= 0.0:
+        return -1.0
+    f = 1.0
+    lim_t = (sigma_t - m) / r
+    if lim_t < f:
+        f = lim_t
+    lim_mc = (sigma_c - (q - 1.0) * m) / ((q + 1.0) * r)
+    if lim_mc < f:
+        f = lim_mc
+    if f < 0.0:
+        return -1.0
+    return f
+
+
 @njit(cache=True, parallel=True)
 def damage_update_kernel(sigma, damage, cohesion, dt, td, heal_rate, q, denom, max_damage,
-                         dcrit_out):
+                         dcrit_out, mean_stress_path=False):
     """Explicit damage update with stress correction, in place (Dansereau et al. 2016 eqs. 9-11).
 
     Per element: r = min(1, dt/td_e)(1 − d_crit);  1 − d ← (1 − d)(1 − r);
@@ -143,13 +168,30 @@ def damage_update_kernel(sigma, damage, cohesion, dt, td, heal_rate, q, denom, m
     is returned so the caller can report it.
 
     ``heal_rate`` is an array (m,) [s-1] (zeros: no healing).
+
+    ``mean_stress_path`` (``rheology.stress_correction = "mean_stress"``): a super-critical
+    stress is brought back by scaling only its deviatoric part, σ ← m I + (1 − r)(σ − m I)
+    with m = (σxx + σyy)/2, and d_crit is the factor of :func:`_dcrit_mean_stress` (the
+    origin path where that factor does not exist). With dt = td the stress lands on the
+    envelope in both cases.
     """
     n_capped = 0
     for e in prange(sigma.shape[0]):
         dc = _dcrit(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom)
+        deviatoric = False
+        if mean_stress_path and dc < 1.0:
+            fm = _dcrit_mean_stress(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom)
+            if fm >= 0.0:
+                dc = fm
+                deviatoric = True
         dcrit_out[e] = dc
         d, f, capped = damage_step(damage[e], dc, dt, td[e], heal_rate[e], max_damage)
-        if dc < 1.0:
+        if deviatoric:
+            m = 0.5 * (sigma[e, 0] + sigma[e, 1])
+            sigma[e, 0] = m + f * (sigma[e, 0] - m)
+            sigma[e, 1] = m + f * (sigma[e, 1] - m)
+            sigma[e, 2] *= f
+        elif dc < 1.0:
             sigma[e, 0] *= f
             sigma[e, 1] *= f
             sigma[e, 2] *= f
@@ -213,7 +255,7 @@ class MaxwellEB:
         out = np.empty(len(damage))
         kernel = pick(DAMAGE_UPDATE, len(damage))
         n = kernel(sigma, damage, cohesion, float(dt), np.ascontiguousarray(td),
-                                 np.ascontiguousarray(heal_rate), self.q, self._denom,
-                                 self.params.max_damage, out)
+                   np.ascontiguousarray(heal_rate), self.q, self._denom,
+                   self.params.max_damage, out, self.params.stress_correction == "mean_stress")
         self.n_capped_total += int(n)
         return out

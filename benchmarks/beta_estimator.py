@@ -1,0 +1,89 @@
+"""β with and without the widths that hold only a few boxes (docs/physics.md, "How β was estimated").
+
+β is the slope of ⟨ε̇tot⟩(L) from the coarse-graining (:func:`lagice.diagnostics.spatial_scaling`).
+In the 1000 km basin, less 100 km along the coast, the widest box width (about 300 km) holds one
+box, and the next (about 150 km) a few. Until 2026-11-24 every width with a box entered the fit, so
+one box (a mean over one sample of a heavy-tailed rate) carried the fit's lever arm. This script
+re-analyses finished runs of ``benchmarks/physics_experiments.py`` window by window (the 3-day
+windows from day 1 and the 100 km coast buffer of the validation) and prints, per run, the medians
+over the windows of:
+
+* β with every width (``min_boxes = 1``, the estimator used before);
+* β with the widths holding at least 4 boxes, and at least 10 (the default now);
+* the widest width used with 10 boxes, and the ratio of the element-scale ⟨ε̇tot⟩ to the
+  ⟨ε̇tot⟩ at that width (observed: about 2 between 10 and 300 km, from β ≈ 0.2).
+
+    python benchmarks/beta_estimator.py F10 F10x2 ...   # runs in benchmarks/out/physics
+    python benchmarks/beta_estimator.py                  # the default list below
+
+Results go to ``docs/figures/beta_estimator.json``.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from lagice.diagnostics.scaling import MIN_FIT_BOXES, fit_power_law
+from lagice.diagnostics.windows import window_starts_days, window_summary
+
+ROOT = Path(__file__).resolve().parents[1]
+RUNS = ROOT / "benchmarks" / "out" / "physics"
+DAY_S = 86400.0
+DEFAULT_RUNS = ("F10", "F10s", "F10-w2027", "F10-heal-K50-w2027", "B20", "B20x2", "F10x2", "F10x2-w2027",
+                "E10", "E10s")
+
+
+def run_estimates(run_dir: Path, window_days: float = 3.0, start_day: float = 1.0,
+                  coast_buffer_m: float = 100e3) -> dict:
+    """Per-window β for several minimum box counts, and their medians over the windows."""
+    rows = []
+    for s0 in window_starts_days(run_dir, window_days, start_day):
+        s = window_summary(run_dir, s0 * DAY_S, window_days * DAY_S, coast_buffer_m)["interior"]
+        sc = s["scaling_space"]
+        scale = np.asarray(sc["scale_m"], float)
+        mean = np.asarray(sc["mean_total_s"], float)
+        nbox = np.asarray(sc["n_boxes"])
+        row = {"start_day": float(s0), "element_rate_per_day": float(mean[0] * DAY_S)}
+        for n_min in (1, 4, MIN_FIT_BOXES):
+            k = nbox >= n_min
+            row[f"beta_min_boxes_{n_min}"] = fit_power_law(scale[k], mean[k]).exponent
+        k = nbox >= MIN_FIT_BOXES
+        row["widest_scale_km_min_boxes_10"] = float(scale[k].max() / 1e3)
+        row["element_to_widest_rate_ratio"] = float(mean[0] / mean[k][-1])
+        row["scales_km"] = [float(x / 1e3) for x in scale]
+        row["n_boxes"] = [int(n) for n in nbox]
+        rows.append(row)
+    keys = [k for k in rows[0] if k not in ("start_day", "scales_km", "n_boxes")]
+    return {"windows": rows, "median": {k: float(np.median([r[k] for r in rows])) for k in keys}}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("runs", nargs="*", default=list(DEFAULT_RUNS), help="run names in benchmarks/out/physics")
+    ap.add_argument("--json", type=Path, default=ROOT / "docs" / "figures" / "beta_estimator.json")
+    args = ap.parse_args(argv)
+    missing = [r for r in args.runs if not (RUNS / r / "snapshots").is_dir()]
+    if missing:
+        raise SystemExit(f"beta_estimator: no finished run for {', '.join(missing)} in {RUNS} "
+                         "(make them with benchmarks/physics_experiments.py run NAME)")
+    out = json.loads(args.json.read_text()) if args.json.exists() else {}
+    print("| run | β, every width | β, ≥ 4 boxes | β, ≥ 10 boxes | widest width with ≥ 10 boxes (km) "
+          "| ⟨ε̇tot⟩ element / widest |")
+    print("|---|---|---|---|---|---|")
+    for name in args.runs:
+        r = run_estimates(RUNS / name)
+        out[name] = r
+        m = r["median"]
+        print(f"| {name} | {m['beta_min_boxes_1']:.3f} | {m['beta_min_boxes_4']:.3f} | "
+              f"{m[f'beta_min_boxes_{MIN_FIT_BOXES}']:.3f} | {m['widest_scale_km_min_boxes_10']:.0f} | "
+              f"{m['element_to_widest_rate_ratio']:.2f} |", flush=True)
+        args.json.write_text(json.dumps(out, indent=1, allow_nan=True) + "\n")
+    print(f"beta_estimator: wrote {args.json}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
