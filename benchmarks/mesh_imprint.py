@@ -18,8 +18,9 @@ Options (``--variants``): ``base`` (gmsh Frontal-Delaunay: one lattice over the 
 domain); ``jitter`` (interior nodes moved by up to 0.3 × their edge length,
 ``domain.jitter``); ``delaunay`` (gmsh's Delaunay algorithm, ``domain.mesh_algorithm = 5``:
 no domain-wide lattice direction); ``meanstress`` (``rheology.stress_correction =
-"mean_stress"``: the damage correction keeps the mean normal stress; combine with ``+``,
-e.g. ``delaunay+meanstress``).
+"mean_stress"``: the damage correction keeps the mean normal stress); ``mean025``,
+``mean050``, ``mean075`` (the correction towards 0.25, 0.5, 0.75 times the mean stress,
+``stress_correction_mean_fraction``); combine with ``+``, e.g. ``delaunay+meanstress``.
 
     python benchmarks/mesh_imprint.py cyclone --variants base jitter delaunay
     python benchmarks/mesh_imprint.py compression --n-across 40 80 --variants base jitter delaunay
@@ -44,7 +45,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 ROTATIONS = (0.0, 15.0, 30.0)
 VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.mesh_algorithm=5"],
-            "meanstress": ["rheology.stress_correction=mean_stress"]}
+            "meanstress": ["rheology.stress_correction=mean_stress"],
+            **{f"mean{int(round(100 * t)):03d}": ["rheology.stress_correction=mean_stress",
+                                                  f"rheology.stress_correction_mean_fraction={t}"]
+               for t in (0.25, 0.5, 0.75)}}
 
 
 def _value(v: str):

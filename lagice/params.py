@@ -38,8 +38,10 @@ class MaxwellEBParams:
         max_damage: damage cap below 1 keeping E > 0 [-]
         stress_correction: path that brings a super-critical stress back to the envelope:
             ``"origin"`` (Dansereau et al. 2016, neXtSIM: the whole tensor scaled towards 0)
-            or ``"mean_stress"`` (only the deviatoric part scaled, the mean normal stress
-            kept; implicit solver only; docs/physics.md, compression test)
+            or ``"mean_stress"`` (towards θ times the mean normal stress; θ = 1: only the
+            deviatoric part scaled, the mean kept; implicit solver only; docs/physics.md,
+            compression test)
+        stress_correction_mean_fraction: θ ∈ (0, 1] of ``"mean_stress"`` (None: 1) [-]
     """
 
     poisson: float = 0.3
@@ -55,6 +57,7 @@ class MaxwellEBParams:
     concentration_c: float = 20.0
     max_damage: float = 1.0 - 1.0e-6
     stress_correction: str = "origin"
+    stress_correction_mean_fraction: float | None = None
 
     def __post_init__(self):
         check_range("poisson (ν)", self.poisson, 0.0, 0.5, high_open=True)
@@ -74,6 +77,20 @@ class MaxwellEBParams:
         if self.stress_correction not in STRESS_CORRECTIONS:
             raise ConfigError(f"rheology.stress_correction = {self.stress_correction!r}: expected one of "
                               f"{list(STRESS_CORRECTIONS)}")
+        if self.stress_correction_mean_fraction is not None:
+            if self.stress_correction != "mean_stress":
+                theta = self.stress_correction_mean_fraction
+                raise ConfigError(f"rheology.stress_correction_mean_fraction = {theta!r} applies to "
+                                  f"stress_correction = 'mean_stress' only (it is {self.stress_correction!r})")
+            check_range("stress_correction_mean_fraction (θ)", self.stress_correction_mean_fraction, 0.0, 1.0,
+                        low_open=True)
+
+    @property
+    def mean_fraction(self) -> float:
+        """θ of the damage stress correction: 0 for the origin path (Dansereau et al. 2016)."""
+        if self.stress_correction == "origin":
+            return 0.0
+        return 1.0 if self.stress_correction_mean_fraction is None else float(self.stress_correction_mean_fraction)
 
     @property
     def E0(self) -> float:

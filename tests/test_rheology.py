@@ -133,9 +133,10 @@ def test_cohesion_field_seeded(rng):
 
 def test_mean_stress_correction_keeps_the_mean_and_lands_on_the_envelope(rng):
     """rheology.stress_correction = "mean_stress": with dt = td a super-critical stress is
-    brought onto the envelope (d_crit 1 after the update) by scaling its deviatoric part
-    only, so the mean normal stress is unchanged; the origin path scales both. Damage
-    grows by the factor that path needs: 1 − d = d_crit (Dansereau et al. 2016 with d0 = 0)."""
+    brought onto the envelope (d_crit 1 after the update) along the path towards θ m I
+    (m the mean normal stress): θ = 1 scales only the deviatoric part, so the mean is kept;
+    θ = 0.5 moves the mean to θ m + d_crit (1 − θ) m; the origin path scales everything.
+    Damage grows by the factor the path needs: 1 − d = d_crit (Dansereau et al. 2016, d0 = 0)."""
     C, mu = 30e3, 0.7
     q, sc, st = envelope(C, mu)
     n = 200
@@ -144,8 +145,12 @@ def test_mean_stress_correction_keeps_the_mean_and_lands_on_the_envelope(rng):
     r_env = (sc - (q - 1.0) * m) / (q + 1.0)
     r = r_env * rng.uniform(1.05, 3.0, n)
     sig = rotate(m + r, m - r, rng.uniform(0, np.pi, n))
-    for path in ("origin", "mean_stress"):
-        rh = MaxwellEB(cohesion_min_pa=C, cohesion_max_pa=C, friction=mu, stress_correction=path)
+    dcs = {}
+    for theta in (0.0, 0.5, 1.0):
+        kw = {} if theta == 0.0 else {"stress_correction": "mean_stress",
+                                      "stress_correction_mean_fraction": None if theta == 1.0 else theta}
+        rh = MaxwellEB(cohesion_min_pa=C, cohesion_max_pa=C, friction=mu, **kw)
+        assert rh.params.mean_fraction == theta
         s = sig.copy()
         d = np.zeros(n)
         dc = rh.damage_update(s, d, np.full(n, C), 1.0, np.ones(n), np.zeros(n))
@@ -153,15 +158,11 @@ def test_mean_stress_correction_keeps_the_mean_and_lands_on_the_envelope(rng):
         s1, s2 = principal_stresses(s)
         np.testing.assert_allclose(q * s1 - s2, sc, rtol=1e-9)
         np.testing.assert_allclose(1.0 - d, dc, rtol=1e-12)
-        mean_after = 0.5 * (s[:, 0] + s[:, 1])
-        if path == "mean_stress":
-            np.testing.assert_allclose(mean_after, m, rtol=1e-12)
-            np.testing.assert_allclose(dc, r_env / r, rtol=1e-9)
-        else:
-            assert np.all(np.abs(mean_after) < np.abs(m) - 1.0)  # moved towards zero
-            dc_origin = dc
-    # keeping the mean costs less damage than scaling the whole tensor (the mean is compressive)
-    assert np.all(dc > dc_origin)
+        np.testing.assert_allclose(0.5 * (s[:, 0] + s[:, 1]), theta * m + dc * (1.0 - theta) * m, rtol=1e-12)
+        dcs[theta] = dc
+    np.testing.assert_allclose(dcs[1.0], r_env / r, rtol=1e-9)
+    # keeping more of the (compressive) mean costs less damage
+    assert np.all(dcs[0.0] < dcs[0.5]) and np.all(dcs[0.5] < dcs[1.0])
 
 
 def test_mean_stress_correction_falls_back_to_the_origin_beyond_the_tensile_strength():
@@ -186,12 +187,21 @@ def test_mean_stress_correction_falls_back_to_the_origin_beyond_the_tensile_stre
     ({"alpha": 0.5}, "alpha"), ({"cohesion_min_pa": -1.0}, "cohesion_min_pa"),
     ({"cohesion_max_pa": 1.0}, "cohesion_max_pa"), ({"relaxation_time_s": 0}, "relaxation_time_s"),
     ({"stress_correction": "normal"}, "stress_correction"),
+    ({"stress_correction_mean_fraction": 0.0, "stress_correction": "mean_stress"}, "stress_correction_mean_fraction"),
+    ({"stress_correction_mean_fraction": 1.5, "stress_correction": "mean_stress"}, "stress_correction_mean_fraction"),
 ])
 def test_bad_parameters_name_the_parameter(kw, name):
     with pytest.raises(ConfigError, match=name) as e:
         MaxwellEBParams(**kw)
     assert "expected" in str(e.value)
     assert repr(list(kw.values())[0]) in str(e.value)
+
+
+def test_mean_fraction_needs_the_mean_stress_path():
+    """A θ with the origin path would be ignored: refused, naming both keys."""
+    with pytest.raises(ConfigError, match="stress_correction_mean_fraction = 0.5 applies to stress_correction = "
+                                          "'mean_stress' only"):
+        MaxwellEBParams(stress_correction_mean_fraction=0.5)
 
 
 def test_unknown_parameter():

@@ -132,25 +132,33 @@ def damage_step(d, dc, dt, td, heal_rate, max_damage):
 
 
 @njit(cache=True, inline="always")
-def _dcrit_mean_stress(sxx, syy, sxy, cohesion, q, denom):
-    """The factor f ∈ [0, 1] that brings a stress onto the envelope by scaling only its
-    deviatoric part (the mean normal stress m = (σ1 + σ2)/2 kept): with σ1,2 = m ± f r,
-    f = min(1, (σT − m)/r, (σc − (q − 1) m)/((q + 1) r)) (tensile cut-off and
-    q σ1 − σ2 = σc). Returns −1 where no such f exists (m beyond the tensile strength or
-    the envelope's apex, or r = 0); the caller then corrects towards the origin."""
+def _dcrit_towards(sxx, syy, sxy, cohesion, q, denom, theta):
+    """The factor f ∈ [0, 1] that brings a stress onto the envelope along the straight path
+    towards the isotropic stress P = θ m I (m = (σ1 + σ2)/2, 0 < θ ≤ 1): σ' = P + f (σ − P).
+    θ = 1 scales only the deviatoric part (the mean kept); θ → 0 is the origin path of
+    :func:`_dcrit`. With σ1,2 = m ± r, the corrected mean is θ m + f (1 − θ) m and the
+    radius f r, so q σ1' − σ2' = σc gives f = (σc − (q − 1) θ m)/((q − 1)(1 − θ) m + (q + 1) r)
+    and σ1' = σT gives f = (σT − θ m)/((1 − θ) m + r), each where the path crosses that
+    branch. Returns −1 where P itself lies outside the envelope or r = 0 (the caller then
+    corrects towards the origin)."""
     m = 0.5 * (sxx + syy)
     r = math.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
     sigma_c = 2.0 * cohesion / denom
     sigma_t = sigma_c / q
-    if r <= 0.0:
+    p = theta * m
+    if r <= 0.0 or (q - 1.0) * p >= sigma_c or p >= sigma_t:
         return -1.0
     f = 1.0
-    lim_t = (sigma_t - m) / r
-    if lim_t < f:
-        f = lim_t
-    lim_mc = (sigma_c - (q - 1.0) * m) / ((q + 1.0) * r)
-    if lim_mc < f:
-        f = lim_mc
+    d_mc = (q - 1.0) * (1.0 - theta) * m + (q + 1.0) * r
+    if d_mc > 0.0:
+        lim = (sigma_c - (q - 1.0) * p) / d_mc
+        if lim < f:
+            f = lim
+    d_t = (1.0 - theta) * m + r
+    if d_t > 0.0:
+        lim = (sigma_t - p) / d_t
+        if lim < f:
+            f = lim
     if f < 0.0:
         return -1.0
     return f
@@ -158,7 +166,7 @@ def _dcrit_mean_stress(sxx, syy, sxy, cohesion, q, denom):
 
 @njit(cache=True, parallel=True)
 def damage_update_kernel(sigma, damage, cohesion, dt, td, heal_rate, q, denom, max_damage,
-                         dcrit_out, mean_stress_path=False):
+                         dcrit_out, mean_fraction=0.0):
     """Explicit damage update with stress correction, in place (Dansereau et al. 2016 eqs. 9-11).
 
     Per element: r = min(1, dt/td_e)(1 − d_crit);  1 − d ← (1 − d)(1 − r);
@@ -169,27 +177,28 @@ def damage_update_kernel(sigma, damage, cohesion, dt, td, heal_rate, q, denom, m
 
     ``heal_rate`` is an array (m,) [s-1] (zeros: no healing).
 
-    ``mean_stress_path`` (``rheology.stress_correction = "mean_stress"``): a super-critical
-    stress is brought back by scaling only its deviatoric part, σ ← m I + (1 − r)(σ − m I)
-    with m = (σxx + σyy)/2, and d_crit is the factor of :func:`_dcrit_mean_stress` (the
-    origin path where that factor does not exist). With dt = td the stress lands on the
-    envelope in both cases.
+    ``mean_fraction`` θ > 0 (``rheology.stress_correction = "mean_stress"``, θ =
+    ``stress_correction_mean_fraction``, default 1): a super-critical stress is brought back
+    towards P = θ m I instead of the origin, σ ← P + (1 − r)(σ − P) with m = (σxx + σyy)/2,
+    and d_crit is the factor of :func:`_dcrit_towards` (the origin path where that factor
+    does not exist). θ = 1 keeps the mean stress. With dt = td the stress lands on the
+    envelope on every path. θ = 0 is the origin path, bit for bit.
     """
     n_capped = 0
     for e in prange(sigma.shape[0]):
         dc = _dcrit(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom)
-        deviatoric = False
-        if mean_stress_path and dc < 1.0:
-            fm = _dcrit_mean_stress(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom)
+        towards_mean = False
+        if mean_fraction > 0.0 and dc < 1.0:
+            fm = _dcrit_towards(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom, mean_fraction)
             if fm >= 0.0:
                 dc = fm
-                deviatoric = True
+                towards_mean = True
         dcrit_out[e] = dc
         d, f, capped = damage_step(damage[e], dc, dt, td[e], heal_rate[e], max_damage)
-        if deviatoric:
-            m = 0.5 * (sigma[e, 0] + sigma[e, 1])
-            sigma[e, 0] = m + f * (sigma[e, 0] - m)
-            sigma[e, 1] = m + f * (sigma[e, 1] - m)
+        if towards_mean:
+            p = mean_fraction * 0.5 * (sigma[e, 0] + sigma[e, 1])
+            sigma[e, 0] = p + f * (sigma[e, 0] - p)
+            sigma[e, 1] = p + f * (sigma[e, 1] - p)
             sigma[e, 2] *= f
         elif dc < 1.0:
             sigma[e, 0] *= f
@@ -256,6 +265,6 @@ class MaxwellEB:
         kernel = pick(DAMAGE_UPDATE, len(damage))
         n = kernel(sigma, damage, cohesion, float(dt), np.ascontiguousarray(td),
                    np.ascontiguousarray(heal_rate), self.q, self._denom,
-                   self.params.max_damage, out, self.params.stress_correction == "mean_stress")
+                   self.params.max_damage, out, self.params.mean_fraction)
         self.n_capped_total += int(n)
         return out

@@ -58,6 +58,7 @@ SCHEMA = {
         "relaxation_time_s": (NUM, 1e7), "alpha": (NUM, 4.0), "cohesion_min_pa": (NUM, 25e3),
         "cohesion_max_pa": (NUM, 50e3), "healing_time_s": (NUM, 1e5), "concentration_c": (NUM, 20.0),
         "max_damage": (NUM, 1.0 - 1e-6), "stress_correction": (str, "origin"),
+        "stress_correction_mean_fraction": (NUM, None),
         "p_star": (NUM, 27.5e3), "c_star": (NUM, 20.0), "ellipse": (NUM, 2.0), "delta_min": (NUM, 2e-9),
         "replacement_pressure": (bool, False),
         # strength law (lagice.strength; issue 12): "uniform" = cohesion_min/max_pa,
@@ -101,7 +102,7 @@ REMOVED = {
 RHEOLOGY_KEYS = {
     "maxwell_eb": ("poisson", "friction", "rho_ice", "shear_wave_speed", "young_modulus_pa", "relaxation_time_s",
                    "alpha", "cohesion_min_pa", "cohesion_max_pa", "healing_time_s", "concentration_c",
-                   "max_damage", "stress_correction"),
+                   "max_damage", "stress_correction", "stress_correction_mean_fraction"),
     "viscous_plastic": ("p_star", "c_star", "ellipse", "delta_min", "replacement_pressure", "rho_ice"),
 }
 
