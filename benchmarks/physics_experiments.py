@@ -138,6 +138,10 @@ EXPERIMENTS["F10x2"] = ("closed", [f"domain.file={BASIN_X2}"] + from_spinup("S10
                         "as F10 in a basin twice as wide (radius 1000 km), from its own 10 km spin-up state")
 EXPERIMENTS["B20x2"] = ("closed", [f"domain.file={BASIN_X2}"] + from_spinup("S20x2"), 20e3, 28,
                         "as B20 in a basin twice as wide (radius 1000 km), from its own spin-up state")
+# resolution test for β (docs/physics.md, "How β was estimated"): the flagship at 5 km for
+# its first 10 days (three windows, the storm window 7-10 among them), from the shipped
+# (10 km) spin-up state, mapped to the 5 km elements
+EXPERIMENTS["F5-10d"] = ("closed", [], 5e3, 10, "recommended set at 5 km, first 10 days (β resolution test)")
 EXPERIMENTS["F10x2-w2027"] = ("closed", [f"domain.file={BASIN_X2}", "forcing.wind.seed=2027"]
                               + from_spinup("S10x2"), 10e3, 28,
                               "as F10x2 with the weather of wind seed 2027 (second realisation)")
