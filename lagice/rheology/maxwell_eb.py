@@ -259,6 +259,13 @@ class MaxwellEB:
         rate = 0.0 if th is None or not np.isfinite(th) else 1.0 / th
         return np.full(n, rate)
 
+    def require_origin_correction(self):
+        """Raise :class:`ConfigError` unless the stress correction is the origin path, the
+        only one the explicit steppers (CPU and CUDA) implement."""
+        if self.params.stress_correction != "origin":
+            raise ConfigError(f"rheology.stress_correction = {self.params.stress_correction!r}: the explicit "
+                              "stepper corrects towards the origin only (the option is in the implicit solver)")
+
     def damage_update(self, sigma, damage, cohesion, dt, td, heal_rate):
         """Apply the damage/healing update in place; returns d_crit per element."""
         out = np.empty(len(damage))

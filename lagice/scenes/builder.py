@@ -285,7 +285,7 @@ def validate_config(cfg: dict) -> None:
     if sv["name"] in SOLVERS and want is not None and rheo.name != want:
         raise ConfigError(f"solver.name = {sv['name']!r} solves the {want} rheology, but rheology.law = "
                           f"{cfg['rheology']['law']!r}; set rheology.law = {want!r}")
-    if getattr(getattr(rheo, "params", None), "stress_correction", "origin") != "origin" and sv["name"] != "implicit":
+    if rheo.name == "maxwell_eb" and rheo.params.stress_correction != "origin" and sv["name"] != "implicit":
         raise ConfigError(f"rheology.stress_correction = {rheo.params.stress_correction!r} is implemented in the "
                           f"implicit solver's damage update only; solver.name = {sv['name']!r} corrects towards the "
                           f"origin. Use solver.name = 'implicit' or stress_correction = 'origin'")

@@ -292,9 +292,7 @@ class CudaExplicitSolver:
         self.device_name = require_cuda("solver.device")
         if not isinstance(rheology, MaxwellEB):
             raise ConfigError(f"the explicit stepper solves the Maxwell-EB rheology; got {type(rheology).__name__}")
-        if rheology.params.stress_correction != "origin":
-            raise ConfigError(f"rheology.stress_correction = {rheology.params.stress_correction!r}: the explicit "
-                              "stepper corrects towards the origin only (the option is in the implicit solver)")
+        rheology.require_origin_correction()
         if substeps is not None:
             if int(substeps) != substeps or int(substeps) < 1:
                 raise ConfigError(f"substeps = {substeps!r} must be an integer >= 1 (or None: automatic)")
