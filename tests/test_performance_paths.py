@@ -194,18 +194,25 @@ def test_bad_parallel_setting_names_the_key(tmp_path):
         scene_sim("wind_square", tmp_path, {**KW, "solver.parallel": "fast"})
 
 
-def test_import_makes_openmp_workers_sleep_unless_the_user_chose():
-    """`import lagice` sets OMP_WAIT_POLICY=PASSIVE before numba's OpenMP runtime loads
-    (spinning workers made the parallel kernels 4-5x slower on shared cores and slowed the
-    serial components, docs/benchmarks.md); a user's own setting is kept."""
+def test_import_makes_openmp_workers_spin_briefly_unless_the_user_chose():
+    """`import lagice` sets a short libgomp spin (GOMP_SPINCOUNT=10000, ~0.1 ms) and
+    OMP_WAIT_POLICY=PASSIVE before numba's OpenMP runtime loads: workers spin between the
+    sub-step kernels of a quiet machine, then sleep (libgomp's default 3-ms spin made the
+    parallel kernels 4-5x slower on shared cores, docs/benchmarks.md). A user's own
+    OMP_WAIT_POLICY or GOMP_SPINCOUNT is kept, and a wait policy of theirs is not
+    overridden by our spin count (libgomp lets GOMP_SPINCOUNT win)."""
     import os
     import subprocess
     import sys
 
-    code = "import os, lagice; print(os.environ['OMP_WAIT_POLICY'])"
-    env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
-    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "PASSIVE"
-    out = subprocess.run([sys.executable, "-c", code], env={**env, "OMP_WAIT_POLICY": "ACTIVE"},
-                         capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "ACTIVE"
+    code = ("import os, lagice; print(os.environ['OMP_WAIT_POLICY'], "
+            "os.environ.get('GOMP_SPINCOUNT', 'unset'))")
+    env = {k: v for k, v in os.environ.items() if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")}
+
+    def run(**extra):
+        return subprocess.run([sys.executable, "-c", code], env={**env, **extra}, capture_output=True,
+                              text=True, check=True).stdout.split()
+
+    assert run() == ["PASSIVE", "10000"]
+    assert run(OMP_WAIT_POLICY="ACTIVE") == ["ACTIVE", "unset"]
+    assert run(GOMP_SPINCOUNT="0") == ["PASSIVE", "0"]
