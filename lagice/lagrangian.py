@@ -45,6 +45,7 @@ from numba import njit
 
 from .errors import ConfigError, SolverError
 from .mesh import OPEN, Mesh
+from .mesh.core import _signed_areas_kernel
 
 
 def new_budget() -> dict:
@@ -65,14 +66,6 @@ def fixed_node_mask(mesh: Mesh) -> np.ndarray:
     """(n,) bool: nodes that never move (on ``"coast"`` or ``"open"`` edges);
     :attr:`Mesh.fixed_node_mask`, cached on the mesh."""
     return mesh.fixed_node_mask
-
-
-@njit(cache=True)
-def _signed_areas_kernel(nodes, tri, out):
-    for e in range(tri.shape[0]):
-        i, j, k = tri[e, 0], tri[e, 1], tri[e, 2]
-        out[e] = 0.5 * ((nodes[j, 0] - nodes[i, 0]) * (nodes[k, 1] - nodes[i, 1])
-                        - (nodes[k, 0] - nodes[i, 0]) * (nodes[j, 1] - nodes[i, 1]))
 
 
 @njit(cache=True)

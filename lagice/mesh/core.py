@@ -18,6 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
 from ..errors import ConfigError, MeshError
 
@@ -25,13 +26,42 @@ COAST = "coast"
 OPEN = "open"
 
 
+@njit(cache=True)
+def _signed_areas_kernel(nodes, tri, out):
+    for e in range(tri.shape[0]):
+        i, j, k = tri[e, 0], tri[e, 1], tri[e, 2]
+        out[e] = 0.5 * ((nodes[j, 0] - nodes[i, 0]) * (nodes[k, 1] - nodes[i, 1])
+                        - (nodes[k, 0] - nodes[i, 0]) * (nodes[j, 1] - nodes[i, 1]))
+
+
 def signed_areas(nodes: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """Signed triangle areas [m²]; positive for counter-clockwise triangles."""
-    p0 = nodes[triangles[:, 0]]
-    p1 = nodes[triangles[:, 1]]
-    p2 = nodes[triangles[:, 2]]
-    return 0.5 * ((p1[:, 0] - p0[:, 0]) * (p2[:, 1] - p0[:, 1])
-                  - (p2[:, 0] - p0[:, 0]) * (p1[:, 1] - p0[:, 1]))
+    """Signed triangle areas [m²]; positive for counter-clockwise triangles (a compiled loop:
+    the numpy gathers took ~1 ms at 26k elements, and this runs every step)."""
+    triangles = np.asarray(triangles)
+    out = np.empty(len(triangles))
+    if len(triangles):
+        _signed_areas_kernel(np.ascontiguousarray(nodes, np.float64),
+                             np.ascontiguousarray(triangles.reshape(-1, 3)), out)
+    return out
+
+
+@njit(cache=True)
+def _centroids_kernel(nodes, tri, out):
+    """(a + b + c)/3 per coordinate, in numpy's ``nodes[tri].mean(axis=1)`` order (bit for bit):
+    that numpy expression costs ~3 ms at 26k elements (a gathered (m, 3, 2) copy and a
+    strided reduction) and ran several times per step; this loop ~0.1 ms."""
+    for e in range(tri.shape[0]):
+        i, j, k = tri[e, 0], tri[e, 1], tri[e, 2]
+        out[e, 0] = (nodes[i, 0] + nodes[j, 0] + nodes[k, 0]) / 3.0
+        out[e, 1] = (nodes[i, 1] + nodes[j, 1] + nodes[k, 1]) / 3.0
+
+
+def centroids(nodes: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """(m, 2) element centroids [m]."""
+    out = np.empty((len(triangles), 2))
+    if len(triangles):
+        _centroids_kernel(np.ascontiguousarray(nodes, np.float64), np.ascontiguousarray(triangles), out)
+    return out
 
 
 def node_element_adjacency(triangles: np.ndarray, n_nodes: int):
@@ -114,7 +144,8 @@ class Mesh:
         return np.sqrt(2.0 * np.abs(self.areas()))
 
     def centroids(self) -> np.ndarray:
-        return self.nodes[self.triangles].mean(axis=1)
+        """(m, 2) element centroids [m] (a new array)."""
+        return centroids(self.nodes, self.triangles)
 
     # -- topology --------------------------------------------------------
     @property

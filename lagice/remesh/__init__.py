@@ -117,7 +117,7 @@ def element_fields(state) -> dict:
 
 def totals(mesh: Mesh, state) -> dict:
     """Ice volume [m³], ice area [m²] and snow volume [m³] of the whole mesh."""
-    from ..lagrangian import _signed_areas_kernel
+    from ..mesh.core import _signed_areas_kernel
 
     a = np.empty(mesh.n_elements)
     _signed_areas_kernel(mesh.nodes, mesh.triangles, a)
