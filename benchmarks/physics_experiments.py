@@ -157,6 +157,19 @@ EXPERIMENTS["F10-w2027"] = ("closed", ["forcing.wind.seed=2027"], 10e3, 28,
                             "as F10, the weather of wind seed 2027 (second realisation)")
 EXPERIMENTS["F10-heal-K50-w2027"] = ("closed", COMPLIANCE50 + from_spinup("K50") + ["forcing.wind.seed=2027"],
                                      10e3, 28, "as F10-heal-K50, the weather of wind seed 2027")
+# a pack of thick and thin ice (docs/physics.md §4, "Thick and thin ice"): the spin-up's
+# thickness with correlated heterogeneity at 120-370 km (std 0.49 m against 0.16 m, 0.5-2.8 m,
+# the same mean 1.6 m;
+# winter Arctic thickness spans 1-4 m over a few hundred km, Laxon et al. 2013, "CryoSat-2
+# estimates of Arctic sea ice thickness and volume", GRL 40). A scenario, not a calibration:
+# does large-scale heterogeneity make deformation cancel between 10 and 300 km (β)?
+HETERO_THICKNESS = ("1.6 - 0.5e-6*x + 0.5*sin(2.1e-5*x + 0.7)*cos(1.7e-5*y + 1.3)"
+                    " + 0.4*sin(1.6e-5*(x + y) + 2.1) + 0.3*cos(2.5e-5*(x - 0.6*y) + 0.4)"
+                    " + 0.25*sin(5.2e-5*(0.8*x - 0.6*y) + 1.0)")
+SPINUPS["H"] = ([f"initial.thickness_m={HETERO_THICKNESS}"], OUT / "spinup-H.npz", 10e3)
+EXPERIMENTS["F10-hthick"] = ("closed", from_spinup("H"), 10e3, 28,
+                             "as F10 from a pack of thick and thin ice (correlated thickness, std 0.5 m), "
+                             "its own spin-up")
 ENSEMBLES = {"disorder": ["W20"] + [f"W20-d{i}" for i in (1, 2, 3)],
              "weather": ["W20"] + [f"W20-w{i}" for i in (1, 2, 3)]}
 for _i in (1, 2, 3):
@@ -228,7 +241,11 @@ def _store(res: dict):
     p = OUT / "experiments.json"
     with open(OUT / "experiments.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        allr = json.loads(p.read_text()) if p.exists() else {}
+        # a fresh checkout has no experiments.json: start from the published records, so
+        # that one new run does not drop every earlier one from docs/figures
+        pub = ROOT / "docs" / "figures" / "physics_experiments.json"
+        src = p if p.exists() else pub
+        allr = json.loads(src.read_text()) if src.exists() else {}
         allr[res["name"]] = res
         tmp = p.with_suffix(".tmp")
         tmp.write_text(json.dumps(allr, indent=1, default=float))

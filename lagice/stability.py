@@ -6,7 +6,13 @@ the law that the measurements follow:
 * explicit: the elastic sub-step is bounded by the wave speed,
   ``Δt_s,max = C · Δx_min / sqrt(E/ρi)``, with Δx_min = sqrt(2·min area) and E the
   stiffest element's modulus (E0 for undamaged, compact ice). C was fitted over
-  resolution, E0 and α (see ``docs/solvers.md``).
+  resolution, E0 and α (see ``docs/solvers.md``) on meshes of uniform E. Where E
+  varies between elements (damage, concentration) the solvers apply it element by
+  element, ``C · min_e Δx_e / sqrt(E_e/ρi)`` (:func:`effective_dx`): the largest
+  eigenvalue of the lumped-mass system is bounded by the largest element eigenvalue
+  (Irons' element eigenvalue theorem; the usual rule of explicit finite elements), and
+  an element's scales as E_e/(ρi Δx_e²), its thickness cancelling between stiffness
+  and mass. On uniform E this is the fitted law itself.
 * implicit: the JSON says whether a limit was found (``dt_over_td_max``:
   Δt_max / td, td = Δx/cs) or none within the range tested.
 
@@ -54,6 +60,17 @@ def explicit_substep_limit(dx_min_m: float, E_pa: float, params: MaxwellEBParams
         rho_ice = (params or MaxwellEBParams()).rho_ice
     C = float(load_limits()["explicit"]["C"])
     return C * dx_min_m / wave_speed(E_pa, rho_ice)
+
+
+def effective_dx(dx_min_m: float, E_max_pa: float, stiffness_max: float) -> float:
+    """The element size Δx_eff [m] that, with the stiffest modulus E_max [Pa], gives the
+    element-wise bound of the module doc: C Δx_eff / sqrt(E_max/ρ) = C min_e Δx_e / sqrt(E_e/ρ).
+    With Δx_e² = 2 area_e, Δx_eff = sqrt(2 E_max / max_e(E_e/area_e)); ``stiffness_max`` is
+    that max_e(E_e/area_e) [Pa m-2]. Never below ``dx_min_m`` (the bound of uniform E, to
+    which it reduces); ``dx_min_m`` where the maximum is not a positive finite number."""
+    if not (math.isfinite(stiffness_max) and stiffness_max > 0.0 and E_max_pa > 0.0):
+        return float(dx_min_m)
+    return max(float(dx_min_m), math.sqrt(2.0 * E_max_pa / stiffness_max))
 
 
 def _verdict(what, value, limit, detail, allow_unstable):

@@ -47,7 +47,7 @@ def signatures():
         "finish_nodes_kernel": (i8, A2, A2, A2, C1, A1),
         "finish_elements_kernel": (I2, A2, A2, A2, A2, B1, A2, A1, C1),
         "geometry_kernel": (A2, I2, A2, A2, A1, A1, f8, A1, C1),
-        "prepare_elements_kernel": (A1, A2, A1, A1, f8, f8, f8, f8, f8, f8, A1, A2, A1, A1, A1, A1, A1, B1, A1),
+        "prepare_elements_kernel": (A1, A2, A1, A1, A1, f8, f8, f8, f8, f8, f8, A1, A2, A1, A1, A1, A1, A1, B1, A1),
         "finish_moduli_kernel": (A1, A1, f8),
         "prepare_nodes_kernel": (I1, I1, B1, A1, A1, A2, A2, f8, f8, A2, i8, f8, f8, f8, A2, A2, A2, A1, A2,
                                  A1, A1, A1, A1),

@@ -52,6 +52,7 @@ from ..boundary import DirichletSet
 from ..errors import ConfigError, ForcingError, SolverError
 from ..forces import Coriolis, OceanDrag, WindStress, evaluate_vector
 from ..rheology import MaxwellEB
+from ..stability import effective_dx
 from .base import StepInfo
 from .explicit import ExplicitSolver
 
@@ -437,6 +438,7 @@ class CudaExplicitSolver:
         self._d["counters"].copy_to_device(np.zeros(K.N_COUNTERS, np.int64))
         sc = np.zeros(K.N_SCALARS)
         sc[K.S_E_MAX] = -math.inf
+        sc[K.S_STIFF_MAX] = -math.inf
         sc[K.S_AREA_MIN] = math.inf
         self._d["scalars"].copy_to_device(sc)
 
@@ -457,6 +459,7 @@ class CudaExplicitSolver:
         if cnt[K.C_INVERTED]:
             raise SolverError(f"{int(cnt[K.C_INVERTED])} inverted elements in the mesh")
         self.dx_min = float(np.sqrt(2.0 * sc[K.S_AREA_MIN]))
+        self.dx_eff = self.dx_min
 
     def _geom(self, key):
         if key not in self._geom_cache:
@@ -625,7 +628,8 @@ class CudaExplicitSolver:
         mesh = self.mesh
         n, m = mesh.n_nodes, mesh.n_elements
         t_new = t_s + dt_s
-        self._launch(K.prepare_elements_kernel, m, d["damage"], d["sigma"], d["conc"], d["coh"], float(p.E0),
+        self._launch(K.prepare_elements_kernel, m, d["damage"], d["sigma"], d["conc"], d["coh"], d["area"],
+                     float(p.E0),
                      float(p.relaxation_time_s), float(p.concentration_c), float(p.alpha), rh._denom, rh.q,
                      d["damage_w"], d["sigma_w"], d["e_dt"], d["gamma"], d["conc_factor"], d["sig_c"],
                      d["sig_t"], d["flag"], d["scalars"])
@@ -656,7 +660,9 @@ class CudaExplicitSolver:
 
         # -- mid-step sync: E_max, forcing checks, sub-step count ------------------------------
         cnt = d["counters"].copy_to_host()
-        E_max = float(d["scalars"].copy_to_host()[K.S_E_MAX]) if m else float(p.E0)
+        scal = d["scalars"].copy_to_host()
+        E_max = float(scal[K.S_E_MAX]) if m else float(p.E0)
+        self.dx_eff = effective_dx(self.dx_min, E_max, float(scal[K.S_STIFF_MAX])) if m else self.dx_min
         n_sub = self.substeps_for(dt_s, E_max)
         dt_sub = dt_s / n_sub
         self._check_stability(dt_sub, E_max)

@@ -45,8 +45,10 @@ C_NONFINITE_ELEM = 8
 N_COUNTERS = 9
 # scalar slots (float64): S_SPEED2_MAX = largest u² + v² [m2 s-2] of the finite
 # end-of-step velocities (the NaN checker's speed bound, checked on the device)
-S_E_MAX, S_AREA_MIN, S_SPEED2_MAX = 0, 1, 2
-N_SCALARS = 3
+# S_STIFF_MAX = max over elements of E/area [Pa m-2] (the element-wise stability bound,
+# lagice.stability.effective_dx)
+S_E_MAX, S_AREA_MIN, S_SPEED2_MAX, S_STIFF_MAX = 0, 1, 2, 3
+N_SCALARS = 4
 
 strain_rate_dev = cuda.jit(device=True)(element_strain_rate.py_func)
 bilinear_dev = cuda.jit(device=True)(_bilinear.py_func)
@@ -377,14 +379,15 @@ def geometry_kernel(nodes, tri, b, c, area, td, shear_wave_speed, scalars, count
 
 
 @cuda.jit
-def prepare_elements_kernel(damage, sigma, concentration, cohesion, E0, lambda0, c_star, alpha, denom, q,
+def prepare_elements_kernel(damage, sigma, concentration, cohesion, area, E0, lambda0, c_star, alpha, denom, q,
                             damage_w, sigma_w, e_buf, lam_buf, conc_factor, sigma_c, sigma_t, damaged_flag,
                             scalars):
     """Start of an outer step, per element: working copies of σ and d (the
     committed state stays untouched until the step succeeds), E and λ
     (``MaxwellEB.moduli``) into ``e_buf``/``lam_buf``, g = exp(−c*(1−A)),
-    σc = 2C/denom, σT = σc/q, flags cleared; E_max into ``scalars``."""
+    σc = 2C/denom, σT = σc/q, flags cleared; E_max and max E/area into ``scalars``."""
     emax = -math.inf
+    kmax = -math.inf
     for e in range(cuda.grid(1), damage.shape[0], cuda.gridsize(1)):
         d = damage[e]
         damage_w[e] = d
@@ -401,7 +404,9 @@ def prepare_elements_kernel(damage, sigma, concentration, cohesion, E0, lambda0,
         sigma_t[e] = sc / q
         damaged_flag[e] = 0
         emax = max2(emax, E)
+        kmax = max2(kmax, E / area[e])
     cuda.atomic.max(scalars, S_E_MAX, emax)
+    cuda.atomic.max(scalars, S_STIFF_MAX, kmax)
 
 
 @cuda.jit

@@ -47,6 +47,7 @@ from ..errors import ConfigError
 from ..fem import STRAIN_RATE, NodeSystem, element_strain_rate, solve_node_2x2
 from ..forces import explicit_terms
 from ..rheology import MaxwellEB, _dcrit, damage_step
+from ..stability import effective_dx
 from ..state import IceState
 from .base import StepInfo
 
@@ -345,27 +346,30 @@ class ExplicitSolver:
         area = ns.area
         self.td = self.rheology.damage_time(np.sqrt(2.0 * area))
         self.dx_min = float(np.sqrt(2.0 * area.min()))
+        #: the element size of the element-wise stability bound (lagice.stability.effective_dx),
+        #: set at each step from the moduli; dx_min until then
+        self.dx_eff = self.dx_min
 
     # -- sub-step choice -------------------------------------------------------------
     def substeps_for(self, dt: float, E_max: float | None = None) -> int:
         """N for an outer step dt [s]: the fixed ``substeps``, or the smallest N with
-        dt/N <= safety × the measured limit for the stiffest element (E_max [Pa],
-        default E0)."""
+        dt/N <= safety × the measured limit, applied element by element
+        (:func:`lagice.stability.effective_dx`: ``dx_eff`` with E_max [Pa], default E0)."""
         if self.substeps is not None:
             return self.substeps
         from ..stability import explicit_substep_limit
 
         E_max = self.rheology.params.E0 if E_max is None else E_max
-        lim = explicit_substep_limit(self.dx_min, E_max, self.rheology.params)
+        lim = explicit_substep_limit(self.dx_eff, E_max, self.rheology.params)
         return max(1, int(math.ceil(dt / (self.safety * lim) - 1e-9)))
 
     def _check_stability(self, dt_s: float, E_max: float) -> None:
-        key = (round(dt_s, 9), round(self.dx_min, 3), round(E_max, 3))
+        key = (round(dt_s, 9), round(self.dx_eff, 3), round(E_max, 3))
         if key in self._checked:
             return
         from ..stability import check_explicit_substep
 
-        check_explicit_substep(dt_s, self.dx_min, E_max, self.rheology.params,
+        check_explicit_substep(dt_s, self.dx_eff, E_max, self.rheology.params,
                                allow_unstable=self.allow_unstable)
         if len(self._checked) > 1000:
             self._checked.clear()
@@ -444,6 +448,7 @@ class ExplicitSolver:
         t0 = time.perf_counter()
         E, lam = self.rheology.moduli(state.damage, state.concentration)
         E_max = float(E.max()) if len(E) else p.E0
+        self.dx_eff = effective_dx(self.dx_min, E_max, float((E / ns.area).max())) if len(E) else self.dx_min
         n_sub = self.substeps_for(dt, E_max)
         dt_s = dt / n_sub
         self._check_stability(dt_s, E_max)
