@@ -170,6 +170,13 @@ SPINUPS["H"] = ([f"initial.thickness_m={HETERO_THICKNESS}"], OUT / "spinup-H.npz
 EXPERIMENTS["F10-hthick"] = ("closed", from_spinup("H"), 10e3, 28,
                              "as F10 from a pack of thick and thin ice (correlated thickness, std 0.5 m), "
                              "its own spin-up")
+# the flagship re-run with the numerics of 2026-11-25 (FMA contraction in the explicit kernels,
+# the sub-step limit applied element by element: ~10 % fewer sub-steps): the same set-up as
+# F10/F10s, whose records (older code) are kept
+EXPERIMENTS["F10-n25"] = ("closed", [], 10e3, 28,
+                          "F10 re-run with the 2026-11-25 numerics (FMA, element-wise sub-step)")
+EXPERIMENTS["F10s-n25"] = ("strait", [], 10e3, 28,
+                           "F10s re-run with the 2026-11-25 numerics (FMA, element-wise sub-step)")
 ENSEMBLES = {"disorder": ["W20"] + [f"W20-d{i}" for i in (1, 2, 3)],
              "weather": ["W20"] + [f"W20-w{i}" for i in (1, 2, 3)]}
 for _i in (1, 2, 3):
