@@ -177,6 +177,10 @@ EXPERIMENTS["F10-n25"] = ("closed", [], 10e3, 28,
                           "F10 re-run with the 2026-11-25 numerics (FMA, element-wise sub-step)")
 EXPERIMENTS["F10s-n25"] = ("strait", [], 10e3, 28,
                            "F10s re-run with the 2026-11-25 numerics (FMA, element-wise sub-step)")
+# the same with the sub-step count fixed at 170, the count of the old (whole-mesh) limit at
+# the start of F10: separates the effect of the sub-step length from that of round-off
+EXPERIMENTS["F10-n25-sub170"] = ("closed", ["solver.substeps=170"], 10e3, 28,
+                                 "F10-n25 with 170 sub-steps per step (the old limit's count at the start)")
 ENSEMBLES = {"disorder": ["W20"] + [f"W20-d{i}" for i in (1, 2, 3)],
              "weather": ["W20"] + [f"W20-w{i}" for i in (1, 2, 3)]}
 for _i in (1, 2, 3):

@@ -41,7 +41,7 @@ model misses") is placed into the report.
     python benchmarks/validate.py --quick          # 4-day basins at 20 km, N = 20 compression (~3 min)
     python benchmarks/validate.py --analyse-only   # re-analyse the runs already in --out
     python benchmarks/validate.py --analyse-only --from-physics --evp-km 20
-        # analyse the runs of benchmarks/physics_experiments.py (F10, F10s, E20, E20s, S20, X-*)
+        # analyse the runs of benchmarks/physics_experiments.py (PHYSICS_RUNS: F10-n25, F10s-n25, E10/E20, X10-*)
 
 Writes ``--out`` (default ``benchmarks/out/validate``: runs, logs, the full
 ``validation.json``), ``docs/validation.md``, ``docs/figures/validation_*.png``
@@ -112,9 +112,11 @@ SENSITIVITY = {
 #: resolution of the sensitivity runs [m]
 SENSITIVITY_RESOLUTION_M = 10e3
 #: the runs of benchmarks/physics_experiments.py that --from-physics analyses
-#: (``{evp}``: E10/E20 by --evp-km)
-PHYSICS_RUNS = {"closed_maxwell_eb": "F10", "strait_maxwell_eb": "F10s", "closed_evp": "E{evp}",
-                "strait_evp": "E{evp}s", "sensitivity_base": "F10", "sensitivity_strength-50": "X10-str-50",
+#: (``{evp}``: E10/E20 by --evp-km). The flagship runs are F10-n25/F10s-n25: the F10/F10s
+#: set-up re-run with the numerics of 2026-11-25 (FMA, element-wise sub-step limit); the
+#: records of F10/F10s (older numerics) are kept in docs/figures/physics_experiments.json
+PHYSICS_RUNS = {"closed_maxwell_eb": "F10-n25", "strait_maxwell_eb": "F10s-n25", "closed_evp": "E{evp}",
+                "strait_evp": "E{evp}s", "sensitivity_base": "F10-n25", "sensitivity_strength-50": "X10-str-50",
                 "sensitivity_strength+50": "X10-str+50", "sensitivity_drag-50": "X10-drag-50",
                 "sensitivity_drag+50": "X10-drag+50", "sensitivity_wind-50": "X10-wind-50",
                 "sensitivity_wind+50": "X10-wind+50"}
@@ -819,7 +821,7 @@ def main(argv=None):
     ap.add_argument("--compression-job", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--from-physics", action="store_true",
                     help="with --analyse-only: analyse the runs of benchmarks/physics_experiments.py "
-                         "(benchmarks/out/physics: F10, F10s, E10/E20, S20, X-*)")
+                         "(benchmarks/out/physics: PHYSICS_RUNS)")
     ap.add_argument("--evp-km", type=float, default=10.0, help="with --from-physics: the EVP runs' resolution")
     ap.add_argument("--physics-dir", type=Path, default=ROOT / "benchmarks" / "out" / "physics",
                     help="with --from-physics: where benchmarks/physics_experiments.py put its runs")
