@@ -202,7 +202,7 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="10k elements, serial kernels, 2 timed steps")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="scene override as `lagice run --set` (e.g. domain.renumber=false)")
-    ap.add_argument("--json", type=Path, default=Path("benchmarks/out/explicit.json"))
+    ap.add_argument("--json", type=Path, default=Path(__file__).resolve().parent / Path("out/explicit.json"))
     a = ap.parse_args(argv)
     from lagice.scenes.config import _split
 

@@ -66,7 +66,7 @@ def main(argv=None):
     ap.add_argument("--preload", type=float, default=2.4e-4,
                     help="initial uniform compressive strain so damage is active (0: elastic only)")
     ap.add_argument("--quick", action="store_true", help="N = 20, cg only, 10 steps")
-    ap.add_argument("--json", type=Path, default=Path("benchmarks/out/implicit.json"))
+    ap.add_argument("--json", type=Path, default=Path(__file__).resolve().parent / Path("out/implicit.json"))
     a = ap.parse_args(argv)
     if a.quick:
         a.n, a.solvers, a.steps = [20], ["cg"], 10

@@ -82,7 +82,7 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="20 km, 1 day")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="scene override as `lagice run --set` (e.g. domain.renumber=false)")
-    ap.add_argument("--json", type=Path, default=Path("benchmarks/out/winter.json"))
+    ap.add_argument("--json", type=Path, default=Path(__file__).resolve().parent / Path("out/winter.json"))
     a = ap.parse_args(argv)
     from lagice.scenes.config import _split
 

@@ -291,10 +291,10 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=1,
                     help="numba threads (1: the meshes here are small, one thread is fastest)")
     ap.add_argument("--only", choices=["uniaxial_compression", "wind_square"], help="run one scene only")
-    ap.add_argument("--json", type=Path, default=Path("benchmarks/out/speed_accuracy.json"))
+    ap.add_argument("--json", type=Path, default=Path(__file__).resolve().parent / Path("out/speed_accuracy.json"))
     ap.add_argument("--png", type=Path, default=Path("docs/figures/speed_accuracy.png"))
     ap.add_argument("--md", type=Path, default=Path("docs/speed_accuracy.md"))
-    ap.add_argument("--notes", type=Path, default=Path("benchmarks/speed_accuracy_notes.md"),
+    ap.add_argument("--notes", type=Path, default=Path(__file__).resolve().parent / Path("speed_accuracy_notes.md"),
                     help="hand-written discussion placed into the markdown (if the file exists)")
     ap.add_argument("--from-json", action="store_true",
                     help="only redraw the figure and the markdown from an existing --json file")

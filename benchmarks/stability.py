@@ -142,7 +142,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--write-limits", action="store_true")
-    ap.add_argument("--json", type=Path, default=Path("benchmarks/out/stability.json"))
+    ap.add_argument("--json", type=Path, default=Path(__file__).resolve().parent / Path("out/stability.json"))
     ap.add_argument("--png", type=Path, default=Path("docs/figures/stability.png"))
     ap.add_argument("--from-json", action="store_true", help="only redraw the figure from --json")
     a = ap.parse_args(argv)
