@@ -167,20 +167,36 @@ HETERO_THICKNESS = ("1.6 - 0.5e-6*x + 0.5*sin(2.1e-5*x + 0.7)*cos(1.7e-5*y + 1.3
                     " + 0.4*sin(1.6e-5*(x + y) + 2.1) + 0.3*cos(2.5e-5*(x - 0.6*y) + 0.4)"
                     " + 0.25*sin(5.2e-5*(0.8*x - 0.6*y) + 1.0)")
 SPINUPS["H"] = ([f"initial.thickness_m={HETERO_THICKNESS}"], OUT / "spinup-H.npz", 10e3)
-EXPERIMENTS["F10-hthick"] = ("closed", from_spinup("H"), 10e3, 28,
+#: the sub-step rule these runs were made with (solver.substep_limit = "element", the default
+#: for part of 2026-11-25; the spin-up state H too)
+ELEMENT = ["solver.substep_limit=element"]
+EXPERIMENTS["F10-hthick"] = ("closed", from_spinup("H") + ELEMENT, 10e3, 28,
                              "as F10 from a pack of thick and thin ice (correlated thickness, std 0.5 m), "
                              "its own spin-up")
 # the flagship re-run with the numerics of 2026-11-25 (FMA contraction in the explicit kernels,
 # the sub-step limit applied element by element: ~10 % fewer sub-steps): the same set-up as
 # F10/F10s, whose records (older code) are kept
-EXPERIMENTS["F10-n25"] = ("closed", [], 10e3, 28,
+EXPERIMENTS["F10-n25"] = ("closed", ELEMENT, 10e3, 28,
                           "F10 re-run with the 2026-11-25 numerics (FMA, element-wise sub-step)")
-EXPERIMENTS["F10s-n25"] = ("strait", [], 10e3, 28,
+EXPERIMENTS["F10s-n25"] = ("strait", ELEMENT, 10e3, 28,
                            "F10s re-run with the 2026-11-25 numerics (FMA, element-wise sub-step)")
 # the same with the sub-step count fixed at 170, the count of the old (whole-mesh) limit at
 # the start of F10: separates the effect of the sub-step length from that of round-off
 EXPERIMENTS["F10-n25-sub170"] = ("closed", ["solver.substeps=170"], 10e3, 28,
                                  "F10-n25 with 170 sub-steps per step (the old limit's count at the start)")
+# convergence in the sub-step length: 250 sub-steps per step (Δt_s 2.4 s; F10-n25 ~4.2 s,
+# F10-n25-sub170 3.5 s)
+EXPERIMENTS["F10-n25-sub250"] = ("closed", ["solver.substeps=250"], 10e3, 28,
+                                 "F10-n25 with 250 sub-steps per step (sub-step convergence)")
+# a second month of weather for the pair that differs only by the spin-up thickness
+EXPERIMENTS["F10-n25-w2027"] = ("closed", ["forcing.wind.seed=2027"] + ELEMENT, 10e3, 28,
+                                "F10-n25 with the weather of wind seed 2027")
+EXPERIMENTS["F10-hthick-w2027"] = ("closed", from_spinup("H") + ["forcing.wind.seed=2027"] + ELEMENT, 10e3, 28,
+                                   "F10-hthick with the weather of wind seed 2027")
+# the flagship with the code of 2026-11-25 as shipped (FMA contraction, the default "mesh"
+# sub-step rule): the runs the validation report analyses (benchmarks/validate.py PHYSICS_RUNS)
+EXPERIMENTS["F10-1125"] = ("closed", [], 10e3, 28, "the flagship (F10 set-up), code of 2026-11-25")
+EXPERIMENTS["F10s-1125"] = ("strait", [], 10e3, 28, "the flagship strait (F10s set-up), code of 2026-11-25")
 ENSEMBLES = {"disorder": ["W20"] + [f"W20-d{i}" for i in (1, 2, 3)],
              "weather": ["W20"] + [f"W20-w{i}" for i in (1, 2, 3)]}
 for _i in (1, 2, 3):

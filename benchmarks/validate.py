@@ -41,7 +41,7 @@ model misses") is placed into the report.
     python benchmarks/validate.py --quick          # 4-day basins at 20 km, N = 20 compression (~3 min)
     python benchmarks/validate.py --analyse-only   # re-analyse the runs already in --out
     python benchmarks/validate.py --analyse-only --from-physics --evp-km 20
-        # analyse the runs of benchmarks/physics_experiments.py (PHYSICS_RUNS: F10-n25, F10s-n25, E10/E20, X10-*)
+        # analyse the runs of benchmarks/physics_experiments.py (PHYSICS_RUNS: F10-1125, F10s-1125, E10/E20, X10-*)
 
 Writes ``--out`` (default ``benchmarks/out/validate``: runs, logs, the full
 ``validation.json``), ``docs/validation.md``, ``docs/figures/validation_*.png``
@@ -112,11 +112,11 @@ SENSITIVITY = {
 #: resolution of the sensitivity runs [m]
 SENSITIVITY_RESOLUTION_M = 10e3
 #: the runs of benchmarks/physics_experiments.py that --from-physics analyses
-#: (``{evp}``: E10/E20 by --evp-km). The flagship runs are F10-n25/F10s-n25: the F10/F10s
-#: set-up re-run with the numerics of 2026-11-25 (FMA, element-wise sub-step limit); the
-#: records of F10/F10s (older numerics) are kept in docs/figures/physics_experiments.json
-PHYSICS_RUNS = {"closed_maxwell_eb": "F10-n25", "strait_maxwell_eb": "F10s-n25", "closed_evp": "E{evp}",
-                "strait_evp": "E{evp}s", "sensitivity_base": "F10-n25", "sensitivity_strength-50": "X10-str-50",
+#: (``{evp}``: E10/E20 by --evp-km). The flagship runs are F10-1125/F10s-1125: the F10/F10s
+#: set-up re-run with the code of 2026-11-25 (FMA contraction in the explicit kernels); the
+#: records of F10/F10s (older code) are kept in docs/figures/physics_experiments.json
+PHYSICS_RUNS = {"closed_maxwell_eb": "F10-1125", "strait_maxwell_eb": "F10s-1125", "closed_evp": "E{evp}",
+                "strait_evp": "E{evp}s", "sensitivity_base": "F10-1125", "sensitivity_strength-50": "X10-str-50",
                 "sensitivity_strength+50": "X10-str+50", "sensitivity_drag-50": "X10-drag-50",
                 "sensitivity_drag+50": "X10-drag+50", "sensitivity_wind-50": "X10-wind-50",
                 "sensitivity_wind+50": "X10-wind+50"}

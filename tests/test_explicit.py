@@ -225,12 +225,13 @@ def test_explicit_stepper_refuses_the_mean_stress_correction():
 
 
 def test_elementwise_stability_bound(tmp_path):
-    """The sub-step limit is applied element by element (lagice.stability.effective_dx):
-    C min_e Δx_e / sqrt(E_e/ρ) instead of C Δx_min / sqrt(E_max/ρ). With the smaller
-    half of the elements damaged to d = 0.9 (E ten times lower) the automatic count is
-    below the uniform-E bound's, and the run at that count stays bounded; with half that
-    count (beyond the element-wise limit) the same run blows up, so the bound is what
-    keeps it stable, not a margin."""
+    """``solver.substep_limit = "element"`` applies the sub-step limit element by element
+    (lagice.stability.effective_dx): C min_e Δx_e / sqrt(E_e/ρ) instead of the default
+    C Δx_min / sqrt(E_max/ρ). With the smaller half of the elements damaged to d = 0.9
+    (E ten times lower) its automatic count is below the default's, and the run at that
+    count stays bounded; with half that count (beyond the element-wise limit) the same
+    run blows up, so the bound is what keeps it stable, not a margin. A bad value is
+    refused before meshing, naming the key."""
     import math
 
     from lagice.stability import effective_dx, explicit_substep_limit
@@ -239,7 +240,8 @@ def test_elementwise_stability_bound(tmp_path):
         sim = scene_sim("wind_square", tmp_path / sub,
                         {"domain.resolution_m": 25e3, "run.duration": "1h", "forcing.wind.params.ramp_h": 0.0,
                          "rheology.cohesion_min_pa": 1e12, "rheology.cohesion_max_pa": 2e12,
-                         "lagrangian.enabled": False, "output.timeseries": None, **(overrides or {})})
+                         "lagrangian.enabled": False, "output.timeseries": None,
+                         "solver.substep_limit": "element", **(overrides or {})})
         st = sim.model.state
         size = np.sqrt(2.0 * np.abs(st.mesh.areas()))
         d = np.where(size < np.median(size), 0.9, 0.0)
@@ -259,6 +261,9 @@ def test_elementwise_stability_bound(tmp_path):
     n_auto = st.last_substeps
     n_uniform = math.ceil(sim.dt / (0.7 * explicit_substep_limit(st.dx_min, E.max())))
     assert n_auto < n_uniform
+    default, _, _ = sim_with_damaged_small_elements("default", {"solver.substep_limit": "mesh"})
+    default.run(n_steps=1)
+    assert default.model.stepper.last_substeps == n_uniform  # the default rule: whole-mesh Δx_min, E_max
     assert sim.dt / n_auto <= 0.7 * explicit_substep_limit(st.dx_eff, E.max())
     v = sim.model.state.velocity
     assert np.isfinite(v).all() and np.abs(v).max() < 1.0  # bounded: wind-driven ice, < 1 m/s
@@ -275,3 +280,5 @@ def test_elementwise_stability_bound(tmp_path):
         except LagiceError:
             blew_up = True
     assert blew_up
+    with pytest.raises(ConfigError, match=r"solver.substep_limit = 'cell': expected one of \['mesh', 'element'\]"):
+        scene_sim("wind_square", tmp_path / "bad", {"solver.substep_limit": "cell"})

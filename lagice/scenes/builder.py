@@ -405,7 +405,8 @@ def solver_options(cfg: dict) -> dict:
         raise ConfigError(f"solver.name = {sv['name']!r}: expected one of {sorted(SOLVERS)}")
     accepted = set(inspect.signature(SOLVERS[sv["name"]].__init__).parameters)
     opts = {}
-    for k in ("linear_solver", "tol", "max_iter", "substeps", "allow_unstable", "safety", "parallel"):
+    for k in ("linear_solver", "tol", "max_iter", "substeps", "allow_unstable", "safety", "parallel",
+              "substep_limit"):
         if sv[k] is None or (k == "allow_unstable" and sv[k] is False):
             continue
         if k == "parallel" and isinstance(sv[k], str):
@@ -415,6 +416,10 @@ def solver_options(cfg: dict) -> dict:
             continue  # "auto" is the steppers' default (None)
         if k not in accepted:
             raise ConfigError(f"solver.{k} does not apply to solver {sv['name']!r}")
+        if k == "substep_limit":
+            from ..solvers.explicit import check_substep_limit
+
+            check_substep_limit(sv[k])
         opts[k] = sv[k]
     if sv["velocity"] is not None or sv["velocity_params"]:
         if "velocity" not in accepted:

@@ -70,6 +70,7 @@ SCHEMA = {
         "name": (str, "implicit"), "dt": (EXPR, None), "substeps": (int, None),
         "linear_solver": (str, None), "tol": (NUM, None), "max_iter": (int, None),
         "allow_unstable": (bool, False), "safety": (NUM, None), "parallel": ((bool, str), None),
+        "substep_limit": (str, None),
         "velocity": (str, None), "velocity_params": (dict, {}),
         "device": (str, "cpu"),
     },

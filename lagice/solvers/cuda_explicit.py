@@ -54,7 +54,7 @@ from ..forces import Coriolis, OceanDrag, WindStress, evaluate_vector
 from ..rheology import MaxwellEB
 from ..stability import effective_dx
 from .base import StepInfo
-from .explicit import ExplicitSolver
+from .explicit import ExplicitSolver, check_substep_limit
 
 #: values of ``[solver] device``
 DEVICES = ("cpu", "cuda")
@@ -289,7 +289,7 @@ class CudaExplicitSolver:
     def __init__(self, rheology: MaxwellEB, mesh, bcs=(), forces=(), substeps: int | None = None,
                  heal_rate=None, safety: float = 0.7, allow_unstable: bool = False,
                  parallel: bool | None = None, *, sync: str = "step", launch: str = "auto",
-                 threads_per_block: int = 128, max_blocks: int | None = None):
+                 threads_per_block: int = 128, max_blocks: int | None = None, substep_limit: str = "mesh"):
         self.device_name = require_cuda("solver.device")
         if not isinstance(rheology, MaxwellEB):
             raise ConfigError(f"the explicit stepper solves the Maxwell-EB rheology; got {type(rheology).__name__}")
@@ -310,6 +310,7 @@ class CudaExplicitSolver:
             raise ConfigError(f"max_blocks = {max_blocks!r} must be an integer >= 1 or None")
         from . import cuda_kernels as K
 
+        self.substep_limit = check_substep_limit(substep_limit)
         self.rheology = rheology
         self.bcs = list(bcs)
         self.forces = list(forces)
@@ -662,7 +663,8 @@ class CudaExplicitSolver:
         cnt = d["counters"].copy_to_host()
         scal = d["scalars"].copy_to_host()
         E_max = float(scal[K.S_E_MAX]) if m else float(p.E0)
-        self.dx_eff = effective_dx(self.dx_min, E_max, float(scal[K.S_STIFF_MAX])) if m else self.dx_min
+        self.dx_eff = (effective_dx(self.dx_min, E_max, float(scal[K.S_STIFF_MAX]))
+                       if m and self.substep_limit == "element" else self.dx_min)
         n_sub = self.substeps_for(dt_s, E_max)
         dt_sub = dt_s / n_sub
         self._check_stability(dt_sub, E_max)
