@@ -7,8 +7,9 @@ the law that the measurements follow:
   ``Δt_s,max = C · Δx_min / sqrt(E/ρi)``, with Δx_min = sqrt(2·min area) and E the
   stiffest element's modulus (E0 for undamaged, compact ice). C was fitted over
   resolution, E0 and α (see ``docs/solvers.md``) on meshes of uniform E. Where E
-  varies between elements (damage, concentration) the solvers apply it element by
-  element, ``C · min_e Δx_e / sqrt(E_e/ρi)`` (:func:`effective_dx`): the largest
+  varies between elements (damage, concentration), ``solver.substep_limit = "element"``
+  applies it element by element, ``C · min_e Δx_e / sqrt(E_e/ρi)`` (:func:`effective_dx`;
+  the default, "mesh", keeps the smallest Δx with the stiffest E): the largest
   eigenvalue of the lumped-mass system is bounded by the largest element eigenvalue
   (Irons' element eigenvalue theorem; the usual rule of explicit finite elements), and
   an element's scales as E_e/(ρi Δx_e²), its thickness cancelling between stiffness
