@@ -193,6 +193,12 @@ EXPERIMENTS["F10-n25-w2027"] = ("closed", ["forcing.wind.seed=2027"] + ELEMENT, 
                                 "F10-n25 with the weather of wind seed 2027")
 EXPERIMENTS["F10-hthick-w2027"] = ("closed", from_spinup("H") + ["forcing.wind.seed=2027"] + ELEMENT, 10e3, 28,
                                    "F10-hthick with the weather of wind seed 2027")
+# the thick-and-thin pack with the default ("mesh") sub-step rule: its own spin-up state
+SPINUPS["H1125"] = ([f"initial.thickness_m={HETERO_THICKNESS}"], OUT / "spinup-H1125.npz", 10e3)
+EXPERIMENTS["F10-hthick-1125"] = ("closed", from_spinup("H1125"), 10e3, 28,
+                                  "F10-hthick with the default sub-step rule (code of 2026-11-25)")
+EXPERIMENTS["F10s-hthick-1125"] = ("strait", from_spinup("H1125"), 10e3, 28,
+                                   "the strait from the thick-and-thin pack, default sub-step rule")
 # the flagship with the code of 2026-11-25 as shipped (FMA contraction, the default "mesh"
 # sub-step rule): the runs the validation report analyses (benchmarks/validate.py PHYSICS_RUNS)
 EXPERIMENTS["F10-1125"] = ("closed", [], 10e3, 28, "the flagship (F10 set-up), code of 2026-11-25")
