@@ -114,8 +114,10 @@ SPINUPS = {"shipped": ([], ROOT / "data_stubs" / "winter_basin_spinup.npz", 10e3
 
 
 def from_spinup(name: str) -> list:
-    """The override that starts a run from spin-up state ``name`` (see SPINUPS)."""
-    return [f"initial.state_file={SPINUPS[name][1]}"]
+    """The override that starts a run from spin-up state ``name`` (see SPINUPS), with the
+    path relative to the repository root (the runs' working directory), so that records do
+    not carry the path of one checkout."""
+    return [f"initial.state_file={SPINUPS[name][1].relative_to(ROOT)}"]
 
 
 def prepare_inputs():

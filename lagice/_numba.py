@@ -27,21 +27,15 @@ from numba import njit
 PARALLEL_MIN_SIZE = int(os.environ.get("LAGICE_PARALLEL_MIN_SIZE", "200000"))
 
 
-def renamed_copy(py_func, suffix: str, **njit_kw):
-    """A numba dispatcher of ``py_func`` under the name ``<name><suffix>``: its own entry in
-    numba's disk cache (keyed by qualname, not by the compile options)."""
-    py_func = getattr(py_func, "py_func", py_func)
-    fn = types.FunctionType(py_func.__code__, py_func.__globals__, py_func.__name__ + suffix,
-                            py_func.__defaults__, py_func.__closure__)
-    fn.__qualname__ = py_func.__qualname__ + suffix
-    fn.__module__ = py_func.__module__
-    fn.__doc__ = py_func.__doc__
-    return njit(cache=True, **njit_kw)(fn)
-
-
 def serial_copy(py_func, **njit_kw):
     """A serial numba dispatcher of ``py_func`` (``prange`` runs as ``range``)."""
-    return renamed_copy(py_func, "_serial", **njit_kw)
+    py_func = getattr(py_func, "py_func", py_func)
+    ser = types.FunctionType(py_func.__code__, py_func.__globals__, py_func.__name__ + "_serial",
+                             py_func.__defaults__, py_func.__closure__)
+    ser.__qualname__ = py_func.__qualname__ + "_serial"
+    ser.__module__ = py_func.__module__
+    ser.__doc__ = py_func.__doc__
+    return njit(cache=True, **njit_kw)(ser)
 
 
 def serial_and_parallel(py_func, **njit_kw):
