@@ -207,6 +207,22 @@ EXPERIMENTS["F10-1125"] = ("closed", [], 10e3, 28, "the flagship (F10 set-up), c
 EXPERIMENTS["F10s-1125"] = ("strait", [], 10e3, 28, "the flagship strait (F10s set-up), code of 2026-11-25")
 ENSEMBLES = {"disorder": ["W20"] + [f"W20-d{i}" for i in (1, 2, 3)],
              "weather": ["W20"] + [f"W20-w{i}" for i in (1, 2, 3)]}
+# weather ensembles of the flagship (shipped pack) and of the thick-and-thin pack, closed
+# and strait, with the code of 2026-11-25 and the default sub-step rule: wind seeds 2026 (the
+# scene's own), 2027 and 2028; spin-up states and strength disorder unchanged. One 28-day
+# run cannot decide whether a set-up is inside a band (docs/physics.md §4); three can say
+# how often it is.
+for _seed in (2027, 2028):
+    _w = [f"forcing.wind.seed={_seed}"]
+    EXPERIMENTS[f"F10-1125-w{_seed}"] = ("closed", _w, 10e3, 28, f"F10-1125, the weather of wind seed {_seed}")
+    EXPERIMENTS[f"F10s-1125-w{_seed}"] = ("strait", _w, 10e3, 28, f"F10s-1125, the weather of wind seed {_seed}")
+    EXPERIMENTS[f"F10-hthick-1125-w{_seed}"] = ("closed", from_spinup("H1125") + _w, 10e3, 28,
+                                                f"F10-hthick-1125, the weather of wind seed {_seed}")
+    EXPERIMENTS[f"F10s-hthick-1125-w{_seed}"] = ("strait", from_spinup("H1125") + _w, 10e3, 28,
+                                                 f"F10s-hthick-1125, the weather of wind seed {_seed}")
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    ENSEMBLES[f"flagship, {_basin}"] = [f"{_p}-1125"] + [f"{_p}-1125-w{s}" for s in (2027, 2028)]
+    ENSEMBLES[f"thick-and-thin, {_basin}"] = [f"{_p}-hthick-1125"] + [f"{_p}-hthick-1125-w{s}" for s in (2027, 2028)]
 for _i in (1, 2, 3):
     EXPERIMENTS[f"W20-d{_i}"] = ("closed", ["forcing.wind.seed=2026", f"run.seed={_i}"], 20e3, 28,
                                  f"as W20, strength disorder of run seed {_i} (same weather)")

@@ -194,11 +194,19 @@ class Model:
         return self.ledger.budget(self.state.ice_volume_m3)
 
     # -- checkpoint support ------------------------------------------------------
-    def fingerprint(self) -> str:
+    def fingerprint(self, without=()) -> str:
         """Hash of the configuration that determines the trajectory: a checkpoint
-        resumes only a model with the same physics."""
+        resumes only a model with the same physics. ``without``: dotted keys
+        (``"solver.substep_limit"``) left out of the hash, as the code of a version
+        that did not have them hashed it (:meth:`lagice.simulation.Simulation.resume`)."""
         cfg = self.fingerprint_config if self.fingerprint_config is not None else self.config
         cfg = {k: v for k, v in cfg.items() if not k.startswith("_")}
+        for key in without:
+            table, _, name = key.partition(".")
+            if name and isinstance(cfg.get(table), dict):
+                cfg[table] = {k: v for k, v in cfg[table].items() if k != name}
+            else:
+                cfg.pop(table, None)
         blob = json.dumps(cfg, sort_keys=True, default=str).encode()
         return hashlib.sha256(blob).hexdigest()[:16]
 

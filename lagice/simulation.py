@@ -263,9 +263,7 @@ class Simulation:
             sim = _call_builder(spec, meta["config"] if config is None else config, **builder_kw)
         else:
             sim = cls(model, dt=meta["simulation"]["dt_s"], stop=meta["simulation"]["stop_s"])
-        if sim.model.fingerprint() != meta.get("scene_fingerprint"):
-            raise RestartError(f"checkpoint {path} belongs to another scene or configuration "
-                               f"(fingerprint {meta.get('scene_fingerprint')}, model {sim.model.fingerprint()})")
+        sim._check_fingerprint(path, meta)
         sim.model.load_state(arrays, meta)
         if sim.model.clock.time_s > sim.stop_time * (1 + 1e-12):
             raise RestartError(f"checkpoint {path} is at t = {sim.model.clock.time_s:g} s, after the end of the run "
@@ -277,6 +275,38 @@ class Simulation:
         sim.wall_total = float(meta.get("simulation", {}).get("wall_s", 0.0))
         sim.resumed_from = path
         return sim
+
+    def _check_fingerprint(self, path, meta: dict) -> None:
+        """The checkpoint's fingerprint must be the model's: the same physics. A checkpoint
+        written by a version without some of today's keys (its stored configuration lacks
+        them) matches the model's fingerprint hashed without them, provided each has the
+        value that does what that version did (:data:`lagice.scenes.config.LEGACY_VALUES`);
+        otherwise it is refused, naming the keys."""
+        from .scenes.config import absent_keys, legacy_keys_check
+
+        expect = meta.get("scene_fingerprint")
+        model = self.model
+        if model.fingerprint() == expect:
+            return
+        view = model.fingerprint_config if model.fingerprint_config is not None else model.config
+        absent = absent_keys(view, meta.get("config"))
+        if absent and model.fingerprint(without=absent) == expect:
+            bad = legacy_keys_check(view, absent)
+            if bad:
+                raise RestartError(
+                    f"checkpoint {path} was written by lagice {meta.get('lagice_version', '?')}, whose configuration "
+                    f"had no {', '.join(absent)}; with {', '.join(bad)} this run would not continue the same "
+                    f"physics: resume without setting them, or branch a new run (lagice branch {path} --set ...)")
+            import logging
+
+            logging.getLogger("lagice").info(
+                f"checkpoint {path} was written by lagice {meta.get('lagice_version', '?')} without the keys "
+                f"{', '.join(absent)}; their values here do what that version did (the same physics)")
+            return
+        hint = (f"; its configuration has no {', '.join(absent)} (keys added since the version that wrote it)"
+                if absent else "")
+        raise RestartError(f"checkpoint {path} belongs to another scene or configuration "
+                           f"(fingerprint {expect}, model {model.fingerprint()}){hint}")
 
 
 def load_checkpoint(checkpoint):

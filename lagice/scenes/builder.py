@@ -575,8 +575,10 @@ def build_simulation(cfg: dict, out_dir=None, progress: bool | None = None, over
     fingerprint, and the resume is refused)."""
     from .. import rundir
 
-    if overrides:
-        cfg = override_config(cfg, overrides)
+    # validated again (with the overrides): a configuration stored in a checkpoint by an
+    # earlier version gets today's defaults for the keys it lacks (Simulation.resume then
+    # checks that they do what that version did)
+    cfg = override_config(cfg, overrides or {})
     validate_config(cfg)
     if out_dir is None:
         out = rundir.new_run_dir(cfg["scene"]["name"])
@@ -631,7 +633,7 @@ def resume_simulation(checkpoint, overrides=None, progress: bool | None = None, 
     from .config import changed_keys, length_dependent_forcing, override_config
 
     path, arrays, meta = load_checkpoint(checkpoint)
-    old = meta["config"]
+    old = override_config(meta["config"], {})  # keys added since the checkpoint's version get their defaults
     if config is not None:  # a full scene config (lagice run SCENE --out DIR --resume)
         cfg = {**config, **{k: v for k, v in old.items() if k.startswith("_")}}
     else:
@@ -669,7 +671,7 @@ def branch_config(checkpoint, meta: dict, overrides=None, sha256: str | None = N
     from ..io.checkpoint import file_sha256
     from .config import changed_keys, override_config
 
-    old = meta["config"]
+    old = override_config(meta["config"], {})  # keys added since the checkpoint's version get their defaults
     cfg = override_config(old, overrides)
     for key in changed_keys({k: v for k, v in old.items() if not k.startswith("_")},
                             {k: v for k, v in cfg.items() if not k.startswith("_")}):

@@ -115,6 +115,57 @@ NON_PHYSICS = {"scene": ("name", "description", "extends", "source"), "run": ("d
                # equal to round-off (docs/gpu.md), so a checkpoint resumes on another device
                "solver": ("device", "parallel")}
 
+#: keys added to the schema after checkpoints existed, each with the value(s) that do what
+#: the code did before the key existed. A checkpoint written before a key existed has no
+#: such key in its configuration, and its fingerprint was hashed without it: it resumes
+#: when the key's value here is one of these (:func:`legacy_keys_check`, used by
+#: :meth:`lagice.simulation.Simulation.resume`), and is refused, naming the key, otherwise.
+#: A key whose default does not reproduce the earlier code (``domain.renumber``: meshes were
+#: not renumbered before it) is not listed, so such checkpoints are refused.
+LEGACY_VALUES = {
+    "domain.jitter": (0.0, 0),                       # 2026-11-23: no node jitter
+    "domain.mesh_algorithm": (6,),                   # 2026-11-23: gmsh Frontal-Delaunay
+    "rheology.strength_law": ("uniform",),           # 2026-11-23: cohesion_min/max_pa
+    "rheology.strength_lab_pa": (None,),
+    "rheology.strength_lab_scale_m": (None,),
+    "rheology.strength_disorder": (None,),
+    "rheology.stress_correction": ("origin",),       # 2026-11-24: scaling towards the origin
+    "rheology.stress_correction_mean_fraction": (None,),
+    "initial.state_file": (None, ""),                # 2026-11-24: no spin-up state
+    "solver.substep_limit": (None, "mesh"),          # 2026-11-25: the whole-mesh limit
+}
+
+
+def absent_keys(view: dict, stored: dict | None) -> list[str]:
+    """Dotted keys of the physics ``view`` (tables of key → value) that the stored
+    configuration ``stored`` (a checkpoint's) does not have: keys added since the
+    code that wrote it."""
+    if not isinstance(stored, dict):
+        return []
+    out = []
+    for table, val in view.items():
+        if table.startswith("_"):
+            continue
+        if table not in stored:
+            out.append(table)
+        elif isinstance(val, dict) and isinstance(stored[table], dict):
+            out += [f"{table}.{k}" for k in val if k not in stored[table]]
+    return out
+
+
+def legacy_keys_check(view: dict, keys) -> list[str]:
+    """The keys among ``keys`` (dotted, absent from a checkpoint's configuration) whose
+    value in ``view`` is not a value of :data:`LEGACY_VALUES` that reproduces the code
+    from before the key existed: a resume with them would not continue the same physics."""
+    bad = []
+    for key in keys:
+        table, _, name = key.partition(".")
+        val = view.get(table, {}).get(name) if name else view.get(table)
+        if key not in LEGACY_VALUES or not any(val == v and type(val) is type(v) for v in LEGACY_VALUES[key]):
+            bad.append(f"{key} = {val!r}")
+    return bad
+
+
 ROOT = Path(__file__).resolve().parents[2]  # relative data paths of scenes are tried here too
 SCENE_DIR = ROOT / "examples"
 _MODFUNC = re.compile(r"^[A-Za-z_][\w.]*:[A-Za-z_]\w*$")
