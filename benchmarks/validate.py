@@ -120,6 +120,12 @@ PHYSICS_RUNS = {"closed_maxwell_eb": "F10-1125", "strait_maxwell_eb": "F10s-1125
                 "sensitivity_strength+50": "X10-str+50", "sensitivity_drag-50": "X10-drag-50",
                 "sensitivity_drag+50": "X10-drag+50", "sensitivity_wind-50": "X10-wind-50",
                 "sensitivity_wind+50": "X10-wind+50"}
+#: the weather ensemble of the flagship Maxwell-EB runs (--from-physics): the validation run
+#: (wind seed 2026, the scene's) and the same set-up under the winds of seeds 2027 and 2028
+#: (benchmarks/physics_experiments.py ENSEMBLES). One 28-day run is one sample of the
+#: weather: whether a metric is inside its band is read from how many members are inside.
+PHYSICS_ENSEMBLE = {"closed": ["F10-1125", "F10-1125-w2027", "F10-1125-w2028"],
+                    "strait": ["F10s-1125", "F10s-1125-w2027", "F10s-1125-w2028"]}
 RHEOLOGIES = {
     "maxwell_eb": {"label": "Maxwell-EB", "overrides": []},
     "evp": {"label": "EVP (mEVP, Hibler ellipse)",
@@ -679,6 +685,7 @@ def write_report(res: dict, md: Path, figs: dict):
                 f"{_fmt(k, r['median'][k])} ({_inside(k, r['median'][k])})" for k in TARGETS)
                 + f" | {r['remesh_events']} | {np.mean(r['mean_speed_m_s'][1:]):.2g} |")
         lines.append("")
+    lines += ensemble_lines(res.get("weather_ensemble") or {})
     mi = res.get("mesh_imprint") or {}
     if mi:
         lines += ["## Mesh imprint (docs/physics.md §3)", "",
@@ -704,6 +711,58 @@ def write_report(res: dict, md: Path, figs: dict):
     lines += ["## Where the model misses, and why", ""] + res.get("discussion", ["(not written)"]) + [""]
     md.write_text("\n".join(lines))
     return md
+
+
+def analyse_ensemble(physics: Path, days: float, buffer_m: float, basin: dict) -> dict:
+    """Per basin of :data:`PHYSICS_ENSEMBLE` whose member runs have all finished: each
+    member's window medians, and over the members the median, min, max and the number
+    inside the band of every metric (the validation run itself from ``basin``)."""
+    out = {}
+    for scene, names in PHYSICS_ENSEMBLE.items():
+        runs = [physics / n for n in names]
+        if not all((r / "summary.json").exists() for r in runs):
+            print(f"validate: weather ensemble {scene}: not every member has finished ({', '.join(names)})")
+            continue
+        members = {}
+        for n, r in zip(names, runs):
+            own = basin.get(scene, {}).get("maxwell_eb")
+            a = own if own is not None and Path(own["run_dir"]).resolve() == r.resolve() else analyse_run(r, days,
+                                                                                                         buffer_m)
+            members[n] = {"median": a["median"], "remesh_events": a["remesh_events"], "drift_km": a["drift_km"]}
+        stats = {}
+        for k, (lo, hi, _src, _n) in TARGETS.items():
+            v = np.array([np.nan if m["median"][k] is None else m["median"][k] for m in members.values()])
+            ok = np.isfinite(v)
+            some = bool(ok.any())
+            stats[k] = {"median": float(np.median(v[ok])) if some else None,
+                        "min": float(v[ok].min()) if some else None, "max": float(v[ok].max()) if some else None,
+                        "n_inside": int(np.sum(ok & (v >= lo) & (v <= hi))), "n_members": len(v)}
+        out[scene] = {"members": members, "metrics": stats}
+    return out
+
+
+def ensemble_lines(ens: dict) -> list[str]:
+    """Markdown: per basin, each member's medians and how many members are inside each band."""
+    if not ens:
+        return []
+    lines = ["## Weather ensemble of the flagship (Maxwell-EB, three months of winds)", "",
+             "The validation run and the same set-up (spin-up state, strength disorder, parameters) under the "
+             "winds of two other seeds of the wind climatology (`python benchmarks/physics_experiments.py run "
+             "F10-1125-w2027 ...`, `ENSEMBLES` there). Medians of the 3-day windows per member; the last columns give "
+             "the median over the members and how many members are inside the band.", ""]
+    for scene, e in ens.items():
+        names = list(e["members"])
+        lines += [f"**{scene} basin**", "", "| metric | observed | " + " | ".join(names)
+                  + " | median of members | members inside |", "|---|---|" + "---|" * (len(names) + 2)]
+        for k, (lo, hi, _src, _n) in TARGETS.items():
+            st = e["metrics"][k]
+            cells = [_fmt(k, e["members"][n]["median"][k]) for n in names]
+            lines.append(f"| {LABELS[k]} | {_fmt(k, lo)}–{_fmt(k, hi)} | " + " | ".join(cells)
+                         + f" | {_fmt(k, st['median'])} | {st['n_inside']} of {st['n_members']} |")
+        lines.append("| remesh events | | " + " | ".join(str(e["members"][n]["remesh_events"]) for n in names)
+                     + " | | |")
+        lines.append("")
+    return lines
 
 
 def compression_lines(res: dict, figs: dict) -> list[str]:
@@ -883,6 +942,7 @@ def main(argv=None):
     if "strait" in basin and "maxwell_eb" in basin["strait"]:
         figs.setdefault("strait", []).append(figure_rate_map(Path(basin["strait"]["maxwell_eb"]["run_dir"]), days,
                                                              args.fig_dir, "strait"))
+    ensemble = analyse_ensemble(physics, days, args.coast_buffer_km * 1e3, basin) if physics is not None else {}
     mi_json = args.fig_dir / "mesh_imprint.json"
     if mi_json.exists():
         imprint["rotation_test"] = rotation_test_summary(json.loads(mi_json.read_text()))
@@ -890,6 +950,7 @@ def main(argv=None):
            "git_commit": git_commit(), "from_physics": bool(physics), "evp_km": args.evp_km,
            "basin_days": days, "coast_buffer_km": args.coast_buffer_km,
            "basin": basin, "sensitivity": sens, "compression": comp, "mesh_imprint": imprint,
+           "weather_ensemble": ensemble,
            "targets": {k: list(v) for k, v in TARGETS.items()},
            "json": str((args.fig_dir.resolve() / "validation.json").relative_to(ROOT))
            if args.fig_dir.resolve().is_relative_to(ROOT) else str(args.fig_dir / "validation.json")}
