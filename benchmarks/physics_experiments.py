@@ -121,7 +121,17 @@ def from_spinup(name: str) -> list:
 
 
 def prepare_inputs():
-    """Write the inputs that experiments make rather than ship (BASIN_X2)."""
+    """Write the inputs that experiments make rather than ship: BASIN_X2, and the spin-up
+    state shipped until 2026-11-25 (``spinup-shipped-1123.npz``, from git history)."""
+    old_state = SPINUPS["shipped-1123"][1]
+    if not old_state.exists():
+        OUT.mkdir(parents=True, exist_ok=True)
+        blob = subprocess.run(["git", "show", f"{SHIPPED_1123_COMMIT}:data_stubs/winter_basin_spinup.npz"], cwd=ROOT,
+                              capture_output=True, check=False)
+        if blob.returncode != 0:
+            raise SystemExit(f"physics: cannot read the spin-up state of commit {SHIPPED_1123_COMMIT} from git "
+                             f"({blob.stderr.decode().strip()}); the experiments pinned to it need a git checkout")
+        old_state.write_bytes(blob.stdout)
     if not BASIN_X2.exists():
         g = json.loads((ROOT / "data_stubs" / "winter_basin_coast.geojson").read_text())
         geom = g["features"][0]["geometry"]
@@ -205,6 +215,28 @@ EXPERIMENTS["F10s-hthick-1125"] = ("strait", from_spinup("H1125"), 10e3, 28,
 # sub-step rule): the runs the validation report analyses (benchmarks/validate.py PHYSICS_RUNS)
 EXPERIMENTS["F10-1125"] = ("closed", [], 10e3, 28, "the flagship (F10 set-up), code of 2026-11-25")
 EXPERIMENTS["F10s-1125"] = ("strait", [], 10e3, 28, "the flagship strait (F10s set-up), code of 2026-11-25")
+# --- 2026-11-25: the thick-and-thin pack becomes the shipped spin-up state ---------------
+# examples/winter_basin_spinup.toml now starts from HETERO_THICKNESS, and
+# data_stubs/winter_basin_spinup.npz is its 14-day state (bit for bit spinup-H1125.npz).
+# Every experiment above that used the shipped state is pinned to the state shipped until
+# then (data_stubs/winter_basin_spinup.npz of commit SHIPPED_1123_COMMIT, extracted from git
+# by prepare_inputs), so that its name keeps meaning what its record measured.
+SHIPPED_1123_COMMIT = "ffe2d52"
+SPINUPS["shipped-1123"] = (None, OUT / "spinup-shipped-1123.npz", 10e3)
+# the flagship runs of the validation from this date (the same inputs as F10-hthick-1125 /
+# F10s-hthick-1125, which stay its Maxwell-EB runs): EVP on the same pack, and the ±50 %
+# sensitivity from it
+EXPERIMENTS["E10h"] = ("closed", from_spinup("H1125") + EVP, 10e3, 28,
+                       "EVP, closed, 10 km, from the thick-and-thin pack (the shipped state since 2026-11-25)")
+EXPERIMENTS["E10hs"] = ("strait", from_spinup("H1125") + EVP, 10e3, 28,
+                        "EVP, strait, 10 km, from the thick-and-thin pack (the shipped state since 2026-11-25)")
+for _key, _lo, _hi, _what in (("str", "rheology.strength_lab_pa=1.4e6", "rheology.strength_lab_pa=4.2e6", "strength"),
+                              ("drag", "forcing.drag.air_drag=1.0e-3", "forcing.drag.air_drag=3.0e-3", "air drag"),
+                              ("wind", "forcing.wind.wind_scale=0.5", "forcing.wind.wind_scale=1.5", "winds")):
+    EXPERIMENTS[f"X10h-{_key}-50"] = ("closed", from_spinup("H1125") + [_lo], 10e3, 28,
+                                      f"{_what} −50 %, 10 km, thick-and-thin pack")
+    EXPERIMENTS[f"X10h-{_key}+50"] = ("closed", from_spinup("H1125") + [_hi], 10e3, 28,
+                                      f"{_what} +50 %, 10 km, thick-and-thin pack")
 ENSEMBLES = {"disorder": ["W20"] + [f"W20-d{i}" for i in (1, 2, 3)],
              "weather": ["W20"] + [f"W20-w{i}" for i in (1, 2, 3)]}
 # weather ensembles of the flagship (shipped pack) and of the thick-and-thin pack, closed
@@ -228,6 +260,11 @@ for _i in (1, 2, 3):
                                  f"as W20, strength disorder of run seed {_i} (same weather)")
     EXPERIMENTS[f"W20-w{_i}"] = ("closed", [f"forcing.wind.seed={_i}"], 20e3, 28,
                                  f"as W20, weather of wind seed {_i} (same disorder)")
+
+# (the pinning announced above: every experiment so far without a state file of its own)
+for _name, (_sc, _ov, _res, _days, _what) in list(EXPERIMENTS.items()):
+    if not any(o.startswith("initial.state_file=") for o in _ov):
+        EXPERIMENTS[_name] = (_sc, from_spinup("shipped-1123") + _ov, _res, _days, _what)
 
 
 def command(scene, overrides, res, days, out) -> list:
@@ -397,6 +434,8 @@ def spinup(name="shipped", days=14):
     if name not in SPINUPS:
         raise SystemExit(f"physics: unknown spin-up {name!r}; known: {list(SPINUPS)}")
     overrides, target, res = SPINUPS[name]
+    if overrides is None:
+        raise SystemExit(f"physics: spin-up {name!r} is taken from git history (prepare_inputs), not remade")
     out = OUT / ("spinup" if name == "shipped" else f"spinup-{name}")
     cmd = [sys.executable, "-m", "lagice.cli", "run", str(ROOT / "examples" / "winter_basin_spinup.toml"), "--out",
            str(out), "--set", f"run.duration={days:g}d", "--set", f"domain.resolution_m={res:g}"]

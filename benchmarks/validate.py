@@ -112,20 +112,26 @@ SENSITIVITY = {
 #: resolution of the sensitivity runs [m]
 SENSITIVITY_RESOLUTION_M = 10e3
 #: the runs of benchmarks/physics_experiments.py that --from-physics analyses
-#: (``{evp}``: E10/E20 by --evp-km). The flagship runs are F10-1125/F10s-1125: the F10/F10s
-#: set-up re-run with the code of 2026-11-25 (FMA contraction in the explicit kernels); the
-#: records of F10/F10s (older code) are kept in docs/figures/physics_experiments.json
-PHYSICS_RUNS = {"closed_maxwell_eb": "F10-1125", "strait_maxwell_eb": "F10s-1125", "closed_evp": "E{evp}",
-                "strait_evp": "E{evp}s", "sensitivity_base": "F10-1125", "sensitivity_strength-50": "X10-str-50",
-                "sensitivity_strength+50": "X10-str+50", "sensitivity_drag-50": "X10-drag-50",
-                "sensitivity_drag+50": "X10-drag+50", "sensitivity_wind-50": "X10-wind-50",
-                "sensitivity_wind+50": "X10-wind+50"}
+#: (``{evp}``: E10/E20 by --evp-km). Since 2026-11-25 the flagship starts from the pack of
+#: thick and thin ice (examples/winter_basin_spinup.toml; data_stubs/winter_basin_spinup.npz
+#: is the same state as the experiments' spinup-H1125.npz): its Maxwell-EB runs are
+#: F10-hthick-1125 / F10s-hthick-1125, EVP E10h / E10hs, the ±50 % runs X10h-*. The runs of
+#: the pack shipped before (F10-1125, E10, X10-*...) keep their records in
+#: docs/figures/physics_experiments.json
+PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-1125", "strait_maxwell_eb": "F10s-hthick-1125",
+                "closed_evp": "E{evp}h", "strait_evp": "E{evp}hs", "sensitivity_base": "F10-hthick-1125",
+                "sensitivity_strength-50": "X10h-str-50", "sensitivity_strength+50": "X10h-str+50",
+                "sensitivity_drag-50": "X10h-drag-50", "sensitivity_drag+50": "X10h-drag+50",
+                "sensitivity_wind-50": "X10h-wind-50", "sensitivity_wind+50": "X10h-wind+50"}
 #: the weather ensemble of the flagship Maxwell-EB runs (--from-physics): the validation run
 #: (wind seed 2026, the scene's) and the same set-up under the winds of seeds 2027 and 2028
 #: (benchmarks/physics_experiments.py ENSEMBLES). One 28-day run is one sample of the
 #: weather: whether a metric is inside its band is read from how many members are inside.
-PHYSICS_ENSEMBLE = {"closed": ["F10-1125", "F10-1125-w2027", "F10-1125-w2028"],
-                    "strait": ["F10s-1125", "F10s-1125-w2027", "F10s-1125-w2028"]}
+#: The pack shipped before 2026-11-25 (F10-1125...) is the comparison.
+PHYSICS_ENSEMBLE = {"closed": ["F10-hthick-1125", "F10-hthick-1125-w2027", "F10-hthick-1125-w2028"],
+                    "strait": ["F10s-hthick-1125", "F10s-hthick-1125-w2027", "F10s-hthick-1125-w2028"],
+                    "closed, pack shipped before 2026-11-25": ["F10-1125", "F10-1125-w2027", "F10-1125-w2028"],
+                    "strait, pack shipped before 2026-11-25": ["F10s-1125", "F10s-1125-w2027", "F10s-1125-w2028"]}
 RHEOLOGIES = {
     "maxwell_eb": {"label": "Maxwell-EB", "overrides": []},
     "evp": {"label": "EVP (mEVP, Hibler ellipse)",
@@ -748,11 +754,12 @@ def ensemble_lines(ens: dict) -> list[str]:
     lines = ["## Weather ensemble of the flagship (Maxwell-EB, three months of winds)", "",
              "The validation run and the same set-up (spin-up state, strength disorder, parameters) under the "
              "winds of two other seeds of the wind climatology (`python benchmarks/physics_experiments.py run "
-             "F10-1125-w2027 ...`, `ENSEMBLES` there). Medians of the 3-day windows per member; the last columns give "
+             + " ".join(n for e in ens.values() for n in list(e["members"])[1:]) + "`; `PHYSICS_ENSEMBLE` of "
+             "`benchmarks/validate.py`). Medians of the 3-day windows per member; the last columns give "
              "the median over the members and how many members are inside the band.", ""]
     for scene, e in ens.items():
         names = list(e["members"])
-        lines += [f"**{scene} basin**", "", "| metric | observed | " + " | ".join(names)
+        lines += [f"**{scene}**", "", "| metric | observed | " + " | ".join(names)
                   + " | median of members | members inside |", "|---|---|" + "---|" * (len(names) + 2)]
         for k, (lo, hi, _src, _n) in TARGETS.items():
             st = e["metrics"][k]

@@ -53,6 +53,35 @@ def test_shipped_spinup_is_heterogeneous_and_damaged():
     assert st.damage.std() > 0.05
 
 
+def test_shipped_spinup_is_a_pack_of_thick_and_thin_ice():
+    """Since 2026-11-25 the spin-up starts from thickness waves of 120-370 km (the
+    variability of winter Arctic ice, Laxon et al. 2013): its state keeps a thickness
+    standard deviation near 0.5 m, a 5th percentile below 1 m and a 95th above 2.3 m (the
+    pack shipped before: 0.22 m, 1.47 m, 1.97 m), with the
+    thick and thin ice in regions hundreds of km wide (the field is smooth on the 10 km
+    elements, not noise), and the scene's initial thickness takes it."""
+    from lagice.scenes.builder import build_model
+    from lagice.scenes.config import load_scene
+
+    z = np.load(WINTER_BASIN)
+    h, x, y = z["thickness"], z["centroid_x_m"], z["centroid_y_m"]
+    assert 0.4 < h.std() < 0.7 and np.quantile(h, 0.05) < 1.0 and np.quantile(h, 0.95) > 2.3
+    # smooth at the element scale: neighbours within 20 km differ far less than random pairs
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(np.column_stack([x, y])).query_pairs(20e3, output_type="ndarray")
+    near = np.abs(h[pairs[:, 0]] - h[pairs[:, 1]]).mean()
+    rng = np.random.default_rng(0)
+    far = np.abs(h[rng.integers(0, h.size, 20000)] - h[rng.integers(0, h.size, 20000)]).mean()
+    assert near < 0.35 * far
+    st = build_model(load_scene("winter_basin_pack", {"domain.resolution_m": 60e3, "run.duration": "1h",
+                                                      "solver.dt": "1h"})).state
+    c = st.mesh.centroids()
+    np.testing.assert_allclose(st.thickness, field_from_spinup(WINTER_BASIN, "thickness", c[:, 0], c[:, 1]),
+                               rtol=1e-6)
+    assert st.thickness.std() > 0.4
+
+
 @pytest.mark.slow
 def test_short_coarse_run_breaks_the_pack_in_the_interior(tmp_path):
     """The flagship physics (winter_basin_spinup: winter_basin_pack from pristine ice) at
