@@ -255,6 +255,14 @@ for _seed in (2027, 2028):
 for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     ENSEMBLES[f"flagship, {_basin}"] = [f"{_p}-1125"] + [f"{_p}-1125-w{s}" for s in (2027, 2028)]
     ENSEMBLES[f"thick-and-thin, {_basin}"] = [f"{_p}-hthick-1125"] + [f"{_p}-hthick-1125-w{s}" for s in (2027, 2028)]
+# diagnostics of the calm month (wind seed 2028, where both packs lock): what holds the
+# thick-and-thin pack still, the healing between storms or the strength?
+EXPERIMENTS["F10-hthick-1125-w2028-noheal"] = ("closed", from_spinup("H1125") + ["forcing.wind.seed=2028",
+                                                                                 "healing.law=none"], 10e3, 28,
+                                               "F10-hthick-1125-w2028 without healing (diagnostic)")
+EXPERIMENTS["F10-hthick-1125-w2028-str-50"] = ("closed", from_spinup("H1125") + ["forcing.wind.seed=2028",
+                                                                                 "rheology.strength_lab_pa=1.4e6"],
+                                               10e3, 28, "F10-hthick-1125-w2028 with strength −50 % (diagnostic)")
 for _i in (1, 2, 3):
     EXPERIMENTS[f"W20-d{_i}"] = ("closed", ["forcing.wind.seed=2026", f"run.seed={_i}"], 20e3, 28,
                                  f"as W20, strength disorder of run seed {_i} (same weather)")
