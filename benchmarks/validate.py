@@ -101,7 +101,7 @@ LABELS = {
 #: Maxwell-EB sensitivity runs (``--sensitivity``): the closed basin with one parameter
 #: changed, reported apart from the headline and not used to pick any value
 SENSITIVITY = {
-    "base": ("closed", [], "recommended set at 10 km (the flagship F10, the reference of the ±50 % runs)"),
+    "base": ("closed", [], "recommended set at 10 km (the flagship, F10-hthick-1125: the reference of the ±50 % runs)"),
     "strength-50": ("closed", ["rheology.strength_lab_pa=1.4e6"], "strength −50 % (C_lab 1.4 MPa)"),
     "strength+50": ("closed", ["rheology.strength_lab_pa=4.2e6"], "strength +50 % (C_lab 4.2 MPa)"),
     "drag-50": ("closed", ["forcing.drag.air_drag=1.0e-3"], "air drag −50 % (1.0e-3)"),
@@ -574,8 +574,16 @@ def _fmt(k, v):
     if k == "localisation_half_shear_area_fraction":
         return f"{100 * v:.1f} %"
     if k == "mean_total_deformation_rate_per_day":
-        return f"{v:.2g}"
+        return f"{v:.3g}"  # 3 digits: 0.00997 is outside a band that starts at 0.01
     return f"{v:.2f}"
+
+
+def _fmt3(k, v):
+    """:func:`_fmt` with three significant digits (values near a band edge: R² 0.728)."""
+    if v is None or not np.isfinite(v) or k in ("localisation_half_shear_area_fraction",
+                                                 "mean_total_deformation_rate_per_day"):
+        return _fmt(k, v)
+    return f"{v:.3g}"
 
 
 def _res_km(r: dict) -> str:
@@ -763,9 +771,11 @@ def ensemble_lines(ens: dict) -> list[str]:
                   + " | median of members | members inside |", "|---|---|" + "---|" * (len(names) + 2)]
         for k, (lo, hi, _src, _n) in TARGETS.items():
             st = e["metrics"][k]
-            cells = [_fmt(k, e["members"][n]["median"][k]) for n in names]
+            cells = [_fmt3(k, e["members"][n]["median"][k]) for n in names]
+            med = st["median"]
+            mark = "" if med is None else (" ✓" if lo <= med <= hi else " ✗")
             lines.append(f"| {LABELS[k]} | {_fmt(k, lo)}–{_fmt(k, hi)} | " + " | ".join(cells)
-                         + f" | {_fmt(k, st['median'])} | {st['n_inside']} of {st['n_members']} |")
+                         + f" | {_fmt3(k, med)}{mark} | {st['n_inside']} of {st['n_members']} |")
         lines.append("| remesh events | | " + " | ".join(str(e["members"][n]["remesh_events"]) for n in names)
                      + " | | |")
         lines.append("")
