@@ -45,6 +45,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 ROTATIONS = (0.0, 15.0, 30.0)
 VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.mesh_algorithm=5"],
+            # the loading rate (the scene pushes at 1 mm/s): half and twice as fast; the run
+            # length follows, so that every variant reaches the same macroscopic strain
+            "slow": ["boundary.top.v=-5e-4"], "fast": ["boundary.top.v=-2e-3"],
             "meanstress": ["rheology.stress_correction=mean_stress"],
             **{f"mean{int(round(100 * t)):03d}": ["rheology.stress_correction=mean_stress",
                                                   f"rheology.stress_correction_mean_fraction={t}"]

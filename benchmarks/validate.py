@@ -323,7 +323,7 @@ def run_compression(out: Path, n_across: int, max_strain: float, seed: int = 0, 
 
     cfg = scene_config("uniaxial_compression")
     width, length = cfg["domain"]["width_m"], cfg["domain"]["height_m"]
-    push = -cfg["boundary"]["top"]["v"]
+    push = -float((overrides or {}).get("boundary.top.v", cfg["boundary"]["top"]["v"]))  # a variant may change it
     dx = width / n_across
     dt = dx / cfg["rheology"]["shear_wave_speed"]  # td
     block = n_across  # elastic shear wave across the width: (L/2)/(cs Δt) = N steps
