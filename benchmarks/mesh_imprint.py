@@ -48,6 +48,8 @@ VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.me
             # the loading rate (the scene pushes at 1 mm/s): half and twice as fast; the run
             # length follows, so that every variant reaches the same macroscopic strain
             "slow": ["boundary.top.v=-5e-4"], "fast": ["boundary.top.v=-2e-3"],
+            # lateral confinement: the sides (tag "free") held in x
+            "confined": ["boundary.free.u=0.0"],
             "meanstress": ["rheology.stress_correction=mean_stress"],
             **{f"mean{int(round(100 * t)):03d}": ["rheology.stress_correction=mean_stress",
                                                   f"rheology.stress_correction_mean_fraction={t}"]
@@ -251,8 +253,11 @@ def main(argv=None):
             for v in args.variants:
                 r = run_compression(out, n, v, args.max_strain)
                 im = r["imprint"]["rate_rupture"]
+                if not r["ruptured"]:
+                    print(f"  compression N={n} {v:10s}: NO RUPTURE (no stress drop, no damage) up to strain "
+                          f"{args.max_strain:g}; peak {r['peak_stress_kpa']:.0f} kPa", flush=True)
                 print(f"  compression N={n} {v:10s}: fault angles (rate) "
-                      f"{[round(a, 1) for a in r['fault_angles_rate_deg']]} (damage) "
+                      f"{[round(a, 1) for a in (r['fault_angles_rate_deg'] or [])]} (damage) "
                       f"{[round(a, 1) for a in (r['fault_angles_damage_deg'] or [])]} MC "
                       f"{r['mohr_coulomb_angle_deg']:.1f}; imprint index (rate) {im['index']:.3f}; peak "
                       f"{r['peak_stress_kpa']:.0f} kPa; wall {r['wall_s']:.0f} s", flush=True)

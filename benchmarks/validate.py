@@ -379,6 +379,9 @@ def analyse_compression(path: Path) -> dict:
     d_before = z["damage_block_end"][k_rup - 1] if k_rup > 0 else np.zeros(tri.shape[0])
     d_gain = np.clip(z["damage_block_end"][k_rup].astype(float) - d_before, 0.0, None)  # healing lowers d
     f_dmg = fault_orientations(centroids, d_gain * area, 2 * dx) if d_gain.sum() > 0 else None
+    # no stress drop and no damage: the plate never failed, and the "faults" of the rate field
+    # would be its elastic pattern; no fault angles then
+    ruptured = bool(drop[k_rup] > 0.0 and np.any(z["damage_block_end"][-1] > 0.0))
     # intermittency: skewness of the macroscopic stress increments
     inc = np.diff(stress) / dt
     mc = mohr_coulomb_fault_angle_deg(float(z["friction"]))
@@ -387,9 +390,9 @@ def analyse_compression(path: Path) -> dict:
         "wall_s": float(z["wall_s"]), "peak_stress_kpa": float(stress[k_peak] / 1e3),
         "peak_strain": float((k_peak + 1) * dt * float(z["push_speed_m_s"]) / float(z["length_m"])),
         "rupture_block": k_rup, "rupture_time_s": float((k_rup + 1) * block * dt),
-        "rupture_drop_kpa": float(drop[k_rup] / 1e3),
+        "rupture_drop_kpa": float(drop[k_rup] / 1e3), "ruptured": ruptured,
         "mohr_coulomb_angle_deg": mc,
-        "fault_angles_rate_deg": angle_to_axis_deg(f_rate.angles_deg).tolist(),
+        "fault_angles_rate_deg": angle_to_axis_deg(f_rate.angles_deg).tolist() if ruptured else None,
         "fault_directions_rate_deg": f_rate.angles_deg.tolist(), "fault_scores_rate": f_rate.scores.tolist(),
         "fault_angles_damage_deg": None if f_dmg is None else angle_to_axis_deg(f_dmg.angles_deg).tolist(),
         "fault_directions_damage_deg": None if f_dmg is None else f_dmg.angles_deg.tolist(),
@@ -540,7 +543,8 @@ def figure_compression(c: dict, fig_dir: Path) -> Path:
     ax3.set_ylim(nodes[:, 1].min() / 1e3, nodes[:, 1].max() / 1e3)
     ax3.set_aspect("equal")
     ax3.set_title(f"log10 ε̇tot over the rupture block\nfaults (dashed) "
-                  f"{', '.join(f'{a:.1f}°' for a in c['fault_angles_rate_deg'])} from the y axis,\n"
+                  f"{', '.join(f'{a:.1f}°' for a in (c['fault_angles_rate_deg'] or [])) or 'none (no rupture)'}"
+                  f" from the y axis,\n"
                   f"Mohr–Coulomb {c['mohr_coulomb_angle_deg']:.1f}°", fontsize=9)
     ax3.set_xlabel("x (km)")
     ax3.set_ylabel("y (km), compression along y")
@@ -793,7 +797,7 @@ def compression_lines(res: dict, figs: dict) -> list[str]:
               f"{c['rupture_drop_kpa']:.1f} kPa at t = {c['rupture_time_s'] / 3600:.2f} h.", "",
               "| metric | expected | lagice | verdict |", "|---|---|---|---|"]
     mc = c["mohr_coulomb_angle_deg"]
-    ang = c["fault_angles_rate_deg"]
+    ang = c["fault_angles_rate_deg"] or []  # None: the plate did not rupture
     angd = c["fault_angles_damage_deg"] or []
     lines.append(f"| fault angle to the compression axis (active faults: ε̇tot over the rupture block) | "
                  f"Mohr–Coulomb 45° − atan(μ)/2 = {mc:.1f}° (μ = 0.7) | "
