@@ -244,7 +244,10 @@ ENSEMBLES = {"disorder": ["W20"] + [f"W20-d{i}" for i in (1, 2, 3)],
 # scene's own), 2027 and 2028; spin-up states and strength disorder unchanged. One 28-day
 # run cannot decide whether a set-up is inside a band (docs/physics.md §4); three can say
 # how often it is.
-for _seed in (2027, 2028):
+#: the wind seeds of the weather ensembles besides the scene's own (2026); 2029 added later
+#: the same day as a fourth month
+ENSEMBLE_SEEDS = (2027, 2028, 2029)
+for _seed in ENSEMBLE_SEEDS:
     _w = [f"forcing.wind.seed={_seed}"]
     EXPERIMENTS[f"F10-1125-w{_seed}"] = ("closed", _w, 10e3, 28, f"F10-1125, the weather of wind seed {_seed}")
     EXPERIMENTS[f"F10s-1125-w{_seed}"] = ("strait", _w, 10e3, 28, f"F10s-1125, the weather of wind seed {_seed}")
@@ -253,8 +256,8 @@ for _seed in (2027, 2028):
     EXPERIMENTS[f"F10s-hthick-1125-w{_seed}"] = ("strait", from_spinup("H1125") + _w, 10e3, 28,
                                                  f"F10s-hthick-1125, the weather of wind seed {_seed}")
 for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
-    ENSEMBLES[f"flagship, {_basin}"] = [f"{_p}-1125"] + [f"{_p}-1125-w{s}" for s in (2027, 2028)]
-    ENSEMBLES[f"thick-and-thin, {_basin}"] = [f"{_p}-hthick-1125"] + [f"{_p}-hthick-1125-w{s}" for s in (2027, 2028)]
+    ENSEMBLES[f"flagship, {_basin}"] = [f"{_p}-1125"] + [f"{_p}-1125-w{s}" for s in ENSEMBLE_SEEDS]
+    ENSEMBLES[f"thick-and-thin, {_basin}"] = [f"{_p}-hthick-1125"] + [f"{_p}-hthick-1125-w{s}" for s in ENSEMBLE_SEEDS]
 # diagnostics of the calm month (wind seed 2028, where both packs lock): what holds the
 # thick-and-thin pack still, the healing between storms or the strength?
 EXPERIMENTS["F10-hthick-1125-w2028-noheal"] = ("closed", from_spinup("H1125") + ["forcing.wind.seed=2028",

@@ -124,14 +124,15 @@ PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-1125", "strait_maxwell_eb": "F1
                 "sensitivity_drag-50": "X10h-drag-50", "sensitivity_drag+50": "X10h-drag+50",
                 "sensitivity_wind-50": "X10h-wind-50", "sensitivity_wind+50": "X10h-wind+50"}
 #: the weather ensemble of the flagship Maxwell-EB runs (--from-physics): the validation run
-#: (wind seed 2026, the scene's) and the same set-up under the winds of seeds 2027 and 2028
+#: (wind seed 2026, the scene's) and the same set-up under the winds of seeds 2027-2029
 #: (benchmarks/physics_experiments.py ENSEMBLES). One 28-day run is one sample of the
 #: weather: whether a metric is inside its band is read from how many members are inside.
 #: The pack shipped before 2026-11-25 (F10-1125...) is the comparison.
-PHYSICS_ENSEMBLE = {"closed": ["F10-hthick-1125", "F10-hthick-1125-w2027", "F10-hthick-1125-w2028"],
-                    "strait": ["F10s-hthick-1125", "F10s-hthick-1125-w2027", "F10s-hthick-1125-w2028"],
-                    "closed, pack shipped before 2026-11-25": ["F10-1125", "F10-1125-w2027", "F10-1125-w2028"],
-                    "strait, pack shipped before 2026-11-25": ["F10s-1125", "F10s-1125-w2027", "F10s-1125-w2028"]}
+PHYSICS_ENSEMBLE = {
+    "closed": ["F10-hthick-1125"] + [f"F10-hthick-1125-w{y}" for y in (2027, 2028, 2029)],
+    "strait": ["F10s-hthick-1125"] + [f"F10s-hthick-1125-w{y}" for y in (2027, 2028, 2029)],
+    "closed, pack shipped before 2026-11-25": ["F10-1125"] + [f"F10-1125-w{y}" for y in (2027, 2028, 2029)],
+    "strait, pack shipped before 2026-11-25": ["F10s-1125"] + [f"F10s-1125-w{y}" for y in (2027, 2028, 2029)]}
 RHEOLOGIES = {
     "maxwell_eb": {"label": "Maxwell-EB", "overrides": []},
     "evp": {"label": "EVP (mEVP, Hibler ellipse)",
@@ -763,9 +764,9 @@ def ensemble_lines(ens: dict) -> list[str]:
     """Markdown: per basin, each member's medians and how many members are inside each band."""
     if not ens:
         return []
-    lines = ["## Weather ensemble of the flagship (Maxwell-EB, three months of winds)", "",
+    lines = ["## Weather ensemble of the flagship (Maxwell-EB, four months of winds)", "",
              "The validation run and the same set-up (spin-up state, strength disorder, parameters) under the "
-             "winds of two other seeds of the wind climatology (`python benchmarks/physics_experiments.py run "
+             "winds of three other seeds of the wind climatology (`python benchmarks/physics_experiments.py run "
              + " ".join(n for e in ens.values() for n in list(e["members"])[1:]) + "`; `PHYSICS_ENSEMBLE` of "
              "`benchmarks/validate.py`). Medians of the 3-day windows per member; the last columns give "
              "the median over the members and how many members are inside the band.", ""]
