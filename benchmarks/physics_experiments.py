@@ -239,13 +239,13 @@ for _key, _lo, _hi, _what in (("str", "rheology.strength_lab_pa=1.4e6", "rheolog
                                       f"{_what} +50 %, 10 km, thick-and-thin pack")
 ENSEMBLES = {"disorder": ["W20"] + [f"W20-d{i}" for i in (1, 2, 3)],
              "weather": ["W20"] + [f"W20-w{i}" for i in (1, 2, 3)]}
-# weather ensembles of the flagship (shipped pack) and of the thick-and-thin pack, closed
-# and strait, with the code of 2026-11-25 and the default sub-step rule: wind seeds 2026 (the
-# scene's own), 2027 and 2028; spin-up states and strength disorder unchanged. One 28-day
-# run cannot decide whether a set-up is inside a band (docs/physics.md §4); three can say
-# how often it is.
-#: the wind seeds of the weather ensembles besides the scene's own (2026); 2029 added later
-#: the same day as a fourth month
+# weather ensembles of the pack shipped before 2026-11-25 and of the thick-and-thin pack,
+# closed and strait, with the code of 2026-11-25 and the default sub-step rule: the scene's
+# own wind seed (2026) and ENSEMBLE_SEEDS; spin-up states and strength disorder unchanged.
+# One 28-day run cannot decide whether a set-up is inside a band (docs/physics.md §4); a
+# few months can say how often it is.
+#: the wind seeds of the weather ensembles besides the scene's own (2026): the next seeds in
+#: order (2029 added later the same day as a fourth month)
 ENSEMBLE_SEEDS = (2027, 2028, 2029)
 for _seed in ENSEMBLE_SEEDS:
     _w = [f"forcing.wind.seed={_seed}"]
