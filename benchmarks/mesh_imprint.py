@@ -51,6 +51,8 @@ VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.me
             # lateral confinement: the sides (tag "free") held in x
             "confined": ["boundary.free.u=0.0"],
             "meanstress": ["rheology.stress_correction=mean_stress"],
+            # the associated (normal) return: the inelastic strain normal to the envelope
+            "associated": ["rheology.stress_correction=associated"],
             **{f"mean{int(round(100 * t)):03d}": ["rheology.stress_correction=mean_stress",
                                                   f"rheology.stress_correction_mean_fraction={t}"]
                for t in (0.25, 0.5, 0.75)}}

@@ -266,6 +266,48 @@ EXPERIMENTS["F10-hthick-1125-w2028-noheal"] = ("closed", from_spinup("H1125") + 
 EXPERIMENTS["F10-hthick-1125-w2028-str-50"] = ("closed", from_spinup("H1125") + ["forcing.wind.seed=2028",
                                                                                  "rheology.strength_lab_pa=1.4e6"],
                                                10e3, 28, "F10-hthick-1125-w2028 with strength −50 % (diagnostic)")
+# the most promising lead of §4 (compliance healing, K = 50: the most damaged ice the model
+# makes heals fully in T_h) on the thick-and-thin pack, over the same four months: does it
+# unlock the calm months (seeds 2028, 2029)? Its own spin-up, made with the same healing.
+# The rule for adopting it, written before the runs: the median rate of both calm months
+# rises at least ×3 in both basins, and the four-month medians put no fewer bands inside
+# than the linear healing's (3 closed, 2 strait).
+SPINUPS["H1125-K50"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + COMPLIANCE50,
+                        OUT / "spinup-H1125-K50.npz", 10e3)
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    _k = COMPLIANCE50 + from_spinup("H1125-K50")
+    EXPERIMENTS[f"{_p}-hthick-K50"] = (_basin, _k, 10e3, 28,
+                                       f"{_p}-hthick-1125 with compliance healing K = 50, from its own spin-up")
+    for _seed in ENSEMBLE_SEEDS:
+        EXPERIMENTS[f"{_p}-hthick-K50-w{_seed}"] = (_basin, _k + [f"forcing.wind.seed={_seed}"], 10e3, 28,
+                                                    f"{_p}-hthick-K50, the weather of wind seed {_seed}")
+    ENSEMBLES[f"thick-and-thin K50, {_basin}"] = [f"{_p}-hthick-K50"] + [f"{_p}-hthick-K50-w{s}"
+                                                                          for s in ENSEMBLE_SEEDS]
+# the third lead for the calm months (docs/physics.md §5): the basin's width, i.e. the fetch
+# over which a closed basin integrates the wind stress (the Arctic pack is 2-3 times wider
+# than the 1000 km basin). The calm month (wind seed 2028) of the thick-and-thin pack with
+# linear healing, in the basin twice as wide, from its own 10 km spin-up of the current
+# spin-up scene (thick-and-thin) in that basin.
+# (the same thickness waves; the east-west trend halved, so that it still spans ±0.25 m
+# from coast to coast and the thickness stays positive, 0.15-3.0 m: the flagship's trend
+# over 1000 km of radius would give -0.09 m, which the scene refuses)
+HETERO_THICKNESS_X2 = HETERO_THICKNESS.replace("1.6 - 0.5e-6*x", "1.6 - 0.25e-6*x")
+assert HETERO_THICKNESS_X2 != HETERO_THICKNESS
+SPINUPS["H10x2"] = ([f"initial.thickness_m={HETERO_THICKNESS_X2}", f"domain.file={BASIN_X2}"],
+                    OUT / "spinup-H10x2.npz", 10e3)
+EXPERIMENTS["F10x2-hthick-w2028"] = ("closed", [f"domain.file={BASIN_X2}", "forcing.wind.seed=2028"]
+                                     + from_spinup("H10x2"), 10e3, 28,
+                                     "F10-hthick-1125-w2028 (the calm month) in the basin twice as wide")
+# the ±50 % sensitivity of the K = 50 set-up (closed basin, validation month), and K itself
+# ±50 % (K is a calibration)
+for _key, _lo, _hi, _what in (("str", "rheology.strength_lab_pa=1.4e6", "rheology.strength_lab_pa=4.2e6", "strength"),
+                              ("drag", "forcing.drag.air_drag=1.0e-3", "forcing.drag.air_drag=3.0e-3", "air drag"),
+                              ("wind", "forcing.wind.wind_scale=0.5", "forcing.wind.wind_scale=1.5", "winds"),
+                              ("K", "healing.params.compliance_factor=25", "healing.params.compliance_factor=75",
+                               "compliance factor K")):
+    _k = COMPLIANCE50[:1] + ([] if _key == "K" else COMPLIANCE50[1:]) + from_spinup("H1125-K50")
+    EXPERIMENTS[f"X10k-{_key}-50"] = ("closed", _k + [_lo], 10e3, 28, f"{_what} −50 %, 10 km, F10-hthick-K50")
+    EXPERIMENTS[f"X10k-{_key}+50"] = ("closed", _k + [_hi], 10e3, 28, f"{_what} +50 %, 10 km, F10-hthick-K50")
 for _i in (1, 2, 3):
     EXPERIMENTS[f"W20-d{_i}"] = ("closed", ["forcing.wind.seed=2026", f"run.seed={_i}"], 20e3, 28,
                                  f"as W20, strength disorder of run seed {_i} (same weather)")

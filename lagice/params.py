@@ -17,7 +17,7 @@ OMEGA_EARTH = 7.2921e-5  # rad s-1
 
 
 #: stress-correction paths of :class:`MaxwellEBParams` (``rheology.stress_correction``)
-STRESS_CORRECTIONS = ("origin", "mean_stress")
+STRESS_CORRECTIONS = ("origin", "mean_stress", "associated")
 
 
 @dataclass(frozen=True)
@@ -40,7 +40,8 @@ class MaxwellEBParams:
             ``"origin"`` (Dansereau et al. 2016, neXtSIM: the whole tensor scaled towards 0)
             or ``"mean_stress"`` (towards θ times the mean normal stress; θ = 1: only the
             deviatoric part scaled, the mean kept; implicit solver only; docs/physics.md,
-            compression test)
+            compression test) or ``"associated"`` (along K n, n the envelope's normal: the
+            return of an associated plasticity; implicit solver only)
         stress_correction_mean_fraction: θ ∈ (0, 1] of ``"mean_stress"`` (None: 1) [-]
     """
 
@@ -88,7 +89,7 @@ class MaxwellEBParams:
     @property
     def mean_fraction(self) -> float:
         """θ of the damage stress correction: 0 for the origin path (Dansereau et al. 2016)."""
-        if self.stress_correction == "origin":
+        if self.stress_correction in ("origin", "associated"):
             return 0.0
         return 1.0 if self.stress_correction_mean_fraction is None else float(self.stress_correction_mean_fraction)
 

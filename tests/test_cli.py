@@ -44,6 +44,10 @@ def test_cli_bad_override_names_key(tmp_path):
     assert r.returncode == 2 and "expected table.key=value" in r.stderr
     r = run_cli("run", "no_such_scene")
     assert r.returncode == 2 and "unknown scene 'no_such_scene'" in r.stderr
+    # the same key twice with different values: the first would be silently ignored
+    r = run_cli("run", "uniaxial_compression", "--out", str(tmp_path), "--set", "run.seed=3", "--set", "run.seed=4")
+    assert r.returncode == 2
+    assert "--set run.seed is given twice (run.seed=3, then run.seed=4)" in r.stderr
     assert not any(tmp_path.iterdir())
 
 

@@ -11,6 +11,7 @@ from lagice.rheology import (
     dcrit,
     draw_cohesion,
     envelope,
+    plane_stress_matrix,
     principal_stresses,
     relaxation_time,
     young_modulus,
@@ -163,6 +164,61 @@ def test_mean_stress_correction_keeps_the_mean_and_lands_on_the_envelope(rng):
     np.testing.assert_allclose(dcs[1.0], r_env / r, rtol=1e-9)
     # keeping more of the (compressive) mean costs less damage
     assert np.all(dcs[0.0] < dcs[0.5]) and np.all(dcs[0.5] < dcs[1.0])
+
+
+def test_associated_correction_returns_along_the_envelope_normal(rng):
+    """rheology.stress_correction = "associated": with dt = td a super-critical stress lands
+    on the envelope, its principal axes kept, and the correction σ − σ' is parallel (in
+    principal axes) to K n, n the normal of the branch it was past: (q, −1) for the
+    Mohr–Coulomb branch, (1, 0) for the tensile one. The inelastic strain K⁻¹(σ − σ') is
+    then normal to the envelope, so its dilatancy is that of associated flow: in uniaxial
+    compression the origin path compacts (ε1/ε2 = −ν) and this one dilates."""
+    C, mu, nu = 30e3, 0.7, 0.3
+    q, sc, st = envelope(C, mu)
+    K = plane_stress_matrix(nu)
+    rh = MaxwellEB(cohesion_min_pa=C, cohesion_max_pa=C, friction=mu, poisson=nu, stress_correction="associated")
+    assert rh.params.mean_fraction == 0.0
+    n = 400
+    # past the Mohr-Coulomb branch (compressive mean) and past the tensile cut-off (a
+    # tensile mean below σT; beyond it, near isotropic tension, the path would cross the
+    # isotropic axis and the origin path acts, as for "mean_stress")
+    u = rng.uniform(0.7, 0.98, n)
+    m = np.concatenate([-rng.uniform(0.0, 2.0, n) * sc, u * st])
+    r = np.concatenate([(sc - (q - 1.0) * m[:n]) / (q + 1.0) * rng.uniform(1.02, 1.5, n),
+                        (1.0 - u) * rng.uniform(1.05, 1.5, n) * st])
+    # each past one branch only: the first group below σT, the second inside Mohr-Coulomb
+    keep = np.where(np.arange(2 * n) < n, m + r < st, (q - 1.0) * m + (q + 1.0) * r < sc)
+    mc = (np.arange(2 * n) < n)[keep]
+    m, r = m[keep], r[keep]
+    assert mc.sum() > 100 and (~mc).sum() > 100
+    angle = rng.uniform(0, np.pi, m.size)
+    sig = rotate(m + r, m - r, angle)
+    s = sig.copy()
+    d = np.zeros(m.size)
+    dc = rh.damage_update(s, d, np.full(m.size, C), 1.0, np.ones(m.size), np.zeros(m.size))
+    np.testing.assert_allclose(dcrit(s, C, mu), 1.0, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(1.0 - d, dc, rtol=1e-12)
+    s1, s2 = principal_stresses(s)
+    delta = np.column_stack([m + r - s1, m - r - s2])  # the correction in principal axes
+    for rows, normal in ((mc, np.array([q, -1.0])), (~mc, np.array([1.0, 0.0]))):
+        kn = K[:2, :2] @ normal
+        cross = delta[rows, 0] * kn[1] - delta[rows, 1] * kn[0]
+        np.testing.assert_allclose(cross, 0.0, atol=1e-9 * sc)
+        assert np.all(delta[rows] @ kn > 0.0)
+    np.testing.assert_allclose(q * s1[mc] - s2[mc], sc, rtol=1e-9)
+    np.testing.assert_allclose(s1[~mc], st, rtol=1e-9)
+    # the principal axes are kept
+    s_back = rotate(s1, s2, angle)
+    np.testing.assert_allclose(s, s_back, atol=1e-9 * sc)
+    # uniaxial compression along y: the inelastic strain of the origin path is ∝ K⁻¹σ
+    # (lateral/axial = −ν, compaction); that of this path is ∝ n (dilation, sin ψ = sin φ)
+    u = np.array([[0.0, -1.2 * sc, 0.0]])
+    for kw, ratio in (({}, -nu), ({"stress_correction": "associated"}, -q)):
+        rh2 = MaxwellEB(cohesion_min_pa=C, cohesion_max_pa=C, friction=mu, poisson=nu, **kw)
+        s = u.copy()
+        rh2.damage_update(s, np.zeros(1), np.full(1, C), 1.0, np.ones(1), np.zeros(1))
+        de = np.linalg.solve(K[:2, :2], (u - s)[0, :2])
+        assert de[0] / de[1] == pytest.approx(ratio, rel=1e-9)
 
 
 def test_mean_stress_correction_falls_back_to_the_origin_beyond_the_tensile_strength():

@@ -230,8 +230,8 @@ def _cli_overrides(overrides) -> dict:
         return {}
     if isinstance(overrides, dict):
         return dict(overrides)
-    from ..scenes.config import _split
-    return dict(_split(s) for s in overrides)
+    from ..scenes.config import split_overrides
+    return dict(split_overrides(overrides))
 
 
 def _resolve_base(base: str, root: Path, source: str) -> str:

@@ -164,9 +164,45 @@ def _dcrit_towards(sxx, syy, sxy, cohesion, q, denom, theta):
     return f
 
 
+@njit(cache=True, inline="always")
+def _dcrit_associated(sxx, syy, sxy, cohesion, q, denom, nu):
+    """The associated (normal) path: ``(f, p)`` such that σ' = P + f (σ − P), P = p I, lies on
+    the envelope and σ − σ' is parallel to K n, n the outward normal of the envelope branch
+    the stress is past (K of :func:`plane_stress_matrix`). That is the return of an associated
+    plasticity in the metric of the elastic energy: the inelastic strain rate it implies is
+    normal to the envelope (docs/physics.md §4, compression test).
+
+    In principal axes σ = (m + r, m − r). Mohr–Coulomb branch (q σ1 − σ2 = σc): n = (q, −1),
+    K n ∝ (c + 1, c − 1) with c = (q − 1)(1 + ν)/((q + 1)(1 − ν)), so the path meets the
+    isotropic axis at p = m − c r, and f = (σc − (q − 1) p)/((q − 1)(m − p) + (q + 1) r).
+    Tensile branch (σ1 = σT): n = (1, 0), c = (1 + ν)/(1 − ν), f = (σT − p)/(m − p + r).
+    Returns f = −1 where neither branch gives a point of the envelope (the corner, or r = 0):
+    the caller then corrects towards the origin."""
+    m = 0.5 * (sxx + syy)
+    r = math.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
+    sigma_c = 2.0 * cohesion / denom
+    sigma_t = sigma_c / q
+    if r <= 0.0:
+        return -1.0, 0.0
+    tol = 1e-12 * sigma_c
+    c = (q - 1.0) * (1.0 + nu) / ((q + 1.0) * (1.0 - nu))
+    p = m - c * r
+    if (q - 1.0) * p < sigma_c and p < sigma_t:
+        f = (sigma_c - (q - 1.0) * p) / ((q - 1.0) * (m - p) + (q + 1.0) * r)
+        if 0.0 <= f < 1.0 and p + f * (m - p + r) <= sigma_t + tol:
+            return f, p
+    c = (1.0 + nu) / (1.0 - nu)
+    p = m - c * r
+    if (q - 1.0) * p < sigma_c and p < sigma_t:
+        f = (sigma_t - p) / (m - p + r)
+        if 0.0 <= f < 1.0 and (q - 1.0) * (p + f * (m - p)) + (q + 1.0) * f * r <= sigma_c + tol:
+            return f, p
+    return -1.0, 0.0
+
+
 @njit(cache=True, parallel=True)
 def damage_update_kernel(sigma, damage, cohesion, dt, td, heal_rate, q, denom, max_damage,
-                         dcrit_out, mean_fraction=0.0):
+                         dcrit_out, mean_fraction=0.0, associated_nu=-1.0):
     """Explicit damage update with stress correction, in place (Dansereau et al. 2016 eqs. 9-11).
 
     Per element: r = min(1, dt/td_e)(1 − d_crit);  1 − d ← (1 − d)(1 − r);
@@ -183,20 +219,31 @@ def damage_update_kernel(sigma, damage, cohesion, dt, td, heal_rate, q, denom, m
     and d_crit is the factor of :func:`_dcrit_towards` (the origin path where that factor
     does not exist). θ = 1 keeps the mean stress. With dt = td the stress lands on the
     envelope on every path. θ = 0 is the origin path, bit for bit.
+
+    ``associated_nu`` ν ≥ 0 (``rheology.stress_correction = "associated"``): the path of
+    :func:`_dcrit_associated` (towards the envelope along K n), with P = p I from that
+    function; the origin path where it gives none. Negative: not used.
     """
     n_capped = 0
     for e in prange(sigma.shape[0]):
         dc = _dcrit(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom)
         towards_mean = False
-        if mean_fraction > 0.0 and dc < 1.0:
+        p = 0.0
+        if associated_nu >= 0.0 and dc < 1.0:
+            fa, pa = _dcrit_associated(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom, associated_nu)
+            if fa >= 0.0:
+                dc = fa
+                p = pa
+                towards_mean = True
+        elif mean_fraction > 0.0 and dc < 1.0:
             fm = _dcrit_towards(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom, mean_fraction)
             if fm >= 0.0:
                 dc = fm
+                p = mean_fraction * 0.5 * (sigma[e, 0] + sigma[e, 1])
                 towards_mean = True
         dcrit_out[e] = dc
         d, f, capped = damage_step(damage[e], dc, dt, td[e], heal_rate[e], max_damage)
         if towards_mean:
-            p = mean_fraction * 0.5 * (sigma[e, 0] + sigma[e, 1])
             sigma[e, 0] = p + f * (sigma[e, 0] - p)
             sigma[e, 1] = p + f * (sigma[e, 1] - p)
             sigma[e, 2] *= f
@@ -272,6 +319,7 @@ class MaxwellEB:
         kernel = pick(DAMAGE_UPDATE, len(damage))
         n = kernel(sigma, damage, cohesion, float(dt), np.ascontiguousarray(td),
                    np.ascontiguousarray(heal_rate), self.q, self._denom,
-                   self.params.max_damage, out, self.params.mean_fraction)
+                   self.params.max_damage, out, self.params.mean_fraction,
+                   self.params.poisson if self.params.stress_correction == "associated" else -1.0)
         self.n_capped_total += int(n)
         return out

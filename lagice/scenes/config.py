@@ -239,7 +239,7 @@ def parse_value(raw: str):
 def apply_overrides(raw: dict, overrides) -> dict:
     """Apply ``{"table.key": value}`` or ``["table.key=value", ...]`` to a raw scene."""
     raw = copy.deepcopy(raw)
-    items = overrides.items() if isinstance(overrides, dict) else [_split(s) for s in overrides or []]
+    items = overrides.items() if isinstance(overrides, dict) else split_overrides(overrides)
     for dotted, val in items:
         parts = dotted.split(".")
         if len(parts) < 2:
@@ -254,6 +254,18 @@ def apply_overrides(raw: dict, overrides) -> dict:
                 raise ConfigError(f"--set {dotted}: {p} is not a table")
         node[parts[-1]] = val
     return raw
+
+
+def split_overrides(overrides) -> list:
+    """``["table.key=value", ...]`` → ``[(key, value), ...]``. A key given twice with
+    different values is refused (the first value would be silently ignored)."""
+    items = [_split(s) for s in overrides or []]
+    seen = {}
+    for k, v in items:
+        if k in seen and seen[k] != v:
+            raise ConfigError(f"--set {k} is given twice ({k}={seen[k]!r}, then {k}={v!r}); give it once")
+        seen[k] = v
+    return items
 
 
 def _split(s):
