@@ -68,6 +68,13 @@ def _value(v: str):
     return v
 
 
+def run_finished(run: Path) -> bool:
+    """:func:`validate.run_finished`: the run reached its stop time (not stopped by a signal)."""
+    from validate import run_finished as finished
+
+    return finished(run)
+
+
 def variant_sets(name):
     return [s for part in name.split("+") for s in VARIANTS[part]]
 
@@ -79,7 +86,7 @@ def git_commit() -> str:
 # -- cyclone over a disk ----------------------------------------------------------------
 def run_cyclone(out: Path, variant: str, rot: float, extra_sets=()):
     run = out / f"cyclone_{variant}_r{rot:g}"
-    if (run / "summary.json").exists():
+    if run_finished(run):
         return run
     sets = [*variant_sets(variant), f"domain.rotate_deg={rot:g}", "run.progress=false", *extra_sets]
     cmd = [sys.executable, "-m", "lagice.cli", "run", str(ROOT / "examples" / "imprint_cyclone_disk.toml"),
@@ -112,7 +119,7 @@ def analyse_cyclone(out: Path, variant: str):
         per = {}
         for rot in ROTATIONS:
             run = out / f"cyclone_{variant}_r{rot:g}"
-            if not (run / "summary.json").exists():
+            if not run_finished(run):
                 continue
             nodes, tri, d, sh = load_last(run)
             s = imprint_summary(nodes, tri, d if field == "damage" else sh,
@@ -195,7 +202,7 @@ def figure_cyclone(out: Path, variants, path: Path):
         hist_ax = ax[i, 3]
         for j, rot in enumerate(ROTATIONS):
             run = out / f"cyclone_{v}_r{rot:g}"
-            if not (run / "summary.json").exists():
+            if not run_finished(run):
                 continue
             nodes, tri, d, _ = load_last(run)
             t = mtri.Triangulation(nodes[:, 0] / 1e3, nodes[:, 1] / 1e3, tri)

@@ -395,6 +395,13 @@ def _store(res: dict):
     (ROOT / "docs" / "figures" / "physics_experiments.json").write_text(json.dumps(allr, indent=1, default=float))
 
 
+def run_finished(run: Path) -> bool:
+    """:func:`validate.run_finished`: the run reached its stop time (not stopped by a signal)."""
+    from validate import run_finished as finished
+
+    return finished(run)
+
+
 def git_commit() -> str:
     try:
         return subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True,
@@ -407,7 +414,7 @@ def run_experiment(name: str, force: bool = False, run: bool = True) -> dict:
     scene, overrides, res, days, what = EXPERIMENTS[name]
     out = OUT / name
     cmd = command(scene, overrides, res, days, out)
-    if run and (force or not (out / "summary.json").exists()):
+    if run and (force or not run_finished(out)):  # a stopped run is run again
         OUT.mkdir(parents=True, exist_ok=True)
         t0 = time.perf_counter()
         print(f"physics: run {name}: {what}", flush=True)

@@ -347,6 +347,13 @@ def run_compression(out: Path, n_across: int, max_strain: float, seed: int = 0, 
     return path
 
 
+def run_finished(run: Path) -> bool:
+    """A run directory whose summary says the run reached its stop time (a run stopped by
+    a signal writes a summary too, with ``finished = false``)."""
+    summary = run / "summary.json"
+    return summary.exists() and bool(json.loads(summary.read_text()).get("finished", False))
+
+
 def analyse_compression(path: Path) -> dict:
     z = np.load(path)
     stress, dt, block = z["stress_pa"], float(z["dt_s"]), int(z["block_steps"])
@@ -739,7 +746,7 @@ def analyse_ensemble(physics: Path, days: float, buffer_m: float, basin: dict) -
     out = {}
     for scene, names in PHYSICS_ENSEMBLE.items():
         runs = [physics / n for n in names]
-        if not all((r / "summary.json").exists() for r in runs):
+        if not all(run_finished(r) for r in runs):
             print(f"validate: weather ensemble {scene}: not every member has finished ({', '.join(names)})")
             continue
         members = {}
@@ -932,8 +939,7 @@ def main(argv=None):
             jobs.update(sensitivity_commands(out, days, resolution))
         run_jobs(jobs, out, max(1, args.jobs))
 
-    def done(run: Path) -> bool:
-        return (run / "summary.json").exists()
+    done = run_finished
 
     basin = {}
     for s in SCENES:

@@ -130,11 +130,13 @@ def test_outputs_readable(heal_run):
     ({"rheology.poisson": 0.5}, "poisson"), ({"rheology.alpha": 1.0}, "alpha"),
     ({"rheology.cohesion_min_pa": -5.0}, "cohesion_min_pa"),
     ({"rheology.stress_correction": "normal"},
-     "rheology.stress_correction = 'normal': expected one of \\['origin', 'mean_stress'\\]"),
+     "rheology.stress_correction = 'normal': expected one of \\['origin', 'mean_stress', 'associated'\\]"),
     ({"rheology.stress_correction_mean_fraction": 0.5},
      "stress_correction_mean_fraction = 0.5 applies to stress_correction = 'mean_stress' only"),
     ({"rheology.stress_correction": "mean_stress", "solver.name": "explicit"},
      "rheology.stress_correction = 'mean_stress' is implemented in the implicit solver's damage update only"),
+    ({"rheology.stress_correction": "associated", "solver.name": "explicit"},
+     "rheology.stress_correction = 'associated' is implemented in the implicit solver's damage update only"),
 ])
 def test_bad_input_fails_before_meshing(ov, match, monkeypatch, tmp_path):
     import lagice.scenes.builder as mod
