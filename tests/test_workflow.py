@@ -31,8 +31,14 @@ QUICK = ["run.duration=800.0", "solver.dt=40.0", "output.every=400.0", "domain.r
 
 
 def run_cli(*args, sets=(), cwd=None, env=None, timeout=600, **kw):
-    cmd = [sys.executable, "-m", "lagice.cli", *map(str, args)]
+    """``lagice`` as a subprocess; ``sets`` like ``[*QUICK, "run.duration=1200.0"]``: a later
+    value of a key replaces an earlier one here (``lagice`` itself refuses a key given twice
+    with different values)."""
+    merged = {}
     for s in sets:
+        merged[s.split("=", 1)[0]] = s
+    cmd = [sys.executable, "-m", "lagice.cli", *map(str, args)]
+    for s in merged.values():
         cmd += ["--set", s]
     e = dict(os.environ, **(env or {}))
     return subprocess.run(cmd, capture_output=True, text=True, cwd=cwd, env=e, timeout=timeout, **kw)
