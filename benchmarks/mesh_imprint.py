@@ -43,6 +43,8 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
+from validate import run_finished  # noqa: E402  (a run that reached its stop time)
+
 ROTATIONS = (0.0, 15.0, 30.0)
 VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.mesh_algorithm=5"],
             # the loading rate (the scene pushes at 1 mm/s): half and twice as fast; the run
@@ -66,13 +68,6 @@ def _value(v: str):
         except ValueError:
             pass
     return v
-
-
-def run_finished(run: Path) -> bool:
-    """:func:`validate.run_finished`: the run reached its stop time (not stopped by a signal)."""
-    from validate import run_finished as finished
-
-    return finished(run)
 
 
 def variant_sets(name):

@@ -37,6 +37,8 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
+from validate import run_finished  # noqa: E402  (a run that reached its stop time)
+
 OUT = ROOT / "benchmarks" / "out" / "physics"
 DAY = 86400.0
 #: observed ranges (issue 12; sources in benchmarks/validate.py TARGETS)
@@ -393,13 +395,6 @@ def _store(res: dict):
         tmp.replace(p)
     (ROOT / "docs" / "figures").mkdir(parents=True, exist_ok=True)
     (ROOT / "docs" / "figures" / "physics_experiments.json").write_text(json.dumps(allr, indent=1, default=float))
-
-
-def run_finished(run: Path) -> bool:
-    """:func:`validate.run_finished`: the run reached its stop time (not stopped by a signal)."""
-    from validate import run_finished as finished
-
-    return finished(run)
 
 
 def git_commit() -> str:

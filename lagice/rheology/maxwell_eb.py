@@ -227,23 +227,23 @@ def damage_update_kernel(sigma, damage, cohesion, dt, td, heal_rate, q, denom, m
     n_capped = 0
     for e in prange(sigma.shape[0]):
         dc = _dcrit(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom)
-        towards_mean = False
+        towards_point = False
         p = 0.0
         if associated_nu >= 0.0 and dc < 1.0:
             fa, pa = _dcrit_associated(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom, associated_nu)
             if fa >= 0.0:
                 dc = fa
                 p = pa
-                towards_mean = True
+                towards_point = True
         elif mean_fraction > 0.0 and dc < 1.0:
             fm = _dcrit_towards(sigma[e, 0], sigma[e, 1], sigma[e, 2], cohesion[e], q, denom, mean_fraction)
             if fm >= 0.0:
                 dc = fm
                 p = mean_fraction * 0.5 * (sigma[e, 0] + sigma[e, 1])
-                towards_mean = True
+                towards_point = True
         dcrit_out[e] = dc
         d, f, capped = damage_step(damage[e], dc, dt, td[e], heal_rate[e], max_damage)
-        if towards_mean:
+        if towards_point:
             sigma[e, 0] = p + f * (sigma[e, 0] - p)
             sigma[e, 1] = p + f * (sigma[e, 1] - p)
             sigma[e, 2] *= f
