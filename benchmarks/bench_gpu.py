@@ -198,6 +198,31 @@ def agreement(n, a):
     return out
 
 
+def scene_days(n, device, a):
+    """The scene itself for ``--days`` simulated days (item 5): its own outer step
+    (600 s) and automatic sub-step count, mesh motion and remeshing, one snapshot at
+    the start; wall time, its split by component, sub-steps and remesh events."""
+    from lagice.scenes.builder import build_simulation
+
+    cfg = scene_config(n, device, None, a.wind)
+    cfg["run"]["duration"] = f"{a.days * 24:g}h"
+    t0 = time.perf_counter()
+    sim = build_simulation(cfg, a.out / f"days_{device}_{n}")
+    build_s = time.perf_counter() - t0
+    model = sim.model
+    n_sub = [0]
+    sim.add_callback(lambda s: n_sub.__setitem__(0, n_sub[0] + s.model.last_report["solver"].iterations),
+                     every="1 steps", name="substep_count")
+    t0 = time.perf_counter()
+    summ = sim.run()
+    wall = time.perf_counter() - t0
+    m = model.mesh.n_elements
+    return {"device": device, "n_elements": m, "days": a.days, "build_s": build_s, "wall_s": wall,
+            "finished": summ["finished"], "outer_steps": summ["steps"], "substeps": n_sub[0],
+            "element_substeps_per_s_wall": m * n_sub[0] / wall, "remesh_count": summ["remesh_count"],
+            "component_s": dict(summ["timings"]), "mean_damage": float(np.mean(model.state.damage))}
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--elements", type=int, nargs="+", default=[200_000, 2_000_000])
@@ -209,6 +234,10 @@ def main(argv=None):
     ap.add_argument("--cpu", action="store_true", help="also time the CPU stepper and check agreement")
     ap.add_argument("--check-steps", type=int, default=3)
     ap.add_argument("--smoke", action="store_true", help="tiny sizes (for the CUDA simulator)")
+    ap.add_argument("--days", type=float, default=0.0,
+                    help="also run the scene for this many simulated days at the first --elements size "
+                         "(its own 600 s step and sub-step count) on the GPU")
+    ap.add_argument("--days-cpu", action="store_true", help="the --days run on the CPU as well")
     ap.add_argument("--out", type=Path, default=OUT / "gpu_runs", help="scratch folder of the runs")
     ap.add_argument("--json", type=Path, default=OUT / "gpu.json")
     a = ap.parse_args(argv)
@@ -223,6 +252,7 @@ def main(argv=None):
         a.smoke = True
     if a.smoke:
         a.elements, a.steps, a.substeps, a.check_steps = [150], 1, 3, 1
+        a.days = min(a.days, 1 / 24)
     report = {"gpu": ok, "device": info, "simulator": simulator_enabled(), "rows": []}
     if not ok:
         print(f"NO GPU: numba.cuda.is_available() is False ({info}).\n"
@@ -267,6 +297,16 @@ def main(argv=None):
                       f"{r['element_substeps_per_s_stepper'] / 1e6:>10.1f} {other:>9.2f} "
                       f"{r['persistent_bytes_per_element']:>11.0f} {r['step_peak_bytes_per_element']:>16.0f}",
                       flush=True)
+    if a.days > 0:
+        report["days_runs"] = []
+        for dev in (["cuda"] if ok else []) + (["cpu"] if a.days_cpu else []):
+            r = scene_days(a.elements[0], dev, a)
+            report["days_runs"].append(r)
+            comp = ", ".join(f"{k} {v:.1f}" for k, v in r["component_s"].items() if v > 0.05)
+            print(f"{a.days:g} days on {dev}, {r['n_elements']} elements: {r['wall_s']:.1f} s wall "
+                  f"(build {r['build_s']:.1f} s), {r['outer_steps']} steps, {r['substeps']} sub-steps, "
+                  f"{r['element_substeps_per_s_wall'] / 1e9:.3f} G element-sub-steps/s over the wall time, "
+                  f"{r['remesh_count']} remeshes; components [s]: {comp}", flush=True)
     a.json.write_text(json.dumps(report, indent=1, default=str))
     print(f"wrote {a.json}")
     return 0

@@ -52,18 +52,24 @@ def bench(days: float, resolution_m: float, parallel, outputs: bool = True, extr
     tm = dict(model.timings)
     kt = st.kernel_timings
     es = float(rec["el_sub"].sum())
+    gpu = not hasattr(st, "nodes")  # the CUDA stepper (solver.device = "cuda")
     choice = getattr(st, "kernel_choice", None) or {}
-    par = choice.get("parallel", st.nodes.parallel_for(model.mesh))
+    if gpu:
+        choice = {"parallel": False, "threads": 1, "method": f"cuda, launch {st.launch_used}"}
+    par = choice["parallel"] if "parallel" in choice else st.nodes.parallel_for(model.mesh)
     sub_s = kt.get("substeps", 0.0) or (kt["node_velocity"] + kt["element_stress_damage"])
     split = {"dynamics": tm.get("dynamics", 0.0),
-             "  forcing": kt["forcing"], "  setup": kt["setup"], "  sub-step loop": sub_s,
-             "  rest of the step": tm.get("dynamics", 0.0) - kt["forcing"] - kt["setup"] - sub_s}
+             "  forcing": kt["forcing"], "  setup": kt["setup"], "  sub-step loop": sub_s}
+    if gpu:
+        split["  host-device transfers"] = kt.get("transfer", 0.0)
+    split["  rest of the step"] = tm.get("dynamics", 0.0) - sum(v for k, v in split.items() if k != "dynamics")
     for k in COMPONENTS[1:]:
         split[k] = tm.get(k, 0.0)
     split["output and activities"] = wall - sum(tm.get(k, 0.0) for k in COMPONENTS)
     steps = len(rec.time_s)
     simulated_days = steps * sim.dt / DAY_S
-    return {"resolution_m": resolution_m, "n_elements": model.mesh.n_elements, "steps": steps,
+    return {"device": "cuda" if gpu else "cpu", "resolution_m": resolution_m,
+            "n_elements": model.mesh.n_elements, "steps": steps,
             "simulated_days": simulated_days, "parallel": par,
             "threads": choice.get("threads", numba.get_num_threads() if par else 1),
             "choice": choice.get("method", "fixed rule"), "choice_timings_ms": choice.get("timings_ms", {}),
@@ -96,7 +102,7 @@ def main(argv=None):
         r["overrides"] = a.set
         r["requested"] = {None: "auto", True: "parallel", False: "serial"}[par]
         rows.append(r)
-        kern = f"parallel on {r['threads']} threads" if r["parallel"] else "serial"
+        kern = "GPU" if r["device"] == "cuda" else f"parallel on {r['threads']} threads" if r["parallel"] else "serial"
         print(f"winter_basin {r['resolution_m'] / 1e3:g} km, {r['n_elements']} elements, "
               f"{r['simulated_days']:.2f} days ({r['steps']} steps, {r['substeps_per_step']:.0f} sub-steps each), "
               f"solver.parallel={r['requested']}: {kern} ({r['choice']})")

@@ -1,7 +1,7 @@
 """GPU explicit stepper (issue 15): refusal without a GPU, the ``[solver] device``
 option, checkpoints that move between devices, compilation for a real device, and
 agreement with the CPU stepper (serial and parallel kernels) in numba's CUDA
-simulator.
+simulator, or on the GPU itself where one is usable.
 
 numba reads ``NUMBA_ENABLE_CUDASIM`` when it is imported, so everything that
 runs kernels runs in a subprocess with the variable set (``tests/cuda_sim_compare.py``,
@@ -26,6 +26,8 @@ from lagice.solvers.cuda_explicit import check_solver_device, cuda_status
 
 ROOT = Path(__file__).resolve().parents[1]
 GPU_USABLE = cuda_status()[0]
+#: a real device (not the simulator): the comparison then runs on it
+GPU_REAL = GPU_USABLE and not cuda_explicit.simulator_enabled()
 no_gpu_only = pytest.mark.skipif(GPU_USABLE, reason="a CUDA device (or the simulator) is usable here")
 #: largest difference between the CPU and the simulated GPU, relative to the field's largest
 #: value, after 4 damaging steps. Reached: 0 with record forcing, <= 1e-15 where math.hypot
@@ -139,8 +141,10 @@ def test_every_kernel_compiles_for_sm90():
 @pytest.fixture(scope="module")
 def sim_report(tmp_path_factory):
     out = tmp_path_factory.mktemp("cudasim") / "report.json"
+    # on a machine with a usable GPU the comparison runs on the device itself (the H200 of
+    # 2026-11-26 met every assertion below, docs/gpu.md); elsewhere in the simulator
     r = subprocess.run([sys.executable, str(ROOT / "tests" / "cuda_sim_compare.py"), str(out)], check=False,
-                       capture_output=True, text=True, env=_env(True), timeout=600, cwd=ROOT)
+                       capture_output=True, text=True, env=_env(not GPU_REAL), timeout=600, cwd=ROOT)
     assert r.returncode == 0, r.stderr[-3000:]
     return json.loads(out.read_text())
 
@@ -165,7 +169,7 @@ def test_cpu_serial_parallel_and_gpu_agree_on_a_damaging_run(sim_report):
     step, host-evaluated wind) give the CPU serial result to TOL, with the same
     sub-step, capped and damaged counts."""
     r = sim_report
-    assert r["simulator"] is True
+    assert r["simulator"] is (not GPU_REAL)
     assert r["paths"] == {"wind": "device", "ocean": "device"}
     assert r["host_paths"] == {"wind": "host", "ocean": "constant"}
     assert r["launch_auto"] == "cooperative"
