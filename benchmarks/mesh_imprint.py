@@ -258,8 +258,9 @@ def main(argv=None):
                 r = run_compression(out, n, v, args.max_strain)
                 im = r["imprint"]["rate_rupture"]
                 if not r["ruptured"]:
-                    print(f"  compression N={n} {v:10s}: NO RUPTURE (no stress drop, no damage) up to strain "
-                          f"{args.max_strain:g}; peak {r['peak_stress_kpa']:.0f} kPa", flush=True)
+                    print(f"  compression N={n} {v:10s}: NO RUPTURE (largest stress drop {r['rupture_drop_kpa']:.3f} "
+                          f"kPa, below {100 * r['rupture_min_drop_fraction']:g} % of the peak, or no damage) up to "
+                          f"strain {args.max_strain:g}; peak {r['peak_stress_kpa']:.0f} kPa", flush=True)
                 print(f"  compression N={n} {v:10s}: fault angles (rate) "
                       f"{[round(a, 1) for a in (r['fault_angles_rate_deg'] or [])]} (damage) "
                       f"{[round(a, 1) for a in (r['fault_angles_damage_deg'] or [])]} MC "
@@ -268,7 +269,7 @@ def main(argv=None):
                 allres.setdefault("compression", {}).setdefault(f"N{n}", {})[v] = _strip(
                     {k: r[k] for k in ("fault_angles_rate_deg", "fault_angles_damage_deg", "fault_directions_rate_deg",
                                        "mohr_coulomb_angle_deg", "peak_stress_kpa", "rupture_time_s", "wall_s",
-                                       "imprint")} | {"git_commit": git_commit()})
+                                       "imprint", "ruptured", "rupture_drop_kpa")} | {"git_commit": git_commit()})
     else:
         figure_cyclone(out, [v for v in allres.get("cyclone", {})], args.fig_dir / "mesh_imprint_cyclone.png")
     args.fig_dir.mkdir(parents=True, exist_ok=True)

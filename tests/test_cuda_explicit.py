@@ -77,6 +77,29 @@ def test_build_refuses_cuda_before_meshing(tmp_path, monkeypatch):
         cuda_explicit.CudaExplicitSolver(None, None)
 
 
+def test_gpu_that_cannot_compile_is_refused_with_the_reason(monkeypatch):
+    """A GPU that numba finds but cannot compile for (on the first GPU machine: numba-cuda
+    with a numpy it does not support) is refused by require_cuda, before any mesh work,
+    with the device, the compiler's error and the key; a GPU that compiles is usable."""
+    from numba import cuda
+
+    class Device:
+        name = b"Fake GPU"
+
+    monkeypatch.setattr(cuda_explicit, "simulator_enabled", lambda: False)
+    monkeypatch.setattr(cuda, "is_available", lambda: True)
+    monkeypatch.setattr(cuda, "get_current_device", lambda: Device())
+    err = "AttributeError: module 'numpy' has no attribute 'row_stack'"
+    monkeypatch.setattr(cuda_explicit, "_compile_probe_error", lambda: err)
+    ok, info = cuda_status()
+    assert not ok and "numba finds the GPU (Fake GPU) but cannot compile a kernel for it" in info and err in info
+    with pytest.raises(ConfigError, match=r'^solver\.device = "cuda": no CUDA GPU is usable on this machine '
+                                          r"\(numba finds the GPU \(Fake GPU\).*row_stack"):
+        check_solver_device({"device": "cuda", "name": "explicit"})
+    monkeypatch.setattr(cuda_explicit, "_compile_probe_error", lambda: None)
+    assert cuda_status() == (True, "Fake GPU")
+
+
 def test_device_option_schema_and_checks(monkeypatch):
     assert load_scene("wind_square")["solver"]["device"] == "cpu"
     with pytest.raises(ConfigError, match=r"solver\.device = 'gpu': expected one of \['cpu', 'cuda'\]"):

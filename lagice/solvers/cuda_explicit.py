@@ -42,6 +42,7 @@ per node is computed on the device.
 """
 from __future__ import annotations
 
+import functools
 import math
 import time
 import warnings
@@ -82,8 +83,32 @@ def simulator_enabled() -> bool:
     return bool(config.ENABLE_CUDASIM)
 
 
+@functools.lru_cache(maxsize=1)
+def _compile_probe_error() -> str | None:
+    """Compile (not launch) a one-line kernel for the current GPU; the error as text, or None.
+
+    A GPU that numba finds can still be unusable: on the first GPU machine lagice ran on
+    (2026-11-26), NVIDIA's ``numba-cuda`` target failed inside its own modules at the first
+    compilation, because the installed numpy (2.5) no longer had an alias it uses. Without
+    this probe that surfaced after the mesh was built, as an ``AttributeError`` deep in
+    numba. Compiled once per process (about a second)."""
+    try:
+        from numba import cuda
+
+        def _probe(a):
+            i = cuda.grid(1)
+            if i < a.size:
+                a[i] = 2.0 * a[i]
+
+        cuda.jit("void(float64[:])")(_probe)
+    except Exception as exc:  # noqa: BLE001 - any compiler failure means "not usable"
+        return " ".join(f"{type(exc).__name__}: {exc}".split())
+    return None
+
+
 def cuda_status() -> tuple[bool, str]:
-    """``(usable, description)``: the GPU's name, the simulator, or why no GPU is usable."""
+    """``(usable, description)``: the GPU's name, the simulator, or why no GPU is usable
+    (no device, or a device numba cannot compile for)."""
     if simulator_enabled():
         return True, "numba CUDA simulator (NUMBA_ENABLE_CUDASIM=1)"
     try:
@@ -91,23 +116,29 @@ def cuda_status() -> tuple[bool, str]:
 
         if cuda.is_available():
             name = cuda.get_current_device().name
-            return True, name.decode() if isinstance(name, bytes) else str(name)
-        reason = cuda.cuda_error() or "no CUDA device found"
+            name = name.decode() if isinstance(name, bytes) else str(name)
+            err = _compile_probe_error()
+            if err is None:
+                return True, name
+            return False, (f"numba finds the GPU ({name}) but cannot compile a kernel for it: {err}. A numba "
+                           f"CUDA target and a numpy that do not match are a known cause (docs/gpu.md)")
+        reason = f"numba.cuda.is_available() is False: {cuda.cuda_error() or 'no CUDA device found'}"
     except Exception as exc:  # noqa: BLE001 - any driver or toolkit failure means "not usable"
-        reason = f"{type(exc).__name__}: {exc}"
+        reason = f"numba.cuda.is_available() is False: {type(exc).__name__}: {exc}"
     return False, " ".join(str(reason).split())
 
 
 def require_cuda(key: str = "solver.device") -> str:
     """Raise :class:`ConfigError` naming ``key`` unless numba can use a CUDA GPU
-    (or its simulator); returns the device description. Cheap: no mesh, no kernel."""
+    (or its simulator); returns the device description. No mesh; on a GPU, one
+    one-line kernel compiled once per process."""
     ok, info = cuda_status()
     if not ok:
         raise ConfigError(
-            f'{key} = "cuda": no CUDA GPU is usable on this machine (numba.cuda.is_available() is False: '
-            f'{info}). Use {key} = "cpu" (the default), run on a machine with an NVIDIA GPU and the CUDA '
-            f"libraries numba needs (docs/gpu.md), or set NUMBA_ENABLE_CUDASIM=1 to run the GPU kernels in "
-            f"numba's CUDA simulator (for tests: very slow)")
+            f'{key} = "cuda": no CUDA GPU is usable on this machine ({info}). Use {key} = "cpu" (the '
+            f"default), run on a machine with an NVIDIA GPU and the CUDA libraries numba needs (docs/gpu.md), "
+            f"or set NUMBA_ENABLE_CUDASIM=1 to run the GPU kernels in numba's CUDA simulator (for tests: very "
+            f"slow)")
     return info
 
 
