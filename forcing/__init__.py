@@ -8,6 +8,7 @@ from .records import InMemoryRecords, LonLatGrid, RecordField, RegularGrid
 from .synthetic import (
                    Cyclone,
                    cyclone_wind,
+                   eddy_current,
                    gyre_current,
                    ocean_at_rest,
                    random_cyclones,
@@ -23,5 +24,5 @@ __all__ = [
     "RegularGrid", "LonLatGrid", "InMemoryRecords", "RecordField",
     "GriddedRecords", "open_gridded", "open_wind", "open_air_temperature", "open_ocean_current",
     "record_times", "uniform_wind", "random_wind", "Cyclone", "random_cyclones", "cyclone_wind",
-    "ocean_at_rest", "uniform_current", "gyre_current",
+    "ocean_at_rest", "uniform_current", "gyre_current", "eddy_current",
 ]

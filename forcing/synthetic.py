@@ -245,3 +245,49 @@ def gyre_current(grid, max_speed_m_s=0.1, *, bbox=None, clockwise=True, **field_
     u = np.where(inside, -psi0 * np.pi / ly * np.sin(np.pi * xi) * np.cos(np.pi * eta), 0.0)
     v = np.where(inside, psi0 * np.pi / lx * np.cos(np.pi * xi) * np.sin(np.pi * eta), 0.0)
     return _vector_field(grid, np.zeros(1), u[None], v[None], "<synthetic gyre current>", **field_kw)
+
+
+def eddy_current(grid, max_speed_m_s=0.05, radius_m=30e3, *, spacing_radii=4.0, seed=0, bbox=None, **field_kw):
+    """Steady field of ocean eddies of both senses [m s-1], deterministic from ``seed``.
+
+    Stream function ψ = Σᵢ sᵢ ψ0 exp(−|x − xᵢ|²/(2R²)), u = −∂ψ/∂y, v = ∂ψ/∂x
+    (non-divergent; computed analytically at the grid points). Centres xᵢ are uniform
+    random in ``bbox`` (default the grid extent), one per (``spacing_radii`` R)² of area,
+    senses sᵢ = ±1 at random (cyclonic and anticyclonic alike). One Gaussian eddy's
+    largest speed is ψ0 e^(−1/2)/R; ψ0 is then scaled so that the field's largest speed
+    on the grid is ``max_speed_m_s``. A stand-in for the mesoscale and sub-mesoscale
+    variability of the surface current under the ice, whose curl varies on scales of
+    tens of km; ``radius_m`` should span at least three grid spacings.
+    """
+    _check_grid(grid)
+    check_range("max_speed_m_s", max_speed_m_s, 0.0, 2.0, unit="m s-1")
+    check_range("radius_m", radius_m, 0.0, None, low_open=True, unit="m")
+    check_range("spacing_radii", spacing_radii, 1.0, 100.0, unit="eddy radii")
+    dx = min(abs(grid.x_m[1] - grid.x_m[0]), abs(grid.y_m[1] - grid.y_m[0]))
+    if radius_m < 3.0 * dx:
+        raise ConfigError(f"eddy radius_m = {radius_m:g} m spans fewer than three forcing grid spacings "
+                          f"({dx:g} m): the eddies would not be resolved by the records (lower "
+                          f"forcing.grid_spacing_m or raise radius_m)")
+    if bbox is None:
+        bbox = (grid.x_m[0], grid.x_m[-1], grid.y_m[0], grid.y_m[-1])
+    xmin, xmax, ymin, ymax = bbox
+    area = (xmax - xmin) * (ymax - ymin)
+    if not area > 0:
+        raise ConfigError(f"eddy bbox {bbox} is empty")
+    rng = np.random.default_rng(seed)
+    n = max(1, int(round(area / (spacing_radii * radius_m) ** 2)))
+    xc = rng.uniform(xmin, xmax, n)
+    yc = rng.uniform(ymin, ymax, n)
+    sense = rng.choice([-1.0, 1.0], n)
+    X, Y = grid.mesh()
+    u = np.zeros_like(X, dtype=np.float64)
+    v = np.zeros_like(X, dtype=np.float64)
+    for i in range(n):  # one pass per eddy over the grid (setup only, not per step)
+        rx, ry = X - xc[i], Y - yc[i]
+        g = sense[i] * np.exp(-(rx * rx + ry * ry) / (2.0 * radius_m * radius_m)) / (radius_m * radius_m)
+        u += ry * g   # −∂ψ/∂y with ψ = s exp(−r²/2R²) (ψ0 = 1 here)
+        v -= rx * g   # ∂ψ/∂x
+    top = float(np.hypot(u, v).max())
+    scale = max_speed_m_s / top if top > 0 else 0.0
+    return _vector_field(grid, np.zeros(1), scale * u[None], scale * v[None],
+                         f"<synthetic eddy current: {n} eddies, R = {radius_m / 1e3:g} km, seed {seed}>", **field_kw)

@@ -6,6 +6,7 @@ from forcing import (
     Cyclone,
     RegularGrid,
     cyclone_wind,
+    eddy_current,
     gyre_current,
     ocean_at_rest,
     random_cyclones,
@@ -111,6 +112,31 @@ def test_ocean_currents(grid):
     top = g.evaluate(0.0, np.array([cx]), np.array([7e5]))
     bottom = g.evaluate(0.0, np.array([cx]), np.array([1e5]))
     assert top[0, 0] > 0 > bottom[0, 0]
+
+
+def test_eddy_current():
+    """Eddies of both senses: non-divergent (analytic ψ-derivatives: the grid divergence is
+    discretisation error only), the largest speed as asked, vorticity of both signs at the
+    eddy scale, one eddy per (4R)² of area, deterministic from the seed; an unresolved
+    radius is refused."""
+    g10 = RegularGrid.from_bbox(*BBOX, spacing_m=5e3)
+    f = eddy_current(g10, 0.05, 30e3, seed=3)
+    d = f.source.data[0]
+    assert np.hypot(d[0], d[1]).max() == pytest.approx(0.05, rel=1e-12)
+    dx = g10.x_m[1] - g10.x_m[0]
+    dy = g10.y_m[1] - g10.y_m[0]
+    div = np.gradient(d[0], dx, axis=1) + np.gradient(d[1], dy, axis=0)
+    vort = np.gradient(d[1], dx, axis=1) - np.gradient(d[0], dy, axis=0)
+    inner = (slice(2, -2), slice(2, -2))
+    assert np.abs(div[inner]).max() < 0.05 * np.abs(vort[inner]).max()
+    # both senses, at comparable strength: an eddy field, not a gyre
+    assert vort.max() > 0.3 * -vort.min() > 0 and -vort.min() > 0.3 * vort.max()
+    n_expected = round((g10.x_m[-1] - g10.x_m[0]) * (g10.y_m[-1] - g10.y_m[0]) / (4 * 30e3) ** 2)
+    assert f"{n_expected} eddies" in f.source.name
+    np.testing.assert_array_equal(eddy_current(g10, 0.05, 30e3, seed=3).source.data, f.source.data)
+    assert not np.array_equal(eddy_current(g10, 0.05, 30e3, seed=4).source.data, f.source.data)
+    with pytest.raises(ConfigError, match="fewer than three forcing grid spacings"):
+        eddy_current(g10, 0.05, 10e3)
 
 
 def test_bad_config(grid):

@@ -19,7 +19,8 @@ wind ``kind``             generator (``forcing.synthetic``/``forcing.gridded``)
 ========================  =====================================================
 
 ocean ``kind``: ``rest``, ``uniform`` (u_m_s, v_m_s), ``gyre`` (max_speed_m_s,
-clockwise), ``file``, ``expression``, ``function``. air_temperature ``kind``:
+clockwise), ``eddies`` (max_speed_m_s, radius_m, spacing_radii, seed), ``file``,
+``expression``, ``function``. air_temperature ``kind``:
 ``synthetic`` (``synthetic_air_temperature`` keywords), ``constant`` (value_c),
 ``file``, ``expression`` (``value``).
 
@@ -53,7 +54,7 @@ from . import checks
 from .config import resolve_hook, time_space_callable
 
 WIND_KINDS = ("uniform", "random", "cyclones", "climatology", "file", "expression", "function")
-OCEAN_KINDS = ("rest", "uniform", "gyre", "file", "expression", "function")
+OCEAN_KINDS = ("rest", "uniform", "gyre", "eddies", "file", "expression", "function")
 AIR_KINDS = ("synthetic", "constant", "file", "expression")
 HEAL_LAWS = ("none", "constant", "thermodynamic", "fdd", "nextsim")
 
@@ -108,6 +109,7 @@ def _generators(key: str, kind: str):
                 "cyclones": ([syn.random_cyclones, syn.cyclone_wind], ("grid", "t_end_s", "bbox", "cyclones")),
                 "file": ([gridded.open_wind, gridded.open_gridded], ("variables", "quantity"))}.get(kind)
     return {"uniform": ([syn.uniform_current], ("grid",)), "gyre": ([syn.gyre_current], ("grid",)),
+            "eddies": ([syn.eddy_current], ("grid",)),
             "file": ([gridded.open_ocean_current, gridded.open_gridded], ("variables", "quantity"))}.get(kind)
 
 
@@ -231,7 +233,16 @@ def validate(cfg: dict, duration_s: float) -> None:
                                           fc["grid_spacing_m"])
         else:
             _check_kwargs(t, key, kind)
-        if kind in ("uniform", "random", "cyclones", "gyre", "synthetic"):
+        if key == "ocean" and kind == "eddies":
+            from forcing.synthetic import eddy_current
+
+            default = inspect.signature(eddy_current).parameters["radius_m"].default
+            radius = float(_generator_table(t, key, kind).get("radius_m", default))
+            if fc["grid_spacing_m"] is not None and radius < 3.0 * float(fc["grid_spacing_m"]):
+                raise ConfigError(f"forcing.ocean.radius_m = {radius:g} m spans fewer than three forcing grid "
+                                  f"spacings (forcing.grid_spacing_m = {fc['grid_spacing_m']:g} m): the eddies "
+                                  f"would not be resolved by the records")
+        if kind in ("uniform", "random", "cyclones", "gyre", "eddies", "synthetic"):
             _dry_run(cfg, key, kind, duration_s)
     if fc["coriolis"] is not None:
         _check_coriolis(fc["coriolis"])
@@ -475,6 +486,8 @@ def build_ocean(t: dict, grid, crs="EPSG:3413", start_date=None):
         return syn.uniform_current(grid, **kw)
     if kind == "gyre":
         return syn.gyre_current(grid, **_kwargs(t, "ocean", [syn.gyre_current], ("grid",)))
+    if kind == "eddies":
+        return syn.eddy_current(grid, **_kwargs(t, "ocean", [syn.eddy_current], ("grid",)))
     if kind == "file":
         return gridded.open_ocean_current(**_file_kw(t, "ocean", [gridded.open_ocean_current, gridded.open_gridded],
                                                      crs, start_date))
