@@ -316,18 +316,19 @@ for _key, _lo, _hi, _what in (("str", "rheology.strength_lab_pa=1.4e6", "rheolog
 # ocean has eddies of both senses (radii 5-10 km in the halocline, Zhao et al. 2014,
 # "Characterizing the eddy field in the Arctic Ocean halocline", JGR Oceans 119). Diagnostic:
 # a steady field of eddies of both senses, R = 30 km (the smallest the 10 km records resolve:
-# larger than the observed eddies), 5 cm/s at most (an order of magnitude, not a sourced value:
-# the under-ice surface signature of these eddies is not well known), on the linear-healing
+# larger than the observed eddies), 10 cm/s each (a strong case, to learn whether the mechanism
+# can matter at all: not a sourced value; the under-ice surface signature of these eddies is not
+# well known; the field's mean speed is then 5 cm/s, its largest 27 cm/s), on the linear-healing
 # pack and on the K = 50 set, validation month, closed basin. Stated before the runs: a lead
 # for β only if β (>= 10 boxes) rises by at least 0.04 over the run without eddies (F10-hthick-
 # 1125: 0.038; F10-hthick-K50: 0.052) with no other band leaving its range; not adopted either
 # way without a sourced amplitude and more months.
-EDDIES = ["forcing.ocean.kind=eddies", "forcing.ocean.max_speed_m_s=0.05", "forcing.ocean.radius_m=30e3",
+EDDIES = ["forcing.ocean.kind=eddies", "forcing.ocean.eddy_speed_m_s=0.1", "forcing.ocean.radius_m=30e3",
           "forcing.ocean.seed=1"]
 EXPERIMENTS["F10-hthick-1125-eddies"] = ("closed", from_spinup("H1125") + EDDIES, 10e3, 28,
-                                         "F10-hthick-1125 with 5 cm/s ocean eddies of both senses, R = 30 km")
+                                         "F10-hthick-1125 with ocean eddies of both senses, 10 cm/s, R = 30 km")
 EXPERIMENTS["F10-hthick-K50-eddies"] = ("closed", COMPLIANCE50 + from_spinup("H1125-K50") + EDDIES, 10e3, 28,
-                                        "F10-hthick-K50 with 5 cm/s ocean eddies of both senses, R = 30 km")
+                                        "F10-hthick-K50 with ocean eddies of both senses, 10 cm/s, R = 30 km")
 for _i in (1, 2, 3):
     EXPERIMENTS[f"W20-d{_i}"] = ("closed", ["forcing.wind.seed=2026", f"run.seed={_i}"], 20e3, 28,
                                  f"as W20, strength disorder of run seed {_i} (same weather)")

@@ -247,20 +247,22 @@ def gyre_current(grid, max_speed_m_s=0.1, *, bbox=None, clockwise=True, **field_
     return _vector_field(grid, np.zeros(1), u[None], v[None], "<synthetic gyre current>", **field_kw)
 
 
-def eddy_current(grid, max_speed_m_s=0.05, radius_m=30e3, *, spacing_radii=4.0, seed=0, bbox=None, **field_kw):
+def eddy_current(grid, eddy_speed_m_s=0.05, radius_m=30e3, *, spacing_radii=4.0, seed=0, bbox=None,
+                 **field_kw):
     """Steady field of ocean eddies of both senses [m s-1], deterministic from ``seed``.
 
     Stream function ψ = Σᵢ sᵢ ψ0 exp(−|x − xᵢ|²/(2R²)), u = −∂ψ/∂y, v = ∂ψ/∂x
     (non-divergent; computed analytically at the grid points). Centres xᵢ are uniform
     random in ``bbox`` (default the grid extent), one per (``spacing_radii`` R)² of area,
-    senses sᵢ = ±1 at random (cyclonic and anticyclonic alike). One Gaussian eddy's
-    largest speed is ψ0 e^(−1/2)/R; ψ0 is then scaled so that the field's largest speed
-    on the grid is ``max_speed_m_s``. A stand-in for the mesoscale and sub-mesoscale
-    variability of the surface current under the ice, whose curl varies on scales of
-    tens of km; ``radius_m`` should span at least three grid spacings.
+    senses sᵢ = ±1 at random (cyclonic and anticyclonic alike). ψ0 = U R e^(1/2), so
+    that one isolated eddy's largest speed (at r = R) is ``eddy_speed_m_s`` U; where
+    eddies overlap the field can be faster (the record's name gives its largest speed).
+    A stand-in for the mesoscale and sub-mesoscale variability of the surface current
+    under the ice, whose curl varies on scales of tens of km; ``radius_m`` must span at
+    least three grid spacings.
     """
     _check_grid(grid)
-    check_range("max_speed_m_s", max_speed_m_s, 0.0, 2.0, unit="m s-1")
+    check_range("eddy_speed_m_s", eddy_speed_m_s, 0.0, 2.0, unit="m s-1")
     check_range("radius_m", radius_m, 0.0, None, low_open=True, unit="m")
     check_range("spacing_radii", spacing_radii, 1.0, 100.0, unit="eddy radii")
     dx = min(abs(grid.x_m[1] - grid.x_m[0]), abs(grid.y_m[1] - grid.y_m[0]))
@@ -282,12 +284,14 @@ def eddy_current(grid, max_speed_m_s=0.05, radius_m=30e3, *, spacing_radii=4.0, 
     X, Y = grid.mesh()
     u = np.zeros_like(X, dtype=np.float64)
     v = np.zeros_like(X, dtype=np.float64)
-    for i in range(n):  # one pass per eddy over the grid (setup only, not per step)
+    # u = −∂ψ/∂y = s ψ0 (y − yᵢ)/R² exp(...), v = ∂ψ/∂x = −s ψ0 (x − xᵢ)/R² exp(...)
+    amp = eddy_speed_m_s * np.exp(0.5)
+    for i in range(n):  # one pass per eddy over the grid (set-up only, not per step)
         rx, ry = X - xc[i], Y - yc[i]
-        g = sense[i] * np.exp(-(rx * rx + ry * ry) / (2.0 * radius_m * radius_m)) / (radius_m * radius_m)
-        u += ry * g   # −∂ψ/∂y with ψ = s exp(−r²/2R²) (ψ0 = 1 here)
-        v -= rx * g   # ∂ψ/∂x
+        g = sense[i] * amp * np.exp(-(rx * rx + ry * ry) / (2.0 * radius_m * radius_m))
+        u += (ry / radius_m) * g
+        v -= (rx / radius_m) * g
     top = float(np.hypot(u, v).max())
-    scale = max_speed_m_s / top if top > 0 else 0.0
-    return _vector_field(grid, np.zeros(1), scale * u[None], scale * v[None],
-                         f"<synthetic eddy current: {n} eddies, R = {radius_m / 1e3:g} km, seed {seed}>", **field_kw)
+    name = (f"<synthetic eddy current: {n} eddies, R = {radius_m / 1e3:g} km, {eddy_speed_m_s:g} m/s each, "
+            f"largest speed {top:.3f} m/s, seed {seed}>")
+    return _vector_field(grid, np.zeros(1), u[None], v[None], name, **field_kw)

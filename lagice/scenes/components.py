@@ -19,7 +19,7 @@ wind ``kind``             generator (``forcing.synthetic``/``forcing.gridded``)
 ========================  =====================================================
 
 ocean ``kind``: ``rest``, ``uniform`` (u_m_s, v_m_s), ``gyre`` (max_speed_m_s,
-clockwise), ``eddies`` (max_speed_m_s, radius_m, spacing_radii, seed), ``file``,
+clockwise), ``eddies`` (eddy_speed_m_s, radius_m, spacing_radii, seed), ``file``,
 ``expression``, ``function``. air_temperature ``kind``:
 ``synthetic`` (``synthetic_air_temperature`` keywords), ``constant`` (value_c),
 ``file``, ``expression`` (``value``).
