@@ -37,7 +37,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from validate import run_finished  # noqa: E402  (a run that reached its stop time)
+from validate import repo_relative, run_finished  # noqa: E402  (a run that reached its stop time; paths in published records)
 
 OUT = ROOT / "benchmarks" / "out" / "physics"
 DAY = 86400.0
@@ -413,7 +413,8 @@ def _store(res: dict):
         tmp.write_text(json.dumps(allr, indent=1, default=float))
         tmp.replace(p)
     (ROOT / "docs" / "figures").mkdir(parents=True, exist_ok=True)
-    (ROOT / "docs" / "figures" / "physics_experiments.json").write_text(json.dumps(allr, indent=1, default=float))
+    (ROOT / "docs" / "figures" / "physics_experiments.json").write_text(
+        json.dumps(repo_relative(allr), indent=1, default=float))
 
 
 def git_commit() -> str:

@@ -856,6 +856,19 @@ def _drop(obj, keys):
     return obj
 
 
+def repo_relative(obj):
+    """``obj`` with this checkout's absolute path taken out of every string (paths relative
+    to the repository root), for the copies published under docs/: a record names files
+    of the repository, not of the machine that wrote it."""
+    if isinstance(obj, dict):
+        return {k: repo_relative(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [repo_relative(v) for v in obj]
+    if isinstance(obj, str):
+        return obj.replace(f"{ROOT}/", "").replace(str(ROOT), ".")
+    return obj
+
+
 def _strip(obj):
     if isinstance(obj, dict):
         return {k: _strip(v) for k, v in obj.items() if not k.startswith("_")}
@@ -1001,7 +1014,7 @@ def main(argv=None):
     full["git_commit"] = res["git_commit"]["commit"]
     full["git_dirty"] = res["git_commit"]["dirty"]
     (out / "validation.json").write_text(json.dumps(full, indent=1))
-    (args.fig_dir / "validation.json").write_text(json.dumps(_drop(full, BULKY), indent=1))
+    (args.fig_dir / "validation.json").write_text(json.dumps(repo_relative(_drop(full, BULKY)), indent=1))
     md = write_report(res, args.md, figs)
     print(f"validate: report {md}")
     print("\n".join(headline(res)))
