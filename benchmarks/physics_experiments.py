@@ -329,6 +329,40 @@ EXPERIMENTS["F10-hthick-1125-eddies"] = ("closed", from_spinup("H1125") + EDDIES
                                          "F10-hthick-1125 with ocean eddies of both senses, 10 cm/s, R = 30 km")
 EXPERIMENTS["F10-hthick-K50-eddies"] = ("closed", COMPLIANCE50 + from_spinup("H1125-K50") + EDDIES, 10e3, 28,
                                         "F10-hthick-K50 with ocean eddies of both senses, 10 cm/s, R = 30 km")
+# β again: the bands of every run are long and of few orientations, and β > 0 needs
+# deformation of differing orientation within boxes of 10-150 km (docs/physics.md §4). The
+# shipped pack's thickness varies on 120-370 km only (its spin-up's HETERO_THICKNESS), and its
+# strength disorder is white (one element). Diagnostic: the same pack modulated by a mesoscale
+# random field of 30-80 km wavelengths, h = H exp(s g - s^2/2) (g: 24 plane waves of random
+# wavelength, direction and phase, unit variance; s = 0.25: thickness varies by about 25 % at
+# those scales, a strong case, not a sourced value), from its own spin-up (linear healing, and
+# K = 50 for the K = 50 set). Stated before the runs, as for the eddies: a lead for β only if β
+# rises by at least 0.04 over F10-hthick-1125 (0.038) / F10-hthick-K50 (0.052) with no other
+# band leaving its range.
+def _mesoscale_field(n=24, lam_km=(30.0, 80.0), seed=7) -> str:
+    """Expression of a unit-variance random field: n plane waves (sqrt(2/n) each) of
+    log-uniform wavelength in ``lam_km``, uniform direction and phase, from ``seed``."""
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    lam = np.exp(rng.uniform(np.log(lam_km[0] * 1e3), np.log(lam_km[1] * 1e3), n))
+    th = rng.uniform(0.0, np.pi, n)
+    ph = rng.uniform(0.0, 2 * np.pi, n)
+    a = np.sqrt(2.0 / n)
+    k = 2 * np.pi / lam
+    return " + ".join(f"{a:.6f}*cos({kx:.6e}*x + {ky:.6e}*y + {p:.4f})"
+                      for kx, ky, p in zip(k * np.cos(th), k * np.sin(th), ph))
+
+
+MESO_S = 0.25
+MESO_THICKNESS = f"({HETERO_THICKNESS})*exp({MESO_S}*({_mesoscale_field()}) - {MESO_S ** 2 / 2:g})"
+SPINUPS["H1125-meso"] = ([f"initial.thickness_m={MESO_THICKNESS}"], OUT / "spinup-H1125-meso.npz", 10e3)
+SPINUPS["H1125-meso-K50"] = ([f"initial.thickness_m={MESO_THICKNESS}"] + COMPLIANCE50,
+                             OUT / "spinup-H1125-meso-K50.npz", 10e3)
+EXPERIMENTS["F10-hthick-meso"] = ("closed", from_spinup("H1125-meso"), 10e3, 28,
+                                  "F10-hthick-1125 with 30-80 km thickness variability (25 %), its own spin-up")
+EXPERIMENTS["F10-hthick-K50-meso"] = ("closed", COMPLIANCE50 + from_spinup("H1125-meso-K50"), 10e3, 28,
+                                      "F10-hthick-K50 with 30-80 km thickness variability (25 %), its own spin-up")
 for _i in (1, 2, 3):
     EXPERIMENTS[f"W20-d{_i}"] = ("closed", ["forcing.wind.seed=2026", f"run.seed={_i}"], 20e3, 28,
                                  f"as W20, strength disorder of run seed {_i} (same weather)")
