@@ -255,7 +255,7 @@ def main(argv=None):
         a.days = min(a.days, 1 / 24)
     report = {"gpu": ok, "device": info, "simulator": simulator_enabled(), "rows": []}
     if not ok:
-        print(f"NO GPU: numba.cuda.is_available() is False ({info}).\n"
+        print(f"NO GPU: {info}.\n"
               "No GPU figure was measured. Run this on a machine with an NVIDIA GPU (docs/gpu.md).")
         report["reason"] = info
     else:

@@ -254,9 +254,10 @@ def eddy_current(grid, eddy_speed_m_s=0.05, radius_m=30e3, *, spacing_radii=4.0,
     Stream function ψ = Σᵢ sᵢ ψ0 exp(−|x − xᵢ|²/(2R²)), u = −∂ψ/∂y, v = ∂ψ/∂x
     (non-divergent; computed analytically at the grid points). Centres xᵢ are uniform
     random in ``bbox`` (default the grid extent), one per (``spacing_radii`` R)² of area,
-    senses sᵢ = ±1 at random (cyclonic and anticyclonic alike). ψ0 = U R e^(1/2), so
-    that one isolated eddy's largest speed (at r = R) is ``eddy_speed_m_s`` U; where
-    eddies overlap the field can be faster (the record's name gives its largest speed).
+    senses sᵢ = ±1 at random (cyclonic and anticyclonic alike). ψ0 = U R e^(1/2) with
+    U = ``eddy_speed_m_s``, so that one isolated eddy's largest speed (at r = R) is U;
+    where eddies overlap the field can be faster (the record's name gives its largest
+    speed).
     A stand-in for the mesoscale and sub-mesoscale variability of the surface current
     under the ice, whose curl varies on scales of tens of km; ``radius_m`` must span at
     least three grid spacings.
