@@ -372,6 +372,16 @@ for _seed in ENSEMBLE_SEEDS:
         f"F10-hthick-K50-meso, the weather of wind seed {_seed}")
 ENSEMBLES["thick-and-thin K50 + 30-80 km thickness, closed"] = (
     ["F10-hthick-K50-meso"] + [f"F10-hthick-K50-meso-w{s}" for s in ENSEMBLE_SEEDS])
+# the strait, the same four months (rule, stated before these runs: as in the closed basin,
+# the four-month median of β rises by at least 0.02 over F10s-hthick-K50's four months)
+EXPERIMENTS["F10s-hthick-K50-meso"] = ("strait", COMPLIANCE50 + from_spinup("H1125-meso-K50"), 10e3, 28,
+                                       "F10s-hthick-K50 with 30-80 km thickness variability (25 %)")
+for _seed in ENSEMBLE_SEEDS:
+    EXPERIMENTS[f"F10s-hthick-K50-meso-w{_seed}"] = (
+        "strait", COMPLIANCE50 + from_spinup("H1125-meso-K50") + [f"forcing.wind.seed={_seed}"], 10e3, 28,
+        f"F10s-hthick-K50-meso, the weather of wind seed {_seed}")
+ENSEMBLES["thick-and-thin K50 + 30-80 km thickness, strait"] = (
+    ["F10s-hthick-K50-meso"] + [f"F10s-hthick-K50-meso-w{s}" for s in ENSEMBLE_SEEDS])
 for _i in (1, 2, 3):
     EXPERIMENTS[f"W20-d{_i}"] = ("closed", ["forcing.wind.seed=2026", f"run.seed={_i}"], 20e3, 28,
                                  f"as W20, strength disorder of run seed {_i} (same weather)")
