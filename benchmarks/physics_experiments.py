@@ -366,22 +366,17 @@ EXPERIMENTS["F10-hthick-K50-meso"] = ("closed", COMPLIANCE50 + from_spinup("H112
 # does the K = 50 set's +0.027 in β with 30-80 km thickness variability hold over the other
 # three months? Stated before these runs: it holds if the four-month median of β rises by at
 # least 0.02 over the K = 50 set's own four months (F10-hthick-K50, -w2027, -w2028, -w2029).
-for _seed in ENSEMBLE_SEEDS:
-    EXPERIMENTS[f"F10-hthick-K50-meso-w{_seed}"] = (
-        "closed", COMPLIANCE50 + from_spinup("H1125-meso-K50") + [f"forcing.wind.seed={_seed}"], 10e3, 28,
-        f"F10-hthick-K50-meso, the weather of wind seed {_seed}")
-ENSEMBLES["thick-and-thin K50 + 30-80 km thickness, closed"] = (
-    ["F10-hthick-K50-meso"] + [f"F10-hthick-K50-meso-w{s}" for s in ENSEMBLE_SEEDS])
-# the strait, the same four months (rule, stated before these runs: as in the closed basin,
-# the four-month median of β rises by at least 0.02 over F10s-hthick-K50's four months)
+# Then the strait, the same four months (rule, stated before those runs: as in the closed
+# basin, the four-month median of β rises by at least 0.02 over F10s-hthick-K50's four months)
 EXPERIMENTS["F10s-hthick-K50-meso"] = ("strait", COMPLIANCE50 + from_spinup("H1125-meso-K50"), 10e3, 28,
                                        "F10s-hthick-K50 with 30-80 km thickness variability (25 %)")
-for _seed in ENSEMBLE_SEEDS:
-    EXPERIMENTS[f"F10s-hthick-K50-meso-w{_seed}"] = (
-        "strait", COMPLIANCE50 + from_spinup("H1125-meso-K50") + [f"forcing.wind.seed={_seed}"], 10e3, 28,
-        f"F10s-hthick-K50-meso, the weather of wind seed {_seed}")
-ENSEMBLES["thick-and-thin K50 + 30-80 km thickness, strait"] = (
-    ["F10s-hthick-K50-meso"] + [f"F10s-hthick-K50-meso-w{s}" for s in ENSEMBLE_SEEDS])
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    for _seed in ENSEMBLE_SEEDS:
+        EXPERIMENTS[f"{_p}-hthick-K50-meso-w{_seed}"] = (
+            _basin, COMPLIANCE50 + from_spinup("H1125-meso-K50") + [f"forcing.wind.seed={_seed}"], 10e3, 28,
+            f"{_p}-hthick-K50-meso, the weather of wind seed {_seed}")
+    ENSEMBLES[f"thick-and-thin K50 + 30-80 km thickness, {_basin}"] = (
+        [f"{_p}-hthick-K50-meso"] + [f"{_p}-hthick-K50-meso-w{s}" for s in ENSEMBLE_SEEDS])
 for _i in (1, 2, 3):
     EXPERIMENTS[f"W20-d{_i}"] = ("closed", ["forcing.wind.seed=2026", f"run.seed={_i}"], 20e3, 28,
                                  f"as W20, strength disorder of run seed {_i} (same weather)")

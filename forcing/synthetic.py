@@ -247,6 +247,14 @@ def gyre_current(grid, max_speed_m_s=0.1, *, bbox=None, clockwise=True, **field_
     return _vector_field(grid, np.zeros(1), u[None], v[None], "<synthetic gyre current>", **field_kw)
 
 
+def check_eddy_resolution(radius_m, spacing_m, key="eddy radius_m"):
+    """ConfigError unless an eddy of ``radius_m`` spans at least three record spacings."""
+    if radius_m < 3.0 * spacing_m:
+        raise ConfigError(f"{key} = {radius_m:g} m spans fewer than three forcing grid spacings "
+                          f"({spacing_m:g} m): the eddies would not be resolved by the records (lower "
+                          f"forcing.grid_spacing_m or raise radius_m)")
+
+
 def eddy_current(grid, eddy_speed_m_s=0.05, radius_m=30e3, *, spacing_radii=4.0, seed=0, bbox=None,
                  **field_kw):
     """Steady field of ocean eddies of both senses [m s-1], deterministic from ``seed``.
@@ -266,11 +274,7 @@ def eddy_current(grid, eddy_speed_m_s=0.05, radius_m=30e3, *, spacing_radii=4.0,
     check_range("eddy_speed_m_s", eddy_speed_m_s, 0.0, 2.0, unit="m s-1")
     check_range("radius_m", radius_m, 0.0, None, low_open=True, unit="m")
     check_range("spacing_radii", spacing_radii, 1.0, 100.0, unit="eddy radii")
-    dx = min(abs(grid.x_m[1] - grid.x_m[0]), abs(grid.y_m[1] - grid.y_m[0]))
-    if radius_m < 3.0 * dx:
-        raise ConfigError(f"eddy radius_m = {radius_m:g} m spans fewer than three forcing grid spacings "
-                          f"({dx:g} m): the eddies would not be resolved by the records (lower "
-                          f"forcing.grid_spacing_m or raise radius_m)")
+    check_eddy_resolution(radius_m, min(abs(grid.x_m[1] - grid.x_m[0]), abs(grid.y_m[1] - grid.y_m[0])))
     if bbox is None:
         bbox = (grid.x_m[0], grid.x_m[-1], grid.y_m[0], grid.y_m[-1])
     xmin, xmax, ymin, ymax = bbox

@@ -150,6 +150,13 @@ def test_eddy_current():
     assert not np.array_equal(eddy_current(g10, 0.05, 30e3, seed=4).source.data, f.source.data)
     with pytest.raises(ConfigError, match="fewer than three forcing grid spacings"):
         eddy_current(g10, 0.05, 10e3)
+    # in a scene the same rule is checked against forcing.grid_spacing_m before any mesh work
+    from lagice.scenes.builder import validate_config
+    from lagice.scenes.config import load_scene
+
+    with pytest.raises(ConfigError, match=r"forcing\.ocean\.radius_m = 20000 m spans fewer than three"):
+        validate_config(load_scene("winter_basin_pack", {"forcing.ocean": {"kind": "eddies", "radius_m": 20e3}}))
+    validate_config(load_scene("winter_basin_pack", {"forcing.ocean": {"kind": "eddies", "radius_m": 30e3}}))
 
 
 def test_bad_config(grid):

@@ -234,14 +234,12 @@ def validate(cfg: dict, duration_s: float) -> None:
         else:
             _check_kwargs(t, key, kind)
         if key == "ocean" and kind == "eddies":
-            from forcing.synthetic import eddy_current
+            from forcing.synthetic import check_eddy_resolution, eddy_current
 
             default = inspect.signature(eddy_current).parameters["radius_m"].default
             radius = float(_generator_table(t, key, kind).get("radius_m", default))
-            if fc["grid_spacing_m"] is not None and radius < 3.0 * float(fc["grid_spacing_m"]):
-                raise ConfigError(f"forcing.ocean.radius_m = {radius:g} m spans fewer than three forcing grid "
-                                  f"spacings (forcing.grid_spacing_m = {fc['grid_spacing_m']:g} m): the eddies "
-                                  f"would not be resolved by the records")
+            if fc["grid_spacing_m"] is not None:
+                check_eddy_resolution(radius, float(fc["grid_spacing_m"]), "forcing.ocean.radius_m")
         if kind in ("uniform", "random", "cyclones", "gyre", "eddies", "synthetic"):
             _dry_run(cfg, key, kind, duration_s)
     if fc["coriolis"] is not None:
