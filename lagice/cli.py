@@ -28,6 +28,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import math
 import sys
 from pathlib import Path
 
@@ -248,6 +249,11 @@ def _diagnose(args) -> int:
         raise LagiceError(f"--window-steps = {args.window_steps}: expected an integer >= 1")
     if not args.coast_buffer_km >= 0:
         raise LagiceError(f"--coast-buffer-km = {args.coast_buffer_km}: expected a distance >= 0 km")
+    if args.rgps_error_m is not None and args.window_days is None:
+        raise LagiceError(f"--rgps-error-m = {args.rgps_error_m:g} needs --window-days (the RGPS view is computed "
+                          f"per window)")
+    if args.rgps_error_m is not None and not (math.isfinite(args.rgps_error_m) and args.rgps_error_m >= 0):
+        raise LagiceError(f"--rgps-error-m = {args.rgps_error_m}: expected a tracking error >= 0 m (RGPS: 100)")
     index = read_index(snaps)
     if len(index) < 2:
         raise LagiceError(f"{snaps}: need two snapshots to diagnose deformation (found {len(index)})")
@@ -282,7 +288,8 @@ def _diagnose(args) -> int:
 
 
 def _diagnose_windows(args, snaps, out, window_statistics) -> int:
-    res = window_statistics(snaps, args.window_days, args.coast_buffer_km, args.start_day, args.end_day)
+    res = window_statistics(snaps, args.window_days, args.coast_buffer_km, args.start_day, args.end_day,
+                            rgps_tracking_error_m=args.rgps_error_m)
     out.mkdir(parents=True, exist_ok=True)
     path = out / "window_statistics.json"
     path.write_text(json.dumps(res, indent=1, default=_json_default))
@@ -296,6 +303,10 @@ def _diagnose_windows(args, snaps, out, window_statistics) -> int:
               f"beta {_num(w['interior']['beta_space'])}")
     for key, med in res["median"].items():
         print(f"  {key}: median {_num(med)} [{_num(res['min'][key])}, {_num(res['max'][key])}]")
+    if args.rgps_error_m is not None:
+        print(f"  as RGPS would see it (10 km cells, {args.rgps_error_m:g} m tracking error; without error):")
+        for key, med in res["median_rgps"].items():
+            print(f"  {key}: median {_num(med)} ({_num(res['median_rgps_cells'][key])})")
     return 0
 
 
@@ -375,6 +386,9 @@ def main(argv=None) -> int:
     d.add_argument("--start-day", type=float, default=1.0, help="with --window-days: first window start (spin-up)")
     d.add_argument("--end-day", type=float, default=None, help="with --window-days: last window end (default: "
                                                                "the last snapshot)")
+    d.add_argument("--rgps-error-m", type=float, default=None,
+                   help="with --window-days: also the statistics as RGPS would see them: 10 km cells of tracked "
+                        "points with this tracking error in m (RGPS: 100, Lindsay and Stern 2003)")
     d.add_argument("--out")
     d.set_defaults(func=_diagnose)
     sc = sub.add_parser("scenes", help="list bundled scenes", parents=[common])

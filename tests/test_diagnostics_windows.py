@@ -136,3 +136,30 @@ def test_cli_diagnose_windows_on_a_real_run(tmp_path):
     xy0, xy1, tri, dt, info = window_arrays(run, 3 * DAY, 4 * DAY, 15e3)
     s = summarise(xy0, xy1, tri[info["interior"]], dt)
     assert s["beta_space"] == pytest.approx(last["interior"]["beta_space"], rel=1e-12)
+    # the RGPS view: with --window-days it adds the cells' medians; without, it is refused by name
+    rg = _cli("diagnose", str(run), "--window-days", "1", "--start-day", "1", "--coast-buffer-km", "15",
+              "--rgps-error-m", "100", "--out", str(tmp_path / "rgps"))
+    assert "as RGPS would see it (10 km cells, 100 m tracking error" in rg.stdout
+    got_rgps = json.loads((tmp_path / "rgps" / "window_statistics.json").read_text())
+    assert got_rgps["median"] == got["median"] and got_rgps["rgps_tracking_error_m"] == 100.0
+    assert got_rgps["median_rgps"]["mean_total_s"] > got_rgps["median_rgps_cells"]["mean_total_s"] > 0
+    bad = subprocess.run([sys.executable, "-m", "lagice.cli", "diagnose", str(run), "--rgps-error-m", "100"],
+                         capture_output=True, text=True, timeout=600)
+    assert bad.returncode != 0 and "--rgps-error-m = 100 needs --window-days" in bad.stderr
+
+
+def test_window_statistics_as_rgps_would_see_them(shear_run):
+    """A uniform simple shear seen through the operator: without error the cells give the
+    field's rate exactly; with the 100 m error the mean rate rises by the error's part."""
+    res = window_statistics(shear_run, window_days=3.0, coast_buffer_km=60.0, start_day=1.0,
+                            rgps_tracking_error_m=100.0, rgps_seed=0)
+    for w in res["windows"]:
+        assert w["rgps_cells"]["mean_shear_s"] == pytest.approx(GAMMA, rel=1e-9)
+        assert w["rgps_cells"]["tracking_error_m"] == 0.0
+        assert w["rgps"]["n_cells"] == w["rgps_cells"]["n_cells"] > 100
+        assert w["rgps"]["mean_total_s"] > w["rgps_cells"]["mean_total_s"]
+    assert res["median_rgps_cells"]["mean_total_s"] == pytest.approx(GAMMA, rel=1e-9)
+    assert res["rgps_tracking_error_m"] == 100.0
+    # the model part is unchanged by asking for the operator
+    plain = window_statistics(shear_run, window_days=3.0, coast_buffer_km=60.0, start_day=1.0)
+    assert plain["median"] == res["median"]

@@ -120,15 +120,6 @@ def summarise(nodes_xy0, nodes_xy1, triangles, dt_s, *, geometry="mid", box_size
     dt = positive("dt_s", dt_s, "s")
     choice("geometry", geometry, GEOMETRIES)
     rates = _lagrangian(x0, x1, tri, dt, geometry)
-    div, shear, tot = rates.divergence_s, rates.shear_s, rates.total_s
-
-    sp = spatial_scaling(rates, box_sizes_m, min_coverage, fit_range_m, include_element_scale,
-                         min_boxes=min_boxes)
-    box_sizes = list(sp.coarse.box_size_m[np.isfinite(sp.coarse.mean_total_s)])
-    n_boxes = list(sp.coarse.n_boxes[np.isfinite(sp.coarse.mean_total_s)])
-    if include_element_scale:
-        box_sizes = [None] + box_sizes
-        n_boxes = [tri.shape[0]] + n_boxes
 
     tm = None
     if nodes_xy_series is not None:
@@ -137,18 +128,58 @@ def summarise(nodes_xy0, nodes_xy1, triangles, dt_s, *, geometry="mid", box_size
         tm = temporal_scaling(nodes_xy_series, tri, series_dt_s, window_steps, geometry,
                               fit_range_s=fit_range_s)
 
-    tail_s = fit_power_law_tail(shear, tail_x_min_shear_s, min_tail)
-    tail_d = fit_power_law_tail(np.abs(div), tail_x_min_divergence_s, min_tail)
-    dyn = positive("pdf_dynamic_range", pdf_dynamic_range)
-    pdf_s = log_binned_pdf(shear, pdf_bins_per_decade, _pdf_floor(shear, dyn))
-    pdf_d = log_binned_pdf(np.abs(div), pdf_bins_per_decade, _pdf_floor(np.abs(div), dyn))
-
+    stats, arrays = rate_statistics(
+        rates, box_sizes_m=box_sizes_m, min_coverage=min_coverage, fit_range_m=fit_range_m,
+        include_element_scale=include_element_scale, min_boxes=min_boxes,
+        tail_x_min_shear_s=tail_x_min_shear_s, tail_x_min_divergence_s=tail_x_min_divergence_s,
+        min_tail=min_tail, pdf_dynamic_range=pdf_dynamic_range, pdf_bins_per_decade=pdf_bins_per_decade)
     out = {
         "schema_version": SCHEMA_VERSION,
         "n_nodes": int(x0.shape[0]),
         "n_elements": int(tri.shape[0]),
         "dt_s": dt,
         "geometry": geometry,
+        **stats,
+        "alpha_time": None if tm is None else tm.fit.exponent,
+        "alpha_time_stderr": None if tm is None else tm.fit.exponent_stderr,
+        "alpha_time_fit_range_s": None if tm is None else list(tm.fit.fit_range),
+        "scaling_time": None if tm is None else {
+            "window_s": list(tm.window_s), "mean_total_s": list(tm.mean_total_s),
+            "n_windows": [int(n) for n in tm.n_windows]},
+    }
+    out = {k: out[k] for k in JSON_KEYS if k in out}  # the documented key order
+    out["_arrays"] = {**arrays, "temporal": tm,
+                      "map_xy": 0.5 * (x0 + x1) if geometry == "mid" else (x0 if geometry == "start" else x1),
+                      "triangles": tri}
+    return out
+
+
+def rate_statistics(rates, *, box_sizes_m=None, min_coverage=0.75, fit_range_m=None, include_element_scale=True,
+                    min_boxes=MIN_FIT_BOXES, origin_xy_m=None, tail_x_min_shear_s=None,
+                    tail_x_min_divergence_s=None, min_tail=50, pdf_dynamic_range=1e6, pdf_bins_per_decade=10):
+    """The statistics of :func:`summarise` that depend only on the element rates.
+
+    ``rates`` is an :class:`~lagice.diagnostics.strain.ElementStrainRates` of any
+    cells (model triangles, or RGPS-like cells from :mod:`lagice.diagnostics.rgps`);
+    the keyword arguments are those of :func:`summarise` (``origin_xy_m``: lower-left
+    corner of the box grid, see :func:`coarse_grain`). Returns ``(stats, arrays)``:
+    the JSON keys from ``mean_divergence_s`` to ``shear_divergence_r2`` (no temporal
+    scaling), and the result objects for figures (``rates``, ``spatial``, ``pdf``,
+    ``tail``)."""
+    div, shear, tot = rates.divergence_s, rates.shear_s, rates.total_s
+    sp = spatial_scaling(rates, box_sizes_m, min_coverage, fit_range_m, include_element_scale,
+                         origin_xy_m=origin_xy_m, min_boxes=min_boxes)
+    box_sizes = list(sp.coarse.box_size_m[np.isfinite(sp.coarse.mean_total_s)])
+    n_boxes = list(sp.coarse.n_boxes[np.isfinite(sp.coarse.mean_total_s)])
+    if include_element_scale:
+        box_sizes = [None] + box_sizes
+        n_boxes = [int(div.size)] + n_boxes
+    tail_s = fit_power_law_tail(shear, tail_x_min_shear_s, min_tail)
+    tail_d = fit_power_law_tail(np.abs(div), tail_x_min_divergence_s, min_tail)
+    dyn = positive("pdf_dynamic_range", pdf_dynamic_range)
+    pdf_s = log_binned_pdf(shear, pdf_bins_per_decade, _pdf_floor(shear, dyn))
+    pdf_d = log_binned_pdf(np.abs(div), pdf_bins_per_decade, _pdf_floor(np.abs(div), dyn))
+    stats = {
         "mean_divergence_s": float(np.mean(div)),
         "mean_abs_divergence_s": float(np.mean(np.abs(div))),
         "mean_shear_s": float(np.mean(shear)),
@@ -161,12 +192,6 @@ def summarise(nodes_xy0, nodes_xy1, triangles, dt_s, *, geometry="mid", box_size
         "scaling_space": {"box_size_m": box_sizes, "scale_m": list(sp.scale_m),
                           "mean_total_s": list(sp.mean_total_s), "n_boxes": [int(n) for n in n_boxes]},
         "min_box_coverage": sp.coarse.min_coverage,
-        "alpha_time": None if tm is None else tm.fit.exponent,
-        "alpha_time_stderr": None if tm is None else tm.fit.exponent_stderr,
-        "alpha_time_fit_range_s": None if tm is None else list(tm.fit.fit_range),
-        "scaling_time": None if tm is None else {
-            "window_s": list(tm.window_s), "mean_total_s": list(tm.mean_total_s),
-            "n_windows": [int(n) for n in tm.n_windows]},
         "pdf_tail_exponent_shear": tail_s.exponent,
         "pdf_tail_exponent_shear_stderr": tail_s.exponent_stderr,
         "pdf_tail_fit_range_shear_s": [tail_s.x_min, tail_s.x_max],
@@ -182,12 +207,9 @@ def summarise(nodes_xy0, nodes_xy1, triangles, dt_s, *, geometry="mid", box_size
         "localisation_half_shear_area_fraction": localisation_area_fraction(shear, rates.area_m2, 0.5),
         "shear_divergence_r2": shear_divergence_r2(shear, div),
     }
-    out["_arrays"] = {"rates": rates, "spatial": sp, "temporal": tm,
-                      "pdf": {"shear": pdf_s, "|divergence|": pdf_d},
-                      "tail": {"shear": tail_s, "|divergence|": tail_d},
-                      "map_xy": 0.5 * (x0 + x1) if geometry == "mid" else (x0 if geometry == "start" else x1),
-                      "triangles": tri}
-    return out
+    arrays = {"rates": rates, "spatial": sp, "pdf": {"shear": pdf_s, "|divergence|": pdf_d},
+              "tail": {"shear": tail_s, "|divergence|": tail_d}}
+    return stats, arrays
 
 
 def _pdf_floor(values, dynamic_range):

@@ -82,7 +82,8 @@ def window_arrays(run_dir, start_s: float, end_s: float, coast_buffer_m: float =
 
 
 def window_summary(run_dir, start_s: float, window_s: float, coast_buffer_m: float = 0.0,
-                   keep_arrays: bool = False) -> dict:
+                   keep_arrays: bool = False, rgps_tracking_error_m: float | None = None,
+                   rgps_seed: int = 0) -> dict:
     """Statistics of one Lagrangian window ``[start_s, start_s + window_s]`` [s].
 
     Returns ``{"start_day", "end_day", "n_elements" (kept), "n_elements_all",
@@ -90,8 +91,13 @@ def window_summary(run_dir, start_s: float, window_s: float, coast_buffer_m: flo
     :data:`WINDOW_KEYS` of :func:`lagice.diagnostics.summarise` on the elements
     ``coast_buffer_m`` [m] from the boundary (``interior``) and on all elements.
     ``keep_arrays``: ``interior`` also holds ``"_map"`` = (element-map node
-    positions, triangles, shear rate [s-1]) for figures (not JSON-serialisable)."""
-    from lagice.diagnostics.report import summarise
+    positions, triangles, shear rate [s-1]) for figures (not JSON-serialisable).
+    ``rgps_tracking_error_m``: also the statistics of the interior as RGPS would see
+    it (:func:`lagice.diagnostics.rgps.rgps_cells`: 10 km cells, this tracking error
+    [m], seeded by ``(rgps_seed, start_s)``) under ``rgps``, and of the same cells
+    without error under ``rgps_cells``; each with ``n_cells``."""
+    from lagice.diagnostics.report import rate_statistics, summarise
+    from lagice.diagnostics.rgps import rgps_cells
 
     xy0, xy1, tri, dt, info = window_arrays(run_dir, start_s, start_s + window_s, coast_buffer_m)
     out = {"start_day": info["start_s"] / DAY_S, "end_day": info["end_s"] / DAY_S,
@@ -104,6 +110,13 @@ def window_summary(run_dir, start_s: float, window_s: float, coast_buffer_m: flo
         if name == "interior" and keep_arrays:
             res["_map"] = (arr["map_xy"], sub, arr["rates"].shear_s)
         out[name] = res
+    if rgps_tracking_error_m is not None:
+        sub = tri[info["interior"]]
+        for name, err in (("rgps", rgps_tracking_error_m), ("rgps_cells", 0.0)):
+            rates, ci = rgps_cells(xy0, xy1, sub, dt, tracking_error_m=err, seed=(rgps_seed, int(round(start_s))))
+            st, _ = rate_statistics(rates)
+            out[name] = {**{k: st[k] for k in WINDOW_KEYS}, "n_cells": ci["n_cells"],
+                         "tracking_error_m": ci["tracking_error_m"], "seed": ci["seed"]}
     return out
 
 
@@ -127,7 +140,8 @@ def window_starts_days(run_dir, window_days: float, start_day: float = 1.0, end_
 
 
 def window_statistics(run_dir, window_days: float = 3.0, coast_buffer_km: float = 100.0, start_day: float = 1.0,
-                      end_day: float | None = None, metrics=WINDOW_METRICS, keep_arrays: bool = False) -> dict:
+                      end_day: float | None = None, metrics=WINDOW_METRICS, keep_arrays: bool = False,
+                      rgps_tracking_error_m: float | None = None, rgps_seed: int = 0) -> dict:
     """Deformation statistics over back-to-back Lagrangian windows of a run.
 
     Args:
@@ -139,6 +153,9 @@ def window_statistics(run_dir, window_days: float = 3.0, coast_buffer_km: float 
         end_day: last window end [days] (default: the last snapshot).
         metrics: the per-window keys summarised over the windows.
         keep_arrays: keep the element maps of each window (see :func:`window_summary`).
+        rgps_tracking_error_m, rgps_seed: also the statistics as RGPS would see them
+            (see :func:`window_summary`), summarised as ``median_rgps`` (with the
+            tracking error) and ``median_rgps_cells`` (the same cells without it).
 
     Returns ``{"window_days", "coast_buffer_km", "start_day", "windows": [per-window
     dicts of :func:`window_summary`], "skipped": [{"start_day", "end_day", "reason"}],
@@ -152,7 +169,7 @@ def window_statistics(run_dir, window_days: float = 3.0, coast_buffer_km: float 
     for t in starts:
         try:
             windows.append(window_summary(run_dir, t * DAY_S, window_days * DAY_S, coast_buffer_km * 1e3,
-                                          keep_arrays))
+                                          keep_arrays, rgps_tracking_error_m, rgps_seed))
         except WindowError as exc:
             skipped.append({"start_day": float(t), "end_day": float(t + window_days), "reason": str(exc)})
     if not windows:
@@ -166,7 +183,12 @@ def window_statistics(run_dir, window_days: float = 3.0, coast_buffer_km: float 
             out[k] = float(fn(v)) if v.size else None
         return out
 
-    return {"window_days": float(window_days), "coast_buffer_km": float(coast_buffer_km),
-            "start_day": float(start_day), "windows": windows, "skipped": skipped,
-            "median": over(np.median, "interior"), "min": over(np.min, "interior"),
-            "max": over(np.max, "interior"), "median_all_elements": over(np.median, "all")}
+    out = {"window_days": float(window_days), "coast_buffer_km": float(coast_buffer_km),
+           "start_day": float(start_day), "windows": windows, "skipped": skipped,
+           "median": over(np.median, "interior"), "min": over(np.min, "interior"),
+           "max": over(np.max, "interior"), "median_all_elements": over(np.median, "all")}
+    if rgps_tracking_error_m is not None:
+        out["rgps_tracking_error_m"] = float(rgps_tracking_error_m)
+        out["median_rgps"] = over(np.median, "rgps")
+        out["median_rgps_cells"] = over(np.median, "rgps_cells")
+    return out
