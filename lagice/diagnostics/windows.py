@@ -95,7 +95,7 @@ def window_summary(run_dir, start_s: float, window_s: float, coast_buffer_m: flo
     ``rgps_tracking_error_m``: also the statistics of the interior as RGPS would see
     it (:func:`lagice.diagnostics.rgps.rgps_cells`: 10 km cells, this tracking error
     [m], seeded by ``(rgps_seed, start_s)``) under ``rgps``, and of the same cells
-    without error under ``rgps_cells``; each with ``n_cells``."""
+    without error under ``rgps_cells``; each with ``n_cells`` (and without the PDFs)."""
     from lagice.diagnostics.report import rate_statistics, summarise
     from lagice.diagnostics.rgps import rgps_cells
 
@@ -115,7 +115,8 @@ def window_summary(run_dir, start_s: float, window_s: float, coast_buffer_m: flo
         for name, err in (("rgps", rgps_tracking_error_m), ("rgps_cells", 0.0)):
             rates, ci = rgps_cells(xy0, xy1, sub, dt, tracking_error_m=err, seed=(rgps_seed, int(round(start_s))))
             st, _ = rate_statistics(rates)
-            out[name] = {**{k: st[k] for k in WINDOW_KEYS}, "n_cells": ci["n_cells"],
+            out[name] = {**{k: st[k] for k in WINDOW_KEYS if not k.startswith("pdf_") or k.startswith("pdf_tail")},
+                         "n_cells": ci["n_cells"],
                          "tracking_error_m": ci["tracking_error_m"], "seed": ci["seed"]}
     return out
 
