@@ -10,6 +10,7 @@ chooses by size.
 from __future__ import annotations
 
 import logging
+import math
 import os
 import time
 import types
@@ -61,7 +62,7 @@ AUTOTUNE_MIN_SIZE = int(os.environ.get("LAGICE_AUTOTUNE_MIN_SIZE", "2000"))
 AUTOTUNE_MARGIN = 1.05
 
 
-def autotune(trial, n_elements: int, *, max_threads: int | None = None, repeats: int = 3,
+def autotune(trial, n_elements: int, *, max_threads: int | None = None, repeats: int = 5,
              min_size: int | None = None, what: str = "kernels") -> dict:
     """Choose serial or parallel kernel builds and the thread count by measurement.
 
@@ -70,8 +71,8 @@ def autotune(trial, n_elements: int, *, max_threads: int | None = None, repeats:
     and parallel with 2..``max_threads`` numba threads (default: numba's current
     thread count, ``numba.get_num_threads()``: ``NUMBA_NUM_THREADS`` or what
     ``numba.set_num_threads`` limited it to), is run once to warm up (loads the compiled kernels), then timed
-    ``repeats`` times; the best time of each counts. The parallel build is chosen
-    only when it is :data:`AUTOTUNE_MARGIN` faster than the serial one. Below
+    ``repeats`` times, the candidates interleaved round by round; the best time of each
+    counts. The parallel build is chosen only when it is :data:`AUTOTUNE_MARGIN` faster than the serial one. Below
     ``min_size`` elements (default :data:`AUTOTUNE_MIN_SIZE`) the serial build is
     chosen without measuring.
 
@@ -91,16 +92,20 @@ def autotune(trial, n_elements: int, *, max_threads: int | None = None, repeats:
         cands = [(False, 1)] + [(True, t) for t in range(2, n_max + 1)]
         best = {}
         try:
-            for par, t in cands:
+            for par, t in cands:  # warm-up: loads (or compiles) each build
                 if par:
                     numba.set_num_threads(t)
-                trial(par)  # warm-up: loads (or compiles) the build
-                ts = []
-                for _ in range(max(1, int(repeats))):
+                trial(par)
+            # candidates interleaved, round after round: a disturbance of a few ms (another
+            # process, the hypervisor) then hits every candidate alike instead of one
+            for _ in range(max(1, int(repeats))):
+                for par, t in cands:
+                    if par:
+                        numba.set_num_threads(t)
                     t0 = time.perf_counter()
                     trial(par)
-                    ts.append(time.perf_counter() - t0)
-                best[(par, t)] = min(ts)
+                    dt = time.perf_counter() - t0
+                    best[(par, t)] = min(best.get((par, t), math.inf), dt)
         finally:
             numba.set_num_threads(before)
         t_ser = best[(False, 1)]
