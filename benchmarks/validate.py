@@ -125,13 +125,14 @@ PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-1125", "strait_maxwell_eb": "F1
                 "sensitivity_drag-50": "X10h-drag-50", "sensitivity_drag+50": "X10h-drag+50",
                 "sensitivity_wind-50": "X10h-wind-50", "sensitivity_wind+50": "X10h-wind+50"}
 #: the weather ensemble of the flagship Maxwell-EB runs (--from-physics): the validation run
-#: (wind seed 2026, the scene's) and the same set-up under the winds of seeds 2027-2029
+#: (wind seed 2026, the scene's) and the same set-up under the winds of seeds 2027-2033 for
+#: the shipped pack (eight months since 2026-11-26), 2027-2029 for the pack shipped before
 #: (benchmarks/physics_experiments.py ENSEMBLES). One 28-day run is one sample of the
 #: weather: whether a metric is inside its band is read from how many members are inside.
 #: The pack shipped before 2026-11-25 (F10-1125...) is the comparison.
 PHYSICS_ENSEMBLE = {
-    "closed": ["F10-hthick-1125"] + [f"F10-hthick-1125-w{y}" for y in (2027, 2028, 2029)],
-    "strait": ["F10s-hthick-1125"] + [f"F10s-hthick-1125-w{y}" for y in (2027, 2028, 2029)],
+    "closed": ["F10-hthick-1125"] + [f"F10-hthick-1125-w{y}" for y in range(2027, 2034)],
+    "strait": ["F10s-hthick-1125"] + [f"F10s-hthick-1125-w{y}" for y in range(2027, 2034)],
     "closed, pack shipped before 2026-11-25": ["F10-1125"] + [f"F10-1125-w{y}" for y in (2027, 2028, 2029)],
     "strait, pack shipped before 2026-11-25": ["F10s-1125"] + [f"F10s-1125-w{y}" for y in (2027, 2028, 2029)]}
 RHEOLOGIES = {
@@ -672,7 +673,7 @@ def headline(res: dict) -> list[str]:
         cells = []
         for s, k in cols:
             v = res["basin"][s][k]["median"][m]
-            cells.append(_fmt(m, v) + (" ✓" if v is not None and np.isfinite(v) and lo <= v <= hi else " ✗"))
+            cells.append(_fmt(m, v) + (_inside_mark(m, v) or " ✗"))
         lines.append(f"| {LABELS[m]} | {_fmt(m, lo)}–{_fmt(m, hi)} | " + " | ".join(cells) + " |")
     lines.append("| remesh events | | " + " | ".join(str(res["basin"][s][k]["remesh_events"]) for s, k in cols) + " |")
     lines.append("| mean / largest drift (km) | tens of km | " + " | ".join(
@@ -794,9 +795,11 @@ def ensemble_lines(ens: dict) -> list[str]:
     """Markdown: per basin, each member's medians and how many members are inside each band."""
     if not ens:
         return []
-    lines = ["## Weather ensemble of the flagship (Maxwell-EB, four months of winds)", "",
+    months = sorted({len(e["members"]) for e in ens.values()})
+    span = f"{months[0]}–{months[-1]}" if len(months) > 1 else str(months[0])
+    lines = [f"## Weather ensemble of the flagship (Maxwell-EB, {span} months of winds)", "",
              "The validation run and the same set-up (spin-up state, strength disorder, parameters) under the "
-             "winds of three other seeds of the wind climatology (`python benchmarks/physics_experiments.py run "
+             "winds of other seeds of the wind climatology (`python benchmarks/physics_experiments.py run "
              + " ".join(n for e in ens.values() for n in list(e["members"])[1:]) + "`; `PHYSICS_ENSEMBLE` of "
              "`benchmarks/validate.py`). Medians of the 3-day windows per member; the last columns give "
              "the median over the members and how many members are inside the band.", ""]
@@ -844,7 +847,8 @@ def rgps_view_lines(res: dict) -> list[str]:
     lines.append("")
     ens = res.get("weather_ensemble") or {}
     if any("rgps_metrics" in e for e in ens.values()):
-        lines += ["Weather ensemble (Maxwell-EB, four months), median over the members: the model's elements / "
+        lines += ["Weather ensemble (Maxwell-EB, the months of the section above), median over the members: "
+                  "the model's elements / "
                   f"10 km cells with the {err:g} m error:", "",
                   "| metric | observed | " + " | ".join(ens) + " |", "|---|---|" + "---|" * len(ens)]
         for m, (lo, hi, _src, _n) in TARGETS.items():
