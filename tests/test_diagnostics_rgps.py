@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from lagice.diagnostics.report import rate_statistics
-from lagice.diagnostics.rgps import RGPS_CELL_M, RGPS_TRACKING_ERROR_M, rgps_cells
+from lagice.diagnostics.rgps import RGPS_CELL_M, RGPS_TRACKING_ERROR_M, observe, rgps_cells
 from lagice.diagnostics.synthetic import jittered_grid_mesh
 from lagice.errors import ConfigError
 
@@ -80,3 +80,18 @@ def test_bad_arguments_are_named(mesh):
         rgps_cells(xy, xy, tri, DT, cell_m=1e6)
     with pytest.raises(ConfigError, match="dt_s"):
         rgps_cells(xy, xy, tri, 0.0)
+
+
+def test_observe_is_rgps_cells_without_relaying_the_grid(mesh):
+    """The error-free cells seen with an error give what rgps_cells with that error and seed gives."""
+    xy, tri = mesh
+    g = np.array([[2e-7, 1e-7], [-1e-7, 0.5e-7]])
+    xy1 = xy + DT * (xy @ g.T)
+    direct, dinfo = rgps_cells(xy, xy1, tri, DT, tracking_error_m=RGPS_TRACKING_ERROR_M, seed=(5, 7))
+    _, truth = rgps_cells(xy, xy1, tri, DT, tracking_error_m=0.0)
+    seen, sinfo = observe(truth, DT, RGPS_TRACKING_ERROR_M, seed=(5, 7))
+    assert np.array_equal(seen.gradient_s, direct.gradient_s)
+    assert sinfo["seed"] == dinfo["seed"] == [5, 7] and sinfo["tracking_error_m"] == RGPS_TRACKING_ERROR_M
+    assert truth["tracking_error_m"] == 0.0  # the error-free record is left as it was
+    with pytest.raises(ConfigError, match="already carry a 100 m tracking error"):
+        observe(sinfo, DT, 50.0)

@@ -112,6 +112,24 @@ def rgps_cells(nodes_xy0, nodes_xy1, triangles, dt_s, *, cell_m=RGPS_CELL_M, tra
     e, wk = elem[keep], w[keep]
     p0 = pts0[keep]
     p1 = p0 + np.einsum("kj,kjc->kc", wk, (x1 - x0)[tri[e]])
+    truth = {"n_cells": int(cells.shape[0]), "cell_m": cell, "tracking_error_m": 0.0, "seed": None,
+             "origin_xy_m": [float(lo[0]), float(lo[1])], "points_xy0": p0, "points_xy1": p1, "cells": cells}
+    return observe(truth, dt, tracking_error_m, seed)
+
+
+def observe(cells_info: dict, dt_s, tracking_error_m=RGPS_TRACKING_ERROR_M, seed=0):
+    """The cells of an error-free :func:`rgps_cells` result (``tracking_error_m = 0``) seen
+    with another tracking error: ``(rates, info)`` as :func:`rgps_cells` with that error and
+    seed returns them, without laying and locating the grid again (steps 3 and 4 of the
+    module doc)."""
+    if cells_info["tracking_error_m"] != 0.0:
+        raise ConfigError(f"observe: the cells already carry a {cells_info['tracking_error_m']:g} m tracking error; "
+                          f"pass the result of rgps_cells(..., tracking_error_m=0)")
+    if not (math.isfinite(tracking_error_m) and tracking_error_m >= 0.0):
+        raise ConfigError(f"tracking_error_m = {tracking_error_m!r}: expected a standard deviation >= 0 m "
+                          f"(RGPS: {RGPS_TRACKING_ERROR_M:g} m)")
+    dt = positive("dt_s", dt_s, "s")
+    p0, p1, cells = cells_info["points_xy0"], cells_info["points_xy1"], cells_info["cells"]
     if tracking_error_m > 0.0:
         p1 = p1 + np.random.default_rng(seed).normal(0.0, tracking_error_m, p1.shape)
     halves = np.concatenate([cells[:, [0, 1, 2]], cells[:, [0, 2, 3]]])
@@ -122,7 +140,6 @@ def rgps_cells(nodes_xy0, nodes_xy1, triangles, dt_s, *, cell_m=RGPS_CELL_M, tra
     grad = (r.gradient_s.reshape(2, k, 2, 2) * a[..., None, None]).sum(axis=0) / area[:, None, None]
     cen = (r.centroid_xy_m.reshape(2, k, 2) * a[..., None]).sum(axis=0) / area[:, None]
     rates = ElementStrainRates(grad, area, cen, r.bounds_m)
-    info = {"n_cells": int(k), "cell_m": cell, "tracking_error_m": float(tracking_error_m),
-            "seed": seed if np.isscalar(seed) else [int(v) for v in seed],
-            "origin_xy_m": [float(lo[0]), float(lo[1])], "points_xy0": p0, "points_xy1": p1, "cells": cells}
+    info = {**cells_info, "tracking_error_m": float(tracking_error_m),
+            "seed": seed if np.isscalar(seed) else [int(v) for v in seed], "points_xy1": p1}
     return rates, info

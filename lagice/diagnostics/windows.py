@@ -42,6 +42,8 @@ WINDOW_KEYS = ("beta_space", "beta_space_stderr", "beta_space_r2", "beta_space_f
                "pdf_tail_ks_divergence", "localisation_half_shear_area_fraction", "shear_divergence_r2",
                "mean_total_s", "mean_shear_s", "mean_abs_divergence_s", "scaling_space", "pdf_shear",
                "pdf_divergence", "element_scale_m")
+#: the per-window keys kept for the RGPS view (:data:`WINDOW_KEYS` without the PDFs)
+RGPS_WINDOW_KEYS = tuple(k for k in WINDOW_KEYS if k not in ("pdf_shear", "pdf_divergence"))
 
 
 def window_arrays(run_dir, start_s: float, end_s: float, coast_buffer_m: float = 0.0, min_elements: int = 10):
@@ -97,7 +99,7 @@ def window_summary(run_dir, start_s: float, window_s: float, coast_buffer_m: flo
     [m], seeded by ``(rgps_seed, start_s)``) under ``rgps``, and of the same cells
     without error under ``rgps_cells``; each with ``n_cells`` (and without the PDFs)."""
     from lagice.diagnostics.report import rate_statistics, summarise
-    from lagice.diagnostics.rgps import rgps_cells
+    from lagice.diagnostics.rgps import observe, rgps_cells
 
     xy0, xy1, tri, dt, info = window_arrays(run_dir, start_s, start_s + window_s, coast_buffer_m)
     out = {"start_day": info["start_s"] / DAY_S, "end_day": info["end_s"] / DAY_S,
@@ -111,12 +113,11 @@ def window_summary(run_dir, start_s: float, window_s: float, coast_buffer_m: flo
             res["_map"] = (arr["map_xy"], sub, arr["rates"].shear_s)
         out[name] = res
     if rgps_tracking_error_m is not None:
-        sub = tri[info["interior"]]
-        for name, err in (("rgps", rgps_tracking_error_m), ("rgps_cells", 0.0)):
-            rates, ci = rgps_cells(xy0, xy1, sub, dt, tracking_error_m=err, seed=(rgps_seed, int(round(start_s))))
+        truth = rgps_cells(xy0, xy1, tri[info["interior"]], dt, tracking_error_m=0.0)
+        seen = observe(truth[1], dt, rgps_tracking_error_m, seed=(rgps_seed, int(round(start_s))))
+        for name, (rates, ci) in (("rgps", seen), ("rgps_cells", truth)):
             st, _ = rate_statistics(rates)
-            out[name] = {**{k: st[k] for k in WINDOW_KEYS if not k.startswith("pdf_") or k.startswith("pdf_tail")},
-                         "n_cells": ci["n_cells"],
+            out[name] = {**{k: st[k] for k in RGPS_WINDOW_KEYS}, "n_cells": ci["n_cells"],
                          "tracking_error_m": ci["tracking_error_m"], "seed": ci["seed"]}
     return out
 

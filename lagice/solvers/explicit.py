@@ -75,7 +75,7 @@ AUTOTUNE_WORK = 300_000
 #: with ``parallel="auto"`` the choice is measured again after this much wall time [s]
 #: (the load of a shared machine changes during a long run; a measurement costs ~0.05 s,
 #: 0.1 % of a minute); the second measurement comes sooner, after
-#: :data:`AUTOTUNE_FIRST_INTERVAL_S`: on the idle 2-vCPU VM, 3 of 10 start-up measurements
+#: :data:`AUTOTUNE_FIRST_INTERVAL_S`: on the idle 2-vCPU VM, 3 of 12 start-up measurements
 #: took the serial build (a parallel trial as slow as the serial one, a passing
 #: disturbance) for runs that then went 1.8x slower than with the parallel build
 #: (docs/benchmarks.md, 2026-11-26). Serial and parallel builds give identical results, so
