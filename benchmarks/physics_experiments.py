@@ -232,9 +232,11 @@ EXPERIMENTS["E10h"] = ("closed", from_spinup("H1125") + EVP, 10e3, 28,
                        "EVP, closed, 10 km, from the thick-and-thin pack (the shipped state since 2026-11-25)")
 EXPERIMENTS["E10hs"] = ("strait", from_spinup("H1125") + EVP, 10e3, 28,
                         "EVP, strait, 10 km, from the thick-and-thin pack (the shipped state since 2026-11-25)")
-for _key, _lo, _hi, _what in (("str", "rheology.strength_lab_pa=1.4e6", "rheology.strength_lab_pa=4.2e6", "strength"),
-                              ("drag", "forcing.drag.air_drag=1.0e-3", "forcing.drag.air_drag=3.0e-3", "air drag"),
-                              ("wind", "forcing.wind.wind_scale=0.5", "forcing.wind.wind_scale=1.5", "winds")):
+#: the ±50 % changes of the sensitivity runs: (key, −50 %, +50 %, what)
+SENSITIVITY_CHANGES = (("str", "rheology.strength_lab_pa=1.4e6", "rheology.strength_lab_pa=4.2e6", "strength"),
+                       ("drag", "forcing.drag.air_drag=1.0e-3", "forcing.drag.air_drag=3.0e-3", "air drag"),
+                       ("wind", "forcing.wind.wind_scale=0.5", "forcing.wind.wind_scale=1.5", "winds"))
+for _key, _lo, _hi, _what in SENSITIVITY_CHANGES:
     EXPERIMENTS[f"X10h-{_key}-50"] = ("closed", from_spinup("H1125") + [_lo], 10e3, 28,
                                       f"{_what} −50 %, 10 km, thick-and-thin pack")
     EXPERIMENTS[f"X10h-{_key}+50"] = ("closed", from_spinup("H1125") + [_hi], 10e3, 28,
@@ -391,6 +393,27 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
             f"{_p}-hthick-K50-meso, the weather of wind seed {_seed}")
     ENSEMBLES[f"thick-and-thin K50 + 30-80 km thickness, {_basin}"] = (
         [f"{_p}-hthick-K50-meso"] + [f"{_p}-hthick-K50-meso-w{s}" for s in ENSEMBLE_SEEDS])
+# --- 2026-11-26 (fourth session): neXtSIM's compressive term ------------------------------
+# neXtSIM's updateSigmaDamage relaxes the stress of compressed ice only by the part of the
+# mean stress above P_max = 10 kPa h^1.5 exp(-20(1-A)) (its dynamics.compression_factor,
+# exponent_compression_factor): damaged ice under a weaker compression is elastic and does
+# not creep, and ice above P_max relaxes towards it (ridging). lagice had the viscous creep
+# of damaged ice at every stress. Sourced physics, not a calibration. Its own spin-up (the
+# same term), then the four months of the earlier ensembles (seeds 2026-2029) in each basin.
+# The rule for adopting it, written before the runs: over those four months the medians put
+# no fewer bands inside than the shipped set's (closed 3, strait 2), and neither the median
+# rate nor the median beta moves further from its band.
+PMAX = ["rheology.max_pressure_pa=10e3", "rheology.max_pressure_thickness_exponent=1.5"]
+SPINUPS["H1126-P"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + PMAX, OUT / "spinup-H1126-P.npz", 10e3)
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    _k = PMAX + from_spinup("H1126-P")
+    EXPERIMENTS[f"{_p}-hthick-P"] = (_basin, _k, 10e3, 28,
+                                     f"{_p}-hthick-1125 with neXtSIM's compressive term, from its own spin-up")
+    for _seed in ENSEMBLE_SEEDS:
+        EXPERIMENTS[f"{_p}-hthick-P-w{_seed}"] = (_basin, _k + [f"forcing.wind.seed={_seed}"], 10e3, 28,
+                                                  f"{_p}-hthick-P, the weather of wind seed {_seed}")
+    ENSEMBLES[f"thick-and-thin + compressive term, {_basin}"] = (
+        [f"{_p}-hthick-P"] + [f"{_p}-hthick-P-w{s}" for s in ENSEMBLE_SEEDS])
 for _i in (1, 2, 3):
     EXPERIMENTS[f"W20-d{_i}"] = ("closed", ["forcing.wind.seed=2026", f"run.seed={_i}"], 20e3, 28,
                                  f"as W20, strength disorder of run seed {_i} (same weather)")
@@ -401,6 +424,37 @@ for _i in (1, 2, 3):
 for _name, (_sc, _ov, _res, _days, _what) in list(EXPERIMENTS.items()):
     if not any(o.startswith("initial.state_file=") for o in _ov):
         EXPERIMENTS[_name] = (_sc, from_spinup("shipped-1123") + _ov, _res, _days, _what)
+
+# --- 2026-11-26 (fourth session): the compressive term joins the shipped set -----------------
+# By the rule above (four months, both basins) the term was adopted: examples/
+# winter_basin_pack.toml sets it, and data_stubs/winter_basin_spinup.npz is remade with it
+# (`spinup`, bit for bit spinup-H1126-P.npz). Every experiment and spin-up defined before
+# that keeps its meaning: it is pinned to the term off (max_pressure_pa = 0).
+NO_PMAX = ["rheology.max_pressure_pa=0"]
+for _name, (_sc, _ov, _res, _days, _what) in list(EXPERIMENTS.items()):
+    if not any(o.startswith("rheology.max_pressure_pa=") for o in _ov):
+        EXPERIMENTS[_name] = (_sc, _ov + NO_PMAX, _res, _days, _what)
+for _name, (_ov, _target, _res) in list(SPINUPS.items()):
+    if _name != "shipped" and _ov is not None and not any(o.startswith("rheology.max_pressure_pa=") for o in _ov):
+        SPINUPS[_name] = (_ov + NO_PMAX, _target, _res)
+# the rest of the eight months for the set with the term (as MORE_SEEDS for the set before),
+# and EVP from the same pack (the spin-up state with the term) for the comparison
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    for _seed in MORE_SEEDS:
+        EXPERIMENTS[f"{_p}-hthick-P-w{_seed}"] = (_basin, PMAX + from_spinup("H1126-P")
+                                                  + [f"forcing.wind.seed={_seed}"], 10e3, 28,
+                                                  f"{_p}-hthick-P, the weather of wind seed {_seed}")
+    ENSEMBLES[f"thick-and-thin + compressive term, {_basin}, eight months"] = (
+        [f"{_p}-hthick-P"] + [f"{_p}-hthick-P-w{s}" for s in ENSEMBLE_SEEDS + MORE_SEEDS])
+EXPERIMENTS["E10p"] = ("closed", from_spinup("H1126-P") + EVP, 10e3, 28,
+                       "EVP, closed, 10 km, from the pack spun up with the compressive term (shipped 2026-11-26)")
+EXPERIMENTS["E10ps"] = ("strait", from_spinup("H1126-P") + EVP, 10e3, 28,
+                        "EVP, strait, 10 km, from the pack spun up with the compressive term (shipped 2026-11-26)")
+for _key, _lo, _hi, _what in SENSITIVITY_CHANGES:
+    EXPERIMENTS[f"X10p-{_key}-50"] = ("closed", PMAX + from_spinup("H1126-P") + [_lo], 10e3, 28,
+                                      f"{_what} −50 %, 10 km, the set with the compressive term")
+    EXPERIMENTS[f"X10p-{_key}+50"] = ("closed", PMAX + from_spinup("H1126-P") + [_hi], 10e3, 28,
+                                      f"{_what} +50 %, 10 km, the set with the compressive term")
 
 
 def command(scene, overrides, res, days, out) -> list:

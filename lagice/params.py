@@ -43,6 +43,14 @@ class MaxwellEBParams:
             compression test) or ``"associated"`` (along K n, n the envelope's normal: the
             return of an associated plasticity; implicit solver only)
         stress_correction_mean_fraction: θ ∈ (0, 1] of ``"mean_stress"`` (None: 1) [-]
+        max_pressure_pa: P* of neXtSIM's compressive term [Pa] (None or 0: off). Where the mean
+            normal stress is compressive, −σn > 0, the Maxwell relaxation acts only on the part
+            above P_max = P* (h / 1 m)^k exp(−c*(1−A)): the relaxation factor becomes
+            λ/(λ + Δt (1 − P̃)) with P̃ = min(1, P_max/(−σn)), so weakly compressed ice is
+            elastic (no creep) and ice above P_max relaxes towards it (ridging). neXtSIM's
+            ``dynamics.compression_factor`` = 10 kPa, ``exponent_compression_factor`` = 1.5
+            (``model/finiteelement.cpp``, ``updateSigmaDamage``); explicit stepper only (CPU and CUDA)
+        max_pressure_thickness_exponent: k of P_max [-] (neXtSIM: 1.5)
     """
 
     poisson: float = 0.3
@@ -59,6 +67,8 @@ class MaxwellEBParams:
     max_damage: float = 1.0 - 1.0e-6
     stress_correction: str = "origin"
     stress_correction_mean_fraction: float | None = None
+    max_pressure_pa: float | None = None
+    max_pressure_thickness_exponent: float = 1.5
 
     def __post_init__(self):
         check_range("poisson (ν)", self.poisson, 0.0, 0.5, high_open=True)
@@ -75,6 +85,9 @@ class MaxwellEBParams:
             check_range("healing_time_s (th)", self.healing_time_s, 0.0, None, low_open=True, unit="s")
         check_range("concentration_c (c*)", self.concentration_c, 0.0, None)
         check_range("max_damage", self.max_damage, 0.0, 1.0, high_open=True)
+        if self.max_pressure_pa is not None:
+            check_range("max_pressure_pa (P*)", self.max_pressure_pa, 0.0, 1e7, unit="Pa")
+        check_range("max_pressure_thickness_exponent (k)", self.max_pressure_thickness_exponent, 0.0, 3.0)
         if self.stress_correction not in STRESS_CORRECTIONS:
             raise ConfigError(f"rheology.stress_correction = {self.stress_correction!r}: expected one of "
                               f"{list(STRESS_CORRECTIONS)}")

@@ -73,6 +73,11 @@ def top_edge_u(t, x, y):
     return 0.2 * min(1.0, t / 100.0) * (0.5 + x / L)
 
 
+#: neXtSIM's compressive term for the "pmax" variant [Pa]: P_max = P* h^1.5 exp(−20(1−A)) lies
+#: within the spread of the problem's compressive mean stresses, so elements are above and below it
+PMAX_PA = 2000.0
+
+
 def problem(variant="records"):
     poly, segs = rectangle_domain(L, L)
     mesh = generate_mesh(poly, 20e3, segments={"top": segs["top"], "coast": segs["bottom"]}, exterior_tag="free")
@@ -87,7 +92,8 @@ def problem(variant="records"):
         wind, current = host_wind, (0.03, -0.02)
     forces = [WindStress(wind), OceanDrag(current, turning_angle_deg=25.0), Coriolis(latitude_deg=75.0)]
     bcs = [VelocityBC("top", u=top_edge_u, v=-0.02)]
-    rheo = MaxwellEB(cohesion_min_pa=1e3, cohesion_max_pa=3e3, healing_time_s=2e3, max_damage=0.3)
+    rheo = MaxwellEB(cohesion_min_pa=1e3, cohesion_max_pa=3e3, healing_time_s=2e3, max_damage=0.3,
+                     max_pressure_pa=PMAX_PA if variant == "pmax" else None)
     c = mesh.centroids()
     st = IceState.uniform(mesh, thickness_m=1.0 + 0.3 * np.sin(c[:, 0] / 2e4),
                           concentration=0.92 + 0.08 * np.cos(c[:, 1] / 3e4),
@@ -341,6 +347,14 @@ def main():
     rep["heal_compliance_damage_mean"] = [float(ref["damage"].mean()), float(cpu_compliance["damage"].mean())]
     rep["remesh_explicit_sync"] = compare(run(model("cpu", remesh=True)),
                                           run(model("cuda", remesh=True, sync="explicit")))
+    cpu_pmax = model("cpu", variant="pmax")
+    res_pmax = run(cpu_pmax)
+    rep["pmax_explicit_sync"] = compare(res_pmax, run(model("cuda", variant="pmax", sync="explicit")))
+    rep["pmax_vs_without"] = rel_diff(ref["stress"], res_pmax["stress"])
+    st = cpu_pmax.state
+    sn = -0.5 * (st.stress[:, 0] + st.stress[:, 1])
+    pm = cpu_pmax.rheology.max_pressure(st.thickness, st.concentration)
+    rep["pmax_elements_below_above"] = [int(np.sum((sn > 0) & (sn < pm))), int(np.sum(sn > pm))]
     host = model("cuda", variant="host", sync="explicit")
     rep["host_fields"] = compare(run(model("cpu", variant="host")), run(host))
     rep["host_paths"] = host.stepper.forcing_paths

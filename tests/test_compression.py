@@ -137,6 +137,11 @@ def test_outputs_readable(heal_run):
      "rheology.stress_correction = 'mean_stress' is implemented in the implicit solver's damage update only"),
     ({"rheology.stress_correction": "associated", "solver.name": "explicit"},
      "rheology.stress_correction = 'associated' is implemented in the implicit solver's damage update only"),
+    ({"rheology.max_pressure_pa": 10e3},
+     "rheology.max_pressure_pa = 10000.0 \\(neXtSIM's compressive term\\) is implemented in the explicit "
+     "stepper only \\(CPU and CUDA\\); solver.name = 'implicit'"),
+    ({"rheology.max_pressure_pa": -1.0}, "max_pressure_pa \\(P\\*\\) = -1.0 Pa is out of range"),
+    ({"rheology.max_pressure_thickness_exponent": 4.0}, "max_pressure_thickness_exponent \\(k\\) = 4.0"),
 ])
 def test_bad_input_fails_before_meshing(ov, match, monkeypatch, tmp_path):
     import lagice.scenes.builder as mod

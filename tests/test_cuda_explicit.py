@@ -189,7 +189,7 @@ def test_cpu_serial_parallel_and_gpu_agree_on_a_damaging_run(sim_report):
     moving edge, damage, healing, the damage cap and mesh motion, 4 steps through
     Model and Simulation: the CPU parallel kernels and the simulated GPU (both launch
     modes, both sync modes, heal-rate callables of both healing forms, remeshing every
-    step, host-evaluated wind) give the CPU serial result to TOL, with the same
+    step, host-evaluated wind, neXtSIM's compressive term) give the CPU serial result to TOL, with the same
     sub-step, capped and damaged counts."""
     r = sim_report
     assert r["simulator"] is (not GPU_REAL)
@@ -200,8 +200,11 @@ def test_cpu_serial_parallel_and_gpu_agree_on_a_damaging_run(sim_report):
     assert r["damaged_fraction"] > 0.2 and r["damage_max"] == 0.3
     assert r["cpu_parallel"]["velocity"] == 0.0 and r["cpu_parallel"]["damage"] == 0.0  # bit-identical
     for case in ("cpu_parallel", "cuda_step_sync", "cuda_explicit_sync_launches", "heal_callable_explicit_sync",
-                 "heal_compliance_explicit_sync", "remesh_explicit_sync", "host_fields"):
+                 "heal_compliance_explicit_sync", "remesh_explicit_sync", "host_fields", "pmax_explicit_sync"):
         _agree(case, r[case])
+    # neXtSIM's compressive term acted (elements below and above P_max) and changed the result
+    below, above = r["pmax_elements_below_above"]
+    assert below > 0 and above > 0 and r["pmax_vs_without"] > 1e-3
     constant, compliance = r["heal_compliance_damage_mean"]
     assert compliance < 0.9 * constant  # the compliance branch heals (faster than the constant law here)
     assert r["remesh_explicit_sync"]["remeshes"][0] == r["remesh_explicit_sync"]["remeshes"][1] >= 2

@@ -49,7 +49,7 @@ def test_element_kernel_damage_matches_rheology(kernel):
     e_dt, gam = np.zeros(m), np.ones(m)
     sig_c = 2.0 * coh / rheo._denom
     kernel(tri, zeros3, zeros3, np.zeros((1, 2)), s2, d2, conc_factor, coh, sig_c, sig_c / rheo.q, td,
-           heal, e_dt, gam,
+           heal, e_dt, gam, np.zeros(0),
            7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s,
            p.alpha, flag)
     assert (dc < 1).sum() > 100
@@ -102,6 +102,52 @@ def test_maxwell_relaxation_and_coast_no_slip():
         assert np.allclose(st.stress, s0 * (900.0 / 905.0) ** (6 * n), rtol=1e-12, atol=0)
     assert np.abs(st.velocity).max() < 1e-15  # every node is coast here
     assert s.name == "explicit" and SOLVERS["explicit"] is ExplicitSolver
+
+
+def test_max_pressure_relaxation_follows_nextsim():
+    """neXtSIM's compressive term (``rheology.max_pressure_pa``): with no motion (uniform
+    stress, boundary nodes coast) an isotropic stress −p I relaxes by
+    λ/(λ + Δt_s (1 − P_max/p)) per sub-step while p > P_max = P* h^1.5: towards P_max, not
+    to 0 (the discrete recursion to 1e-12, and the continuous p − P_max ∝ e^(−t/λ) to
+    1 %); below P_max it does not relax at all, and in tension it relaxes as without the
+    term (γ^n, as in the test above)."""
+    poly, _ = rectangle_domain(50e3, 50e3)
+    mesh = generate_mesh(poly, 10e3)
+    lam, dts, h, n_steps = 900.0, 5.0, 2.0, 120
+    rheo = MaxwellEB(relaxation_time_s=lam, healing_time_s=None, max_pressure_pa=10e3)
+    pmax = 10e3 * h ** 1.5
+    assert np.allclose(rheo.max_pressure(np.full(3, h), np.ones(3)), pmax, rtol=1e-14)
+
+    def run(s0):
+        s = ExplicitSolver(rheo, mesh, substeps=6)
+        st = IceState.uniform(mesh, cohesion_pa=1e12, thickness_m=h)
+        st.stress[:] = s0
+        for _ in range(n_steps):
+            step(s, st, 6 * dts)
+        assert np.abs(st.velocity).max() < 1e-12
+        return st.stress
+
+    p_ref = 3.0 * pmax
+    for _ in range(6 * n_steps):
+        p_ref = p_ref * lam / (lam + dts * (1.0 - pmax / p_ref))
+    above = run([-3.0 * pmax, -3.0 * pmax, 0.0])
+    assert np.allclose(above[:, :2], -p_ref, rtol=1e-12, atol=0)
+    assert np.abs(above[:, 2]).max() < 1e-9 * pmax
+    t = 6 * n_steps * dts
+    assert p_ref == pytest.approx(pmax + 2.0 * pmax * np.exp(-t / lam), rel=1e-2)
+    assert pmax < p_ref < 1.1 * pmax  # relaxed most of the way, and not below P_max
+    below = run([-0.5 * pmax, -0.5 * pmax, 0.0])
+    assert np.allclose(below[:, :2], -0.5 * pmax, rtol=1e-12, atol=0)  # elastic: no creep
+    s_t = np.array([2e3, 1e3, 5e2])  # mean stress tensile: the term does not act
+    assert np.allclose(run(s_t), s_t * (lam / (lam + dts)) ** (6 * n_steps), rtol=1e-12, atol=0)
+
+
+def test_max_pressure_is_refused_where_it_is_not_implemented():
+    """The implicit solver does not implement the term and must not silently ignore it
+    (scenes: tests/test_compression.py::test_bad_input_fails_before_meshing)."""
+    from lagice.solvers.implicit import ImplicitSolver
+    with pytest.raises(ConfigError, match="max_pressure_pa = 10000.0: the implicit solver"):
+        ImplicitSolver(MaxwellEB(max_pressure_pa=10e3), mesh=None)
 
 
 def test_partial_dirichlet_component():

@@ -313,6 +313,24 @@ class MaxwellEB:
             raise ConfigError(f"rheology.stress_correction = {self.params.stress_correction!r}: the explicit "
                               "stepper corrects towards the origin only (the option is in the implicit solver)")
 
+    def require_no_max_pressure(self, where: str):
+        """Raise :class:`ConfigError` if neXtSIM's compressive term (``max_pressure_pa``) is
+        set: only the explicit stepper (CPU and CUDA) implements it, and ``where`` must not ignore it."""
+        if self.params.max_pressure_pa:
+            raise ConfigError(f"rheology.max_pressure_pa = {self.params.max_pressure_pa!r}: {where} does not "
+                              "implement neXtSIM's compressive term (the explicit stepper does, on CPU and GPU)")
+
+    def max_pressure(self, thickness, concentration):
+        """P_max = P* (h / 1 m)^k exp(−c*(1−A)) [Pa] per element (neXtSIM's compressive term;
+        :class:`lagice.params.MaxwellEBParams`), or None when ``max_pressure_pa`` is unset or 0
+        (off: the kernels then take the relaxation factor unchanged, bit for bit)."""
+        p = self.params
+        if not p.max_pressure_pa:
+            return None
+        h = np.maximum(np.asarray(thickness, np.float64), 0.0)
+        return (p.max_pressure_pa * h ** p.max_pressure_thickness_exponent
+                * np.exp(-p.concentration_c * (1.0 - np.asarray(concentration, np.float64))))
+
     def damage_update(self, sigma, damage, cohesion, dt, td, heal_rate):
         """Apply the damage/healing update in place; returns d_crit per element."""
         out = np.empty(len(damage))

@@ -289,6 +289,10 @@ def validate_config(cfg: dict) -> None:
         raise ConfigError(f"rheology.stress_correction = {rheo.params.stress_correction!r} is implemented in the "
                           f"implicit solver's damage update only; solver.name = {sv['name']!r} corrects towards the "
                           f"origin. Use solver.name = 'implicit' or stress_correction = 'origin'")
+    if rheo.name == "maxwell_eb" and rheo.params.max_pressure_pa and sv["name"] != "explicit":
+        raise ConfigError(f"rheology.max_pressure_pa = {rheo.params.max_pressure_pa!r} (neXtSIM's compressive "
+                          f"term) is implemented in the explicit stepper only (CPU and CUDA); solver.name = "
+                          f"{sv['name']!r}. Use solver.name = 'explicit', or leave max_pressure_pa unset")
     if sv["name"] == "evp" and cfg["healing"]["law"] not in ("none",):
         raise ConfigError(f"healing.law = {cfg['healing']['law']!r}: the viscous-plastic rheology (solver 'evp') "
                           f"has no damage to heal; set healing.law = 'none'")

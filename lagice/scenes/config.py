@@ -59,6 +59,9 @@ SCHEMA = {
         "cohesion_max_pa": (NUM, 50e3), "healing_time_s": (NUM, 1e5), "concentration_c": (NUM, 20.0),
         "max_damage": (NUM, 1.0 - 1e-6), "stress_correction": (str, "origin"),
         "stress_correction_mean_fraction": (NUM, None),
+        # neXtSIM's compressive term (lagice.params.MaxwellEBParams.max_pressure_pa; issue 12):
+        # damaged ice below P_max = P* h^k exp(-c*(1-A)) in compression does not creep
+        "max_pressure_pa": (NUM, None), "max_pressure_thickness_exponent": (NUM, 1.5),
         "p_star": (NUM, 27.5e3), "c_star": (NUM, 20.0), "ellipse": (NUM, 2.0), "delta_min": (NUM, 2e-9),
         "replacement_pressure": (bool, False),
         # strength law (lagice.strength; issue 12): "uniform" = cohesion_min/max_pa,
@@ -103,7 +106,8 @@ REMOVED = {
 RHEOLOGY_KEYS = {
     "maxwell_eb": ("poisson", "friction", "rho_ice", "shear_wave_speed", "young_modulus_pa", "relaxation_time_s",
                    "alpha", "cohesion_min_pa", "cohesion_max_pa", "healing_time_s", "concentration_c",
-                   "max_damage", "stress_correction", "stress_correction_mean_fraction"),
+                   "max_damage", "stress_correction", "stress_correction_mean_fraction", "max_pressure_pa",
+                   "max_pressure_thickness_exponent"),
     "viscous_plastic": ("p_star", "c_star", "ellipse", "delta_min", "replacement_pressure", "rho_ice"),
 }
 
@@ -131,6 +135,8 @@ LEGACY_VALUES = {
     "rheology.strength_disorder": (None,),
     "rheology.stress_correction": ("origin",),       # 2026-11-24: scaling towards the origin
     "rheology.stress_correction_mean_fraction": (None,),
+    "rheology.max_pressure_pa": (None, 0, 0.0),      # 2026-11-26: no compressive term
+    "rheology.max_pressure_thickness_exponent": (1.5,),
     "initial.state_file": (None, ""),                # 2026-11-24: no spin-up state
     "solver.substep_limit": (None, "mesh"),          # 2026-11-25: the whole-mesh limit
 }

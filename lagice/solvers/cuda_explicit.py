@@ -458,6 +458,8 @@ class CudaExplicitSolver:
                            ("vel_sum", (n, 2)), ("mean_vel", (n, 2)), ("strain", (m, 3))):
             d[key] = cuda.device_array(shape, f8)
         d["flag"] = cuda.device_array(m, np.int8)
+        # neXtSIM's compressive term: P_max per element, refreshed each step (a placeholder when off)
+        d["pmax"] = cuda.device_array(m if self.rheology.params.max_pressure_pa else 1, f8)
         d["pres0"] = cuda.to_device(np.zeros((n, 2)))
         d["pres1"] = cuda.to_device(np.zeros((n, 2)))
         d["counters"] = cuda.device_array(K.N_COUNTERS, np.int64)
@@ -665,6 +667,10 @@ class CudaExplicitSolver:
                      float(p.relaxation_time_s), float(p.concentration_c), float(p.alpha), rh._denom, rh.q,
                      d["damage_w"], d["sigma_w"], d["e_dt"], d["gamma"], d["conc_factor"], d["sig_c"],
                      d["sig_t"], d["flag"], d["scalars"])
+        use_pmax = int(bool(p.max_pressure_pa))
+        if use_pmax:
+            self._launch(K.max_pressure_kernel, m, d["h"], d["conc_factor"], float(p.max_pressure_pa),
+                         float(p.max_pressure_thickness_exponent), d["pmax"])
         if self._wind is not None:
             self._wind.evaluate(self, t_new, d["wind"])
         self._ocean.evaluate(self, t_new, d["current"])
@@ -716,7 +722,8 @@ class CudaExplicitSolver:
         node_args = (d["vel_w"], d["vel_sum"], d["sigma_w"], d["ptr"], d["elems"], d["wb"], d["wc"], d["m_dt"],
                      d["fext"], d["cda"], d["current"], self._cos_t, self._sin_t, d["half_mf"], d["fixed"],
                      d["pres0"], d["pres1"])
-        mat = (d["conc_factor"], d["coh"], d["sig_c"], d["sig_t"], d["td"], d["heal"], d["e_dt"], d["gamma"])
+        mat = (d["conc_factor"], d["coh"], d["sig_c"], d["sig_t"], d["td"], d["heal"], d["e_dt"], d["gamma"],
+               d["pmax"], use_pmax)
         consts = (kxx, kxy, kss, rh.q, rh._denom, float(p.max_damage), float(p.E0),
                   float(p.relaxation_time_s), float(p.alpha))
         coop_args = (n_sub, dt_sub, *node_args, d["tri"], d["b"], d["c"], d["damage_w"], *mat, *consts,

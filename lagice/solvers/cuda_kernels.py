@@ -161,13 +161,19 @@ def node_update(i, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, cur
 
 @cuda.jit(device=True)
 def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c, sigma_t, td,
-                   heal_rate, e_dt, gamma, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0,
-                   alpha, damaged_flag):
+                   heal_rate, e_dt, gamma, pmax, use_pmax, dt_s, kxx, kxy, kss, q, denom, max_damage, E0,
+                   lambda0, alpha, damaged_flag):
     """One element of :func:`lagice.solvers.explicit._element_stress_damage`
-    (same expressions); returns 1 when the damage cap acted."""
+    (same expressions; ``use_pmax`` = 1: neXtSIM's compressive term with ``pmax``);
+    returns 1 when the damage cap acted."""
     exx, eyy, exy = strain_rate_dev(tri, b, c, vel, e)
     ed = e_dt[e]
     g = gamma[e]
+    if use_pmax:
+        sn = -0.5 * (sigma[e, 0] + sigma[e, 1])
+        if sn > 0.0:
+            pt = min(1.0, pmax[e] / sn)
+            g = g / (g + (1.0 - g) * (1.0 - pt))
     sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * g
     syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * g
     sxy = (sigma[e, 2] + ed * (kss * exy)) * g
@@ -238,8 +244,9 @@ def finish_element(e, tri, b, c, mean_vel, strain, damaged_flag, sigma, damage):
 @cuda.jit
 def substeps_cooperative(n_sub, dt_s, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current,
                          cos_t, sin_t, half_mf, fixed, pres0, pres1, tri, b, c, damage, conc_factor,
-                         cohesion, sigma_c, sigma_t, td, heal_rate, e_dt, gamma, kxx, kxy, kss, q, denom,
-                         max_damage, E0, lambda0, alpha, damaged_flag, mean_vel, strain, counters, scalars):
+                         cohesion, sigma_c, sigma_t, td, heal_rate, e_dt, gamma, pmax, use_pmax, kxx, kxy, kss,
+                         q, denom, max_damage, E0, lambda0, alpha, damaged_flag, mean_vel, strain, counters,
+                         scalars):
     """All ``n_sub`` sub-steps, then the mean velocity and its strain rate, in one
     launch: the node and element phases are separated by a grid-wide barrier
     (cooperative groups), so the grid must be co-resident (launch with at most
@@ -258,8 +265,8 @@ def substeps_cooperative(n_sub, dt_s, vel, vel_sum, sigma, ptr, elems, wb, wc, m
         grid.sync()
         for e in range(start, m, stride):
             capped += element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c,
-                                     sigma_t, td, heal_rate, e_dt, gamma, dt_s, kxx, kxy, kss, q, denom,
-                                     max_damage, E0, lambda0, alpha, damaged_flag)
+                                     sigma_t, td, heal_rate, e_dt, gamma, pmax, use_pmax, dt_s, kxx, kxy,
+                                     kss, q, denom, max_damage, E0, lambda0, alpha, damaged_flag)
         grid.sync()
     bad = 0
     s2max = 0.0
@@ -300,12 +307,13 @@ def node_substep_kernel(w_time, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, f
 
 @cuda.jit
 def element_substep_kernel(dt_s, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c, sigma_t,
-                           td, heal_rate, e_dt, gamma, kxx, kxy, kss, q, denom, max_damage, E0, lambda0,
-                           alpha, damaged_flag, counters):
+                           td, heal_rate, e_dt, gamma, pmax, use_pmax, kxx, kxy, kss, q, denom, max_damage, E0,
+                           lambda0, alpha, damaged_flag, counters):
     capped = 0
     for e in range(cuda.grid(1), tri.shape[0], cuda.gridsize(1)):
         capped += element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c, sigma_t,
-                                 td, heal_rate, e_dt, gamma, dt_s, kxx, kxy, kss, q, denom, max_damage,
+                                 td, heal_rate, e_dt, gamma, pmax, use_pmax, dt_s, kxx, kxy, kss, q, denom,
+                                 max_damage,
                                  E0, lambda0, alpha, damaged_flag)
     if capped:
         cuda.atomic.add(counters, C_CAPPED, capped)
@@ -376,6 +384,13 @@ def geometry_kernel(nodes, tri, b, c, area, td, shear_wave_speed, scalars, count
     cuda.atomic.min(scalars, S_AREA_MIN, amin)
     if bad:
         cuda.atomic.add(counters, C_INVERTED, bad)
+
+
+@cuda.jit
+def max_pressure_kernel(h, conc_factor, p_star, exponent, pmax):
+    """P_max = P* h^k exp(−c*(1−A)) per element (``MaxwellEB.max_pressure``; h < 0 as 0)."""
+    for e in range(cuda.grid(1), h.shape[0], cuda.gridsize(1)):
+        pmax[e] = p_star * max2(h[e], 0.0) ** exponent * conc_factor[e]
 
 
 @cuda.jit

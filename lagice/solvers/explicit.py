@@ -147,7 +147,7 @@ def _node_velocity(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, cur
 
 
 def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c, sigma_t,
-                           td, heal_rate, e_dt, gamma, dt_s, kxx, kxy, kss, q, denom,
+                           td, heal_rate, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q, denom,
                            max_damage, E0, lambda0, alpha, damaged_flag):
     """Maxwell stress update and damage/healing of one sub-step, in place (module doc, step 2).
 
@@ -156,14 +156,24 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     g = conc_factor = exp(−c*(1−A)) (rheology.young_modulus/relaxation_time;
     an integer α−1 is taken as repeated products). kxx = 1/(1−ν²), kxy = ν/(1−ν²), kss = (1−ν)/(1−ν²) are the
     entries of K; sigma_c = 2C/denom and sigma_t = sigma_c/q [Pa] (Dansereau et al. 2016 eqs. 4, 6)
-    per element. Returns the number of elements whose damage hit the cap.
+    per element. pmax [Pa]: neXtSIM's compressive term (rheology.max_pressure; an empty
+    array: off): where the mean stress σn of the previous sub-step is compressive, the
+    relaxation factor is λ/(λ + Δt_s (1 − P̃)), P̃ = min(1, pmax/(−σn)), computed from
+    γ = λ/(λ+Δt_s) as γ/(γ + (1 − γ)(1 − P̃)) (neXtSIM's ``updateSigmaDamage``).
+    Returns the number of elements whose damage hit the cap.
     """
     m = tri.shape[0]
+    use_pmax = pmax.shape[0] > 0
     n_capped = 0
     for e in prange(m):
         exx, eyy, exy = element_strain_rate(tri, b, c, vel, e)
         ed = e_dt[e]
         g = gamma[e]
+        if use_pmax:
+            sn = -0.5 * (sigma[e, 0] + sigma[e, 1])
+            if sn > 0.0:
+                pt = min(1.0, pmax[e] / sn)
+                g = g / (g + (1.0 - g) * (1.0 - pt))
         sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * g
         syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * g
         sxy = (sigma[e, 2] + ed * (kss * exy)) * g
@@ -224,7 +234,7 @@ PARALLEL_MIN_ELEMENTS = PARALLEL_MIN_SIZE
 @njit(cache=True, error_model="numpy")
 def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
                       half_mf, fixed, pres0, pres1, tri, b, c, damage, conc_factor, coh, sig_c, sig_t, td,
-                      heal, e_dt, gamma, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+                      heal, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
     """All ``n_sub`` sub-steps of one outer step in compiled code (one call per outer
     step, no Python per sub-step): the node kernel then the element kernel, serial
     builds; the same calls as a Python loop over the kernels, bit-identical results."""
@@ -233,7 +243,7 @@ def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, 
         node_velocity_kernel_serial(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
                                     half_mf, fixed, pres0, pres1, (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel_serial(
-            tri, b, c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt, gamma, dt_s, kxx, kxy,
+            tri, b, c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy,
             kss, q, denom, max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
@@ -241,7 +251,7 @@ def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, 
 @njit(cache=True, error_model="numpy")
 def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
                       half_mf, fixed, pres0, pres1, tri, b, c, damage, conc_factor, coh, sig_c, sig_t, td,
-                      heal, e_dt, gamma, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+                      heal, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
     """:func:`substeps_serial` with the parallel kernel builds (one fork/join per
     kernel and sub-step, launched from compiled code)."""
     n_capped = 0
@@ -249,7 +259,7 @@ def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext
         node_velocity_kernel(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
                              half_mf, fixed, pres0, pres1, (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel(
-            tri, b, c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt, gamma, dt_s, kxx, kxy,
+            tri, b, c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy,
             kss, q, denom, max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
@@ -447,7 +457,7 @@ class ExplicitSolver:
     def _profiled_substeps(self, par, n_sub, args):
         """The sub-step loop in Python with each kernel timed (``profile_kernels``)."""
         (vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t, half_mf, fixed, pres0,
-         pres1, tri, b, c, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt, gamma, dt_s, kxx, kxy, kss, q,
+         pres1, tri, b, c, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q,
          denom, max_damage, E0, lambda0, alpha, flag) = args
         node_k = node_velocity_kernel if par else node_velocity_kernel_serial
         elem_k = element_stress_damage_kernel if par else element_stress_damage_kernel_serial
@@ -459,7 +469,7 @@ class ExplicitSolver:
                    fixed, pres0, pres1, (k + 1) / n_sub)
             tb = time.perf_counter()
             n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt,
-                               gamma, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+                               gamma, pmax, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
             tc = time.perf_counter()
             tn += tb - ta
             tm += tc - tb
@@ -494,6 +504,8 @@ class ExplicitSolver:
         e_dt = dt_s * E
         gamma = lam / (lam + dt_s)
         rh = self.rheology
+        pmax = rh.max_pressure(state.thickness, state.concentration)
+        pmax = np.zeros(0) if pmax is None else np.ascontiguousarray(pmax, np.float64)
         heal = (self.heal_rate(state, t_s) if self.heal_rate is not None
                 else self.rheology.constant_heal_rate(mesh.n_elements))
         heal = np.ascontiguousarray(heal, np.float64)
@@ -514,7 +526,7 @@ class ExplicitSolver:
         ptr32, elems32, tri32 = self._indices(mesh)
         args = (vel, vel_sum, sigma, ptr32, elems32, su.wb, su.wc, su.m_dt, su.fext, su.cda, terms.current,
                 terms.cos_turn, terms.sin_turn, half_mf, ns.fixed, pres0, pres1, tri32, ns.b, ns.c, damage,
-                conc_factor, coh, sig_c, sig_t, self.td, heal, e_dt, gamma, dt_s, kxx, kxy, kss, rh.q,
+                conc_factor, coh, sig_c, sig_t, self.td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, rh.q,
                 rh._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), flag)
         if self.kernel_choice is None or (
                 self.parallel_setting is None
