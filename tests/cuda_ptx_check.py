@@ -38,7 +38,7 @@ def signatures():
     B1, B2 = T.Array(T.int8, 1, "C"), T.Array(T.int8, 2, "C")
     C1 = T.Array(i8, 1, "C")
     node = (A2, A2, A2, I1, I1, A1, A1, A1, A2, A1, A2, f8, f8, A1, B2, A2, A2)
-    mat = (A1,) * 8
+    mat = (A1,) * 8 + (A1, i8)  # ... e_dt, gamma, then pmax and use_pmax (neXtSIM's compressive term)
     consts = (f8,) * 9
     return {
         "substeps_cooperative": (i8, f8, *node, I2, A2, A2, A1, *mat, *consts, B1, A2, A2, C1, A1),
@@ -49,6 +49,7 @@ def signatures():
         "geometry_kernel": (A2, I2, A2, A2, A1, A1, f8, A1, C1),
         "prepare_elements_kernel": (A1, A2, A1, A1, A1, f8, f8, f8, f8, f8, f8, A1, A2, A1, A1, A1, A1, A1, B1, A1),
         "finish_moduli_kernel": (A1, A1, f8),
+        "max_pressure_kernel": (A1, A1, f8, f8, A1),
         "prepare_nodes_kernel": (I1, I1, B1, A1, A1, A2, A2, f8, f8, A2, i8, f8, f8, f8, A2, A2, A2, A1, A2,
                                  A1, A1, A1, A1),
         "scatter_prescribed_kernel": (I1, A1, A1, A2, A2),

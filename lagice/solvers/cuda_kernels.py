@@ -172,7 +172,7 @@ def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigm
     if use_pmax:
         sn = -0.5 * (sigma[e, 0] + sigma[e, 1])
         if sn > 0.0:
-            pt = min(1.0, pmax[e] / sn)
+            pt = min2(1.0, pmax[e] / sn)
             g = g / (g + (1.0 - g) * (1.0 - pt))
     sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * g
     syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * g
