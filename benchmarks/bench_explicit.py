@@ -132,7 +132,7 @@ def element_kernel_rates(n_target: int = 50_000, reps: int = 20) -> dict:
         cohv = np.full(m, coh)
         sc = 2 * cohv / rheo._denom
         args = (tri, b, c, vel, sigma, damage, np.ones(m), cohv, sc, sc / rheo.q, np.full(m, 20.0),
-                np.full(m, heal), np.full(m, 4.0 * p.E0), np.full(m, 0.99), np.zeros(0), 4.0, 1.1, 0.3, 0.7, rheo.q,
+                np.full(m, heal), np.full(m, 4.0 * p.E0), np.full(m, 0.99), None, 4.0, 1.1, 0.3, 0.7, rheo.q,
                 rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, np.zeros(m, np.int8))
         kernel(*args)
         t0 = time.process_time()

@@ -49,7 +49,7 @@ def test_element_kernel_damage_matches_rheology(kernel):
     e_dt, gam = np.zeros(m), np.ones(m)
     sig_c = 2.0 * coh / rheo._denom
     kernel(tri, zeros3, zeros3, np.zeros((1, 2)), s2, d2, conc_factor, coh, sig_c, sig_c / rheo.q, td,
-           heal, e_dt, gam, np.zeros(0),
+           heal, e_dt, gam, None,
            7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s,
            p.alpha, flag)
     assert (dc < 1).sum() > 100

@@ -156,20 +156,20 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     g = conc_factor = exp(−c*(1−A)) (rheology.young_modulus/relaxation_time;
     an integer α−1 is taken as repeated products). kxx = 1/(1−ν²), kxy = ν/(1−ν²), kss = (1−ν)/(1−ν²) are the
     entries of K; sigma_c = 2C/denom and sigma_t = sigma_c/q [Pa] (Dansereau et al. 2016 eqs. 4, 6)
-    per element. pmax [Pa]: neXtSIM's compressive term (rheology.max_pressure; an empty
-    array: off): where the mean stress σn of the previous sub-step is compressive, the
+    per element. pmax [Pa]: neXtSIM's compressive term (rheology.max_pressure; None: off,
+    and numba prunes the branch when it compiles the NoneType signature, so the default
+    path pays nothing for it): where the mean stress σn of the previous sub-step is compressive, the
     relaxation factor is λ/(λ + Δt_s (1 − P̃)), P̃ = min(1, pmax/(−σn)), computed from
     γ = λ/(λ+Δt_s) as γ/(γ + (1 − γ)(1 − P̃)) (neXtSIM's ``updateSigmaDamage``).
     Returns the number of elements whose damage hit the cap.
     """
     m = tri.shape[0]
-    use_pmax = pmax.shape[0] > 0
     n_capped = 0
     for e in prange(m):
         exx, eyy, exy = element_strain_rate(tri, b, c, vel, e)
         ed = e_dt[e]
         g = gamma[e]
-        if use_pmax:
+        if pmax is not None:
             sn = -0.5 * (sigma[e, 0] + sigma[e, 1])
             if sn > 0.0:
                 pt = min(1.0, pmax[e] / sn)
@@ -504,8 +504,8 @@ class ExplicitSolver:
         e_dt = dt_s * E
         gamma = lam / (lam + dt_s)
         rh = self.rheology
-        pmax = rh.max_pressure(state.thickness, state.concentration)
-        pmax = np.zeros(0) if pmax is None else np.ascontiguousarray(pmax, np.float64)
+        pmax = rh.max_pressure(state.thickness, state.concentration)  # None: off
+        pmax = None if pmax is None else np.ascontiguousarray(pmax, np.float64)
         heal = (self.heal_rate(state, t_s) if self.heal_rate is not None
                 else self.rheology.constant_heal_rate(mesh.n_elements))
         heal = np.ascontiguousarray(heal, np.float64)
