@@ -313,8 +313,7 @@ def element_substep_kernel(dt_s, tri, b, c, vel, sigma, damage, conc_factor, coh
     for e in range(cuda.grid(1), tri.shape[0], cuda.gridsize(1)):
         capped += element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c, sigma_t,
                                  td, heal_rate, e_dt, gamma, pmax, use_pmax, dt_s, kxx, kxy, kss, q, denom,
-                                 max_damage,
-                                 E0, lambda0, alpha, damaged_flag)
+                                 max_damage, E0, lambda0, alpha, damaged_flag)
     if capped:
         cuda.atomic.add(counters, C_CAPPED, capped)
 
