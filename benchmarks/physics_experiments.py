@@ -122,6 +122,20 @@ def from_spinup(name: str) -> list:
     return [f"initial.state_file={SPINUPS[name][1].relative_to(ROOT)}"]
 
 
+def add_weather_ensemble(tag: str, overrides: list, what: str, group: str, seeds, suffix: str = "") -> None:
+    """The 10 km, 28-day runs of one set-up in both basins: ``F10-hthick-{tag}`` /
+    ``F10s-hthick-{tag}`` (the scene's wind seed) and ``...-w{seed}`` for ``seeds``, with the
+    group ``"{group}, closed{suffix}"`` / ``"{group}, strait{suffix}"`` of :data:`ENSEMBLES`
+    (the runs of those seeds). Run names already defined keep their definition."""
+    for basin, p in (("closed", "F10"), ("strait", "F10s")):
+        base = f"{p}-hthick-{tag}"
+        EXPERIMENTS.setdefault(base, (basin, overrides, 10e3, 28, f"{p}-hthick-1125 {what}"))
+        for seed in seeds:
+            EXPERIMENTS.setdefault(f"{base}-w{seed}", (basin, overrides + [f"forcing.wind.seed={seed}"], 10e3, 28,
+                                                      f"{base}, the weather of wind seed {seed}"))
+        ENSEMBLES[f"{group}, {basin}{suffix}"] = [base] + [f"{base}-w{s}" for s in seeds]
+
+
 def prepare_inputs():
     """Write the inputs that experiments make rather than ship: BASIN_X2, and the spin-up
     state shipped until 2026-11-25 (``spinup-shipped-1123.npz``, from git history)."""
@@ -292,15 +306,8 @@ EXPERIMENTS["F10-hthick-1125-w2028-str-50"] = ("closed", from_spinup("H1125") + 
 # than the linear healing's (3 closed, 2 strait).
 SPINUPS["H1125-K50"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + COMPLIANCE50,
                         OUT / "spinup-H1125-K50.npz", 10e3)
-for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
-    _k = COMPLIANCE50 + from_spinup("H1125-K50")
-    EXPERIMENTS[f"{_p}-hthick-K50"] = (_basin, _k, 10e3, 28,
-                                       f"{_p}-hthick-1125 with compliance healing K = 50, from its own spin-up")
-    for _seed in ENSEMBLE_SEEDS:
-        EXPERIMENTS[f"{_p}-hthick-K50-w{_seed}"] = (_basin, _k + [f"forcing.wind.seed={_seed}"], 10e3, 28,
-                                                    f"{_p}-hthick-K50, the weather of wind seed {_seed}")
-    ENSEMBLES[f"thick-and-thin K50, {_basin}"] = [f"{_p}-hthick-K50"] + [f"{_p}-hthick-K50-w{s}"
-                                                                          for s in ENSEMBLE_SEEDS]
+add_weather_ensemble("K50", COMPLIANCE50 + from_spinup("H1125-K50"),
+                     "with compliance healing K = 50, from its own spin-up", "thick-and-thin K50", ENSEMBLE_SEEDS)
 # the third lead for the calm months (docs/physics.md §5): the basin's width, i.e. the fetch
 # over which a closed basin integrates the wind stress (the Arctic pack is 2-3 times wider
 # than the 1000 km basin). The calm month (wind seed 2028) of the thick-and-thin pack with
@@ -405,15 +412,8 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # rate nor the median beta moves further from its band.
 PMAX = ["rheology.max_pressure_pa=10e3", "rheology.max_pressure_thickness_exponent=1.5"]
 SPINUPS["H1126-P"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + PMAX, OUT / "spinup-H1126-P.npz", 10e3)
-for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
-    _k = PMAX + from_spinup("H1126-P")
-    EXPERIMENTS[f"{_p}-hthick-P"] = (_basin, _k, 10e3, 28,
-                                     f"{_p}-hthick-1125 with neXtSIM's compressive term, from its own spin-up")
-    for _seed in ENSEMBLE_SEEDS:
-        EXPERIMENTS[f"{_p}-hthick-P-w{_seed}"] = (_basin, _k + [f"forcing.wind.seed={_seed}"], 10e3, 28,
-                                                  f"{_p}-hthick-P, the weather of wind seed {_seed}")
-    ENSEMBLES[f"thick-and-thin + compressive term, {_basin}"] = (
-        [f"{_p}-hthick-P"] + [f"{_p}-hthick-P-w{s}" for s in ENSEMBLE_SEEDS])
+add_weather_ensemble("P", PMAX + from_spinup("H1126-P"), "with neXtSIM's compressive term, from its own spin-up",
+                     "thick-and-thin + compressive term", ENSEMBLE_SEEDS)
 for _i in (1, 2, 3):
     EXPERIMENTS[f"W20-d{_i}"] = ("closed", ["forcing.wind.seed=2026", f"run.seed={_i}"], 20e3, 28,
                                  f"as W20, strength disorder of run seed {_i} (same weather)")
@@ -432,13 +432,8 @@ for _name, (_sc, _ov, _res, _days, _what) in list(EXPERIMENTS.items()):
 # 2030-2033, as MORE_SEEDS for the set without it) confirm it: over eight months the medians
 # put 2 bands inside against 3 in each basin. Not adopted; the shipped set is unchanged
 # (docs/physics.md §4, "neXtSIM's compressive term").
-for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
-    for _seed in MORE_SEEDS:
-        EXPERIMENTS[f"{_p}-hthick-P-w{_seed}"] = (_basin, PMAX + from_spinup("H1126-P")
-                                                  + [f"forcing.wind.seed={_seed}"], 10e3, 28,
-                                                  f"{_p}-hthick-P, the weather of wind seed {_seed}")
-    ENSEMBLES[f"thick-and-thin + compressive term, {_basin}, eight months"] = (
-        [f"{_p}-hthick-P"] + [f"{_p}-hthick-P-w{s}" for s in ENSEMBLE_SEEDS + MORE_SEEDS])
+add_weather_ensemble("P", PMAX + from_spinup("H1126-P"), "with neXtSIM's compressive term, from its own spin-up",
+                     "thick-and-thin + compressive term", ENSEMBLE_SEEDS + MORE_SEEDS, ", eight months")
 
 
 def command(scene, overrides, res, days, out) -> list:
