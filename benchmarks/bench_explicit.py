@@ -43,7 +43,7 @@ from pathlib import Path
 import numba
 import numpy as np
 from numba import njit, prange
-from scene_runs import reset_timings, scene_dx_min, scene_simulation, timed_run
+from scene_runs import reset_timings, reuse_gmsh_meshes, scene_dx_min, scene_simulation, timed_run
 
 from lagice.params import MaxwellEBParams
 from lagice.stability import explicit_substep_limit
@@ -202,9 +202,14 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="10k elements, serial kernels, 2 timed steps")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="scene override as `lagice run --set` (e.g. domain.renumber=false)")
+    ap.add_argument("--fresh-meshes", action="store_true",
+                    help="run gmsh for every build (default: once per size, scene_runs.reuse_gmsh_meshes)")
     ap.add_argument("--json", type=Path, default=Path(__file__).resolve().parent / Path("out/explicit.json"))
     a = ap.parse_args(argv)
     from lagice.scenes.config import _split
+
+    if not a.fresh_meshes:  # the repeats and the stability limit mesh each size once
+        reuse_gmsh_meshes()
 
     extra = dict(_split(kv) for kv in a.set)
     if a.quick:

@@ -26,7 +26,9 @@ increase), and a byte model of the sub-step loop with the bandwidth it implies.
 element-sub-steps/s, its memory per element (persistent arrays and the peak of
 one step's temporaries, by tracemalloc), and the largest relative difference of
 velocity, stress and damage between the devices after ``--check-steps`` outer
-steps from the same initial state. Without a usable GPU the script prints
+steps from the same initial state. gmsh meshes each size once per process (``--fresh-meshes`` to mesh every build), so
+``build_s`` of a later build leaves gmsh out; ``mesh_cache`` in the JSON counts both.
+Without a usable GPU the script prints
 ``NO GPU: ...``, writes ``{"gpu": false, ...}`` (plus the CPU rows with ``--cpu``)
 and exits 0.
 """
@@ -124,15 +126,15 @@ def timed(sim, steps):
             "wall_ms_per_step": 1e3 * wall / steps, "mean_damage": float(np.mean(model.state.damage)), "es": es}
 
 
-def bench_gpu(n, mode, a):
+def bench_gpu(n, mode, a, tpb):
     from numba import cuda
 
     from lagice.solvers.cuda_explicit import simulator_enabled
 
     sim_mode = simulator_enabled()
     free0 = None if sim_mode else cuda.current_context().get_memory_info()[0]
-    sim, build_s = build(n, "cuda", a.substeps, a.wind, a.out / f"gpu_{n}_{mode}", launch=mode,
-                         tpb=a.threads_per_block)
+    sim, build_s = build(n, "cuda", a.substeps, a.wind, a.out / f"gpu_{n}_{mode}_{tpb}", launch=mode,
+                         tpb=tpb)
     row = timed(sim, a.steps)
     st = sim.model.stepper
     used = None if sim_mode else free0 - cuda.current_context().get_memory_info()[0]
@@ -206,6 +208,7 @@ def scene_days(n, device, a):
 
     cfg = scene_config(n, device, None, a.wind)
     cfg["run"]["duration"] = f"{a.days * 24:g}h"
+    cfg["run"]["progress"] = not a.smoke  # progress lines: a long run shows where it is
     t0 = time.perf_counter()
     sim = build_simulation(cfg, a.out / f"days_{device}_{n}")
     build_s = time.perf_counter() - t0
@@ -230,7 +233,10 @@ def main(argv=None):
     ap.add_argument("--substeps", type=int, default=100)
     ap.add_argument("--wind", choices=["uniform", "cyclones"], default="uniform")
     ap.add_argument("--mode", choices=["auto", "cooperative", "launches", "both"], default="both")
-    ap.add_argument("--threads-per-block", type=int, default=128)
+    ap.add_argument("--threads-per-block", type=int, nargs="+", default=[128],
+                    help="CUDA block size(s); each is timed for every size and launch mode")
+    ap.add_argument("--fresh-meshes", action="store_true",
+                    help="run gmsh for every build (default: once per size, scene_runs.reuse_gmsh_meshes)")
     ap.add_argument("--cpu", action="store_true", help="also time the CPU stepper and check agreement")
     ap.add_argument("--check-steps", type=int, default=3)
     ap.add_argument("--smoke", action="store_true", help="tiny sizes (for the CUDA simulator)")
@@ -254,6 +260,10 @@ def main(argv=None):
         a.elements, a.steps, a.substeps, a.check_steps = [150], 1, 3, 1
         a.days = min(a.days, 1 / 24)
     report = {"gpu": ok, "device": info, "simulator": simulator_enabled(), "rows": []}
+    if not a.fresh_meshes:
+        from scene_runs import reuse_gmsh_meshes
+
+        report["mesh_cache"] = reuse_gmsh_meshes()  # updated in place as builds run
     if not ok:
         print(f"NO GPU: {info}.\n"
               "No GPU figure was measured. Run this on a machine with an NVIDIA GPU (docs/gpu.md).")
@@ -263,15 +273,16 @@ def main(argv=None):
 
         print(f"device: {info}; numba {numba.__version__}")
         modes = ["cooperative", "launches"] if a.mode == "both" else [a.mode]
-        print(f"{'elements':>9} {'launch':>11} {'sub/step':>8} {'Gel-sub/s':>10} {'loop G/s':>9} "
+        print(f"{'elements':>9} {'launch':>11} {'tpb':>4} {'sub/step':>8} {'Gel-sub/s':>10} {'loop G/s':>9} "
               f"{'setup ms':>9} {'xfer ms':>8} {'other ms':>9} {'B/elem':>7} {'GB/s':>7}")
         for n in a.elements:
-            for mode in modes:
-                r = bench_gpu(n, mode, a)
+            for mode, tpb in ((m, t) for m in modes for t in a.threads_per_block):
+                r = bench_gpu(n, mode, a, tpb)
                 report["rows"].append(r)
                 other = sum(v for k, v in r["component_ms_per_step"].items() if k != "dynamics")
                 loop = (r["substep_loop_per_s"] or 0.0) / 1e9
-                print(f"{r['n_elements']:>9} {r['launch']:>11} {r['substeps_per_step']:>8.0f} "
+                print(f"{r['n_elements']:>9} {r['launch']:>11} {r['threads_per_block']:>4} "
+                      f"{r['substeps_per_step']:>8.0f} "
                       f"{r['element_substeps_per_s_stepper'] / 1e9:>10.3f} {loop:>9.3f} "
                       f"{r['overhead_ms_per_step']:>9.2f} {r['transfer_ms_per_step']:>8.2f} {other:>9.2f} "
                       f"{r['device_bytes_per_element']:>7.0f} {r['achieved_GB_s'] or 0:>7.0f}", flush=True)

@@ -62,6 +62,44 @@ def scene_dx_min(scene: str, overrides: dict | None = None) -> float:
     return float(math.sqrt(2.0 * mesh.areas().min()))
 
 
+def reuse_gmsh_meshes() -> dict:
+    """Mesh each domain once per process (large benchmark meshes: gmsh takes about 70 s
+    for 2M elements, and a benchmark builds the same scene several times).
+
+    Wraps :func:`lagice.mesh.generate_mesh` as the scene builder calls it: the first call
+    with a given polygon, size and options runs gmsh; later calls get a copy of that
+    mesh (:meth:`lagice.mesh.Mesh.copy`, so a run that moves its nodes leaves the cached
+    one alone), which is what gmsh would return again (it is deterministic). Everything
+    after gmsh (jitter, renumbering, rotation, the model) is built afresh. Returns the
+    statistics dict ``{"gmsh_calls": .., "reused": ..}`` that the wrapper updates."""
+    import hashlib
+    import pickle
+
+    import lagice.scenes.builder as builder
+
+    real = getattr(builder.generate_mesh, "__wrapped__", builder.generate_mesh)
+    cache, stats = {}, {"gmsh_calls": 0, "reused": 0}
+
+    def generate_mesh(polygon, size, **kw):
+        try:
+            key = hashlib.sha1(pickle.dumps((polygon.wkb, size, sorted(kw.items())))).hexdigest()
+        except Exception:  # an unpicklable size field: no caching
+            key = None
+        if key is None or key not in cache:
+            stats["gmsh_calls"] += 1
+            mesh = real(polygon, size, **kw)
+            if key is None:
+                return mesh
+            cache[key] = mesh
+        else:
+            stats["reused"] += 1
+        return cache[key].copy()
+
+    generate_mesh.__wrapped__ = real
+    builder.generate_mesh = generate_mesh
+    return stats
+
+
 def whole_steps(duration_s: float, dt_s: float) -> int:
     """Outer steps of ``dt_s`` covering ``duration_s`` (the last one may overshoot)."""
     return max(1, int(math.ceil(duration_s / dt_s - 1e-9)))
