@@ -80,7 +80,7 @@ def scene_config(n_elements: int, device: str, substeps: int, wind: str, paralle
     return load_scene("wind_square", ov)
 
 
-def build(n_elements, device, substeps, wind, out_dir, parallel=None, launch=None, tpb=None):
+def build(n_elements, device, substeps, wind, out_dir, parallel=None, launch=None, tpb=None, max_registers=None):
     """(simulation, seconds to build): the scene, then a Simulation whose outer step holds
     exactly ``substeps`` sub-steps at 0.999 × safety × the stability limit of this mesh."""
     from lagice.scenes.builder import build_simulation
@@ -95,6 +95,8 @@ def build(n_elements, device, substeps, wind, out_dir, parallel=None, launch=Non
         st.launch = launch
     if tpb is not None:
         st.tpb = int(tpb)
+    if max_registers:
+        st.max_registers = int(max_registers)
     dt = substeps * st.safety * explicit_substep_limit(st.dx_min, st.rheology.E0, st.rheology.params) * 0.999
     sim = Simulation(model, dt=dt, stop=10_000 * dt, progress=False)
     sim.output("1000d", Path(out_dir) / "snapshots", crs=None)  # one snapshot, at the start
@@ -126,15 +128,15 @@ def timed(sim, steps):
             "wall_ms_per_step": 1e3 * wall / steps, "mean_damage": float(np.mean(model.state.damage)), "es": es}
 
 
-def bench_gpu(n, mode, a, tpb):
+def bench_gpu(n, mode, a, tpb, regs=0):
     from numba import cuda
 
     from lagice.solvers.cuda_explicit import simulator_enabled
 
     sim_mode = simulator_enabled()
     free0 = None if sim_mode else cuda.current_context().get_memory_info()[0]
-    sim, build_s = build(n, "cuda", a.substeps, a.wind, a.out / f"gpu_{n}_{mode}_{tpb}", launch=mode,
-                         tpb=tpb)
+    sim, build_s = build(n, "cuda", a.substeps, a.wind, a.out / f"gpu_{n}_{mode}_{tpb}_{regs}", launch=mode,
+                         tpb=tpb, max_registers=regs)
     row = timed(sim, a.steps)
     st = sim.model.stepper
     used = None if sim_mode else free0 - cuda.current_context().get_memory_info()[0]
@@ -144,6 +146,7 @@ def bench_gpu(n, mode, a, tpb):
     bpe = bytes_per_element_substep(r, 4 if st._index_dtype == np.int32 else 8)
     loop_s = kt["substeps"]
     row.update(device="cuda", launch=st.launch_used, launch_note=st.launch_note, threads_per_block=st.tpb,
+               max_registers=st.max_registers,
                forcing_paths=st.forcing_paths, build_s=build_s,
                substep_loop_per_s=row["es"] / loop_s if loop_s > 0 else None,
                overhead_ms_per_step=row["kernel_timings_ms_per_step"]["forcing"]
@@ -235,6 +238,8 @@ def main(argv=None):
     ap.add_argument("--mode", choices=["auto", "cooperative", "launches", "both"], default="both")
     ap.add_argument("--threads-per-block", type=int, nargs="+", default=[128],
                     help="CUDA block size(s); each is timed for every size and launch mode")
+    ap.add_argument("--max-registers", type=int, nargs="+", default=[0],
+                    help="register cap(s) per thread of the cooperative kernel (0: none); each is timed")
     ap.add_argument("--fresh-meshes", action="store_true",
                     help="run gmsh for every build (default: once per size, scene_runs.reuse_gmsh_meshes)")
     ap.add_argument("--cpu", action="store_true", help="also time the CPU stepper and check agreement")
@@ -273,15 +278,18 @@ def main(argv=None):
 
         print(f"device: {info}; numba {numba.__version__}")
         modes = ["cooperative", "launches"] if a.mode == "both" else [a.mode]
-        print(f"{'elements':>9} {'launch':>11} {'tpb':>4} {'sub/step':>8} {'Gel-sub/s':>10} {'loop G/s':>9} "
-              f"{'setup ms':>9} {'xfer ms':>8} {'other ms':>9} {'B/elem':>7} {'GB/s':>7}")
+        print(f"{'elements':>9} {'launch':>11} {'tpb':>4} {'regs':>4} {'sub/step':>8} {'Gel-sub/s':>10} "
+              f"{'loop G/s':>9} {'setup ms':>9} {'xfer ms':>8} {'other ms':>9} {'B/elem':>7} {'GB/s':>7}")
         for n in a.elements:
-            for mode, tpb in ((m, t) for m in modes for t in a.threads_per_block):
-                r = bench_gpu(n, mode, a, tpb)
+            combos = [(m, t, g) for m in modes for t in a.threads_per_block
+                      for g in (a.max_registers if m == "cooperative" else [0])]
+            for mode, tpb, regs in combos:
+                r = bench_gpu(n, mode, a, tpb, regs)
                 report["rows"].append(r)
                 other = sum(v for k, v in r["component_ms_per_step"].items() if k != "dynamics")
                 loop = (r["substep_loop_per_s"] or 0.0) / 1e9
                 print(f"{r['n_elements']:>9} {r['launch']:>11} {r['threads_per_block']:>4} "
+                      f"{r['max_registers'] or '-':>4} "
                       f"{r['substeps_per_step']:>8.0f} "
                       f"{r['element_substeps_per_s_stepper'] / 1e9:>10.3f} {loop:>9.3f} "
                       f"{r['overhead_ms_per_step']:>9.2f} {r['transfer_ms_per_step']:>8.2f} {other:>9.2f} "

@@ -334,7 +334,16 @@ def main():
                damaged_fraction=float(np.mean(ref["damage"] > 0)))
     rep["cpu_parallel"] = compare(ref, run(model("cpu_parallel")))
     coop = model("cuda")  # sync="step", launch="auto"
-    rep["cuda_step_sync"] = compare(ref, run(coop))
+    res_coop = run(coop)
+    rep["cuda_step_sync"] = compare(ref, res_coop)
+    # a register cap changes register allocation, not arithmetic: the same result, bit for bit
+    # (on a device; the simulator has no registers and runs the uncapped kernel)
+    rep["register_cap_64_vs_uncapped"] = compare(res_coop, run(model("cuda", max_registers=64)))
+    try:
+        model("cuda", max_registers=8)
+        rep["register_cap_refused"] = None
+    except Exception as exc:  # noqa: BLE001 - the message is the result
+        rep["register_cap_refused"] = f"{type(exc).__name__}: {exc}"
     rep["paths"] = coop.stepper.forcing_paths
     rep["launch_auto"] = coop.stepper.launch_used
     rep["device_bytes_per_element"] = coop.stepper.device_bytes() / coop.mesh.n_elements

@@ -10,8 +10,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
 
 def test_reused_gmsh_mesh_is_the_mesh_gmsh_gives_and_is_not_shared(monkeypatch):
-    import lagice.scenes.builder as builder
     from scene_runs import reuse_gmsh_meshes, scene_config
+
+    import lagice.scenes.builder as builder
 
     monkeypatch.setattr(builder, "generate_mesh", builder.generate_mesh)  # restored after the test
     # without renumbering, build_mesh returns what generate_mesh returned

@@ -205,6 +205,11 @@ def test_cpu_serial_parallel_and_gpu_agree_on_a_damaging_run(sim_report):
     # neXtSIM's compressive term acted (elements below and above P_max) and changed the result
     below, above = r["pmax_elements_below_above"]
     assert below > 0 and above > 0 and r["pmax_vs_without"] > 1e-3
+    # a register cap on the cooperative kernel: same result bit for bit, bad caps refused
+    cap = r["register_cap_64_vs_uncapped"]
+    assert all(cap[f] == 0.0 for f in (*STATE, "transport", "strain", "nodes")), cap
+    assert cap["n_capped"][0] == cap["n_capped"][1] and cap["substeps"][0] == cap["substeps"][1]
+    assert r["register_cap_refused"].startswith("ConfigError: max_registers = 8 must be an integer in [16, 255]")
     constant, compliance = r["heal_compliance_damage_mean"]
     assert compliance < 0.9 * constant  # the compliance branch heals (faster than the constant law here)
     assert r["remesh_explicit_sync"]["remeshes"][0] == r["remesh_explicit_sync"]["remeshes"][1] >= 2

@@ -299,6 +299,10 @@ class CudaExplicitSolver:
         threads_per_block: CUDA block size (default 128).
         max_blocks: cap on blocks per launch (None: one thread per entity; every
             kernel is a grid-stride loop, so any cap is correct).
+        max_registers: register cap per thread for the cooperative sub-step kernel
+            (None: the compiler's choice, 86 on sm_90). A cap raises the number of
+            co-resident blocks and may make ptxas spill to local memory; the
+            results are the same (``docs/gpu.md``, "Measured on an H100").
 
     After a step, ``state.velocity`` is the last sub-step's velocity (in
     ``sync="explicit"`` once downloaded), :attr:`transport_velocity` the mean
@@ -320,7 +324,8 @@ class CudaExplicitSolver:
     def __init__(self, rheology: MaxwellEB, mesh, bcs=(), forces=(), substeps: int | None = None,
                  heal_rate=None, safety: float = 0.7, allow_unstable: bool = False,
                  parallel: bool | None = None, *, sync: str = "step", launch: str = "auto",
-                 threads_per_block: int = 128, max_blocks: int | None = None, substep_limit: str = "mesh"):
+                 threads_per_block: int = 128, max_blocks: int | None = None, substep_limit: str = "mesh",
+                 max_registers: int | None = None):
         self.device_name = require_cuda("solver.device")
         if not isinstance(rheology, MaxwellEB):
             raise ConfigError(f"the explicit stepper solves the Maxwell-EB rheology; got {type(rheology).__name__}")
@@ -339,6 +344,8 @@ class CudaExplicitSolver:
             raise ConfigError(f"threads_per_block = {threads_per_block!r} must be an integer in [1, 1024]")
         if max_blocks is not None and (int(max_blocks) != max_blocks or max_blocks < 1):
             raise ConfigError(f"max_blocks = {max_blocks!r} must be an integer >= 1 or None")
+        if max_registers is not None and (int(max_registers) != max_registers or not 16 <= max_registers <= 255):
+            raise ConfigError(f"max_registers = {max_registers!r} must be an integer in [16, 255] or None")
         from . import cuda_kernels as K
 
         self.substep_limit = check_substep_limit(substep_limit)
@@ -356,6 +363,7 @@ class CudaExplicitSolver:
         self.launch_note = ""
         self.tpb = int(threads_per_block)
         self.max_blocks = None if max_blocks is None else int(max_blocks)
+        self.max_registers = None if max_registers is None else int(max_registers)
         self.kernel_timings = {k: 0.0 for k in KERNELS}
         self._checked = set()
         self.last_substeps = None
@@ -615,7 +623,7 @@ class CudaExplicitSolver:
             self.launch_used = "launches"
             return self.launch_used
         try:
-            kern = K.substeps_cooperative
+            kern = K.cooperative_kernel(self.max_registers)
             if simulator_enabled():
                 mx = kern.overloads[None].max_cooperative_grid_blocks(self.tpb)
             else:
@@ -730,7 +738,7 @@ class CudaExplicitSolver:
                      d["flag"], d["mean_vel"], d["strain"], d["counters"], d["scalars"])
         if self._choose_launch(coop_args) == "cooperative":
             blocks = min(self._coop_max, self._blocks(max(n, m)))
-            K.substeps_cooperative[blocks, self.tpb](*coop_args)
+            K.cooperative_kernel(self.max_registers)[blocks, self.tpb](*coop_args)
         else:
             elem_args = (d["tri"], d["b"], d["c"], d["vel_w"], d["sigma_w"], d["damage_w"], *mat, *consts,
                          d["flag"], d["counters"])

@@ -293,6 +293,23 @@ def substeps_cooperative(n_sub, dt_s, vel, vel_sum, sigma, ptr, elems, wb, wc, m
         cuda.atomic.max(scalars, S_SPEED2_MAX, s2max)
 
 
+_CAPPED = {}
+
+
+def cooperative_kernel(max_registers=None):
+    """:func:`substeps_cooperative`, or the same function compiled with a register cap
+    per thread (``cuda.jit(max_registers=...)``; one dispatcher per cap, made once).
+    The cap changes register allocation only, not what is computed; numba's CUDA
+    simulator has no registers (and no such option), so there the kernel is uncapped."""
+    from numba import config
+
+    if max_registers is None or config.ENABLE_CUDASIM:
+        return substeps_cooperative
+    if max_registers not in _CAPPED:
+        _CAPPED[max_registers] = cuda.jit(max_registers=int(max_registers))(substeps_cooperative.py_func)
+    return _CAPPED[max_registers]
+
+
 # ----------------------------------------------------------------------------
 # ... or two launches per sub-step (fallback) plus two to finish
 # ----------------------------------------------------------------------------
