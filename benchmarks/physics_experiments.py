@@ -420,6 +420,23 @@ for _i in (1, 2, 3):
     EXPERIMENTS[f"W20-w{_i}"] = ("closed", [f"forcing.wind.seed={_i}"], 20e3, 28,
                                  f"as W20, weather of wind seed {_i} (same disorder)")
 
+# --- 2026-11-26 (fifth session): strength-disorder realisations of the shipped flagship ----
+# The 20 km disorder ensemble (W20-d*) was made on an older pack and mesh; these repeat it at
+# 10 km on the shipped set: the scene's weather (wind seed 2026) and air temperature (seed
+# 2026) pinned, another strength disorder (run.seed 1-3), closed and strait. A measurement
+# of how much one disorder realisation tells, not a candidate: nothing is chosen from it.
+# d2026 is the scene's own seed: the base run made again with today's code (a control: its
+# metrics must be those of F10-hthick-1125 / F10s-hthick-1125, made on 2026-11-25).
+for _i in (2026, 1, 2, 3):
+    _d = ["forcing.wind.seed=2026", "forcing.air_temperature.seed=2026", f"run.seed={_i}"]
+    EXPERIMENTS[f"F10-hthick-1125-d{_i}"] = ("closed", from_spinup("H1125") + _d, 10e3, 28,
+                                             f"F10-hthick-1125, strength disorder of run seed {_i} (same weather)")
+    EXPERIMENTS[f"F10s-hthick-1125-d{_i}"] = ("strait", from_spinup("H1125") + _d, 10e3, 28,
+                                              f"F10s-hthick-1125, strength disorder of run seed {_i} (same weather)")
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    ENSEMBLES[f"thick-and-thin disorder, {_basin}"] = [f"{_p}-hthick-1125"] + [f"{_p}-hthick-1125-d{i}"
+                                                                              for i in (1, 2, 3)]
+
 # (the pinning announced above: every experiment so far without a state file of its own)
 for _name, (_sc, _ov, _res, _days, _what) in list(EXPERIMENTS.items()):
     if not any(o.startswith("initial.state_file=") for o in _ov):

@@ -302,7 +302,7 @@ class CudaExplicitSolver:
         max_registers: register cap per thread for the cooperative sub-step kernel
             (None: the compiler's choice, 86 on sm_90). A cap raises the number of
             co-resident blocks and may make ptxas spill to local memory; the
-            results are the same (``docs/gpu.md``, "Measured on an H100").
+            results are the same (``docs/gpu.md``, "a register cap").
 
     After a step, ``state.velocity`` is the last sub-step's velocity (in
     ``sync="explicit"`` once downloaded), :attr:`transport_velocity` the mean
