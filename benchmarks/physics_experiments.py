@@ -437,6 +437,19 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     ENSEMBLES[f"thick-and-thin disorder, {_basin}"] = [f"{_p}-hthick-1125"] + [f"{_p}-hthick-1125-d{i}"
                                                                               for i in (1, 2, 3)]
 
+# The same three disorder draws in the calm month of wind seed 2028, where the shipped set
+# locks (0.0004 day-1 in both basins): is the lock a property of the weather and the pack,
+# or of one disorder draw (a weakest link)? A diagnostic; nothing is chosen from it.
+for _i in (1, 2, 3):
+    _d = ["forcing.wind.seed=2028", "forcing.air_temperature.seed=2026", f"run.seed={_i}"]
+    EXPERIMENTS[f"F10-hthick-1125-w2028-d{_i}"] = ("closed", from_spinup("H1125") + _d, 10e3, 28,
+                                                   f"F10-hthick-1125-w2028, strength disorder of run seed {_i}")
+    EXPERIMENTS[f"F10s-hthick-1125-w2028-d{_i}"] = ("strait", from_spinup("H1125") + _d, 10e3, 28,
+                                                    f"F10s-hthick-1125-w2028, strength disorder of run seed {_i}")
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    ENSEMBLES[f"thick-and-thin disorder, calm month 2028, {_basin}"] = [f"{_p}-hthick-1125-w2028"] + [
+        f"{_p}-hthick-1125-w2028-d{i}" for i in (1, 2, 3)]
+
 # (the pinning announced above: every experiment so far without a state file of its own)
 for _name, (_sc, _ov, _res, _days, _what) in list(EXPERIMENTS.items()):
     if not any(o.startswith("initial.state_file=") for o in _ov):
