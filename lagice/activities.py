@@ -342,6 +342,9 @@ class SignalStop(StopCondition):
 
     name = "signal_stop"
     SIGNALS = ("SIGTERM", "SIGINT")
+    # reads a flag only: with a device stepper, checking it every step must not download
+    # velocity, stress and damage (and upload them again before the next step)
+    needs_host_state = False
 
     def __init__(self):
         super().__init__(lambda sim: self.received is not None, "signal received")
@@ -375,6 +378,7 @@ class WallTimeLimit(StopCondition):
     ``limit`` of wall time has passed — for batch queues."""
 
     name = "wall_time_limit"
+    needs_host_state = False  # reads the wall clock only
 
     def __init__(self, limit):
         sched = WallTimeInterval(limit, "run.wall_time_limit")

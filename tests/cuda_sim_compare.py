@@ -227,15 +227,23 @@ def nan_checker_message(kind, how):
 
 
 def downloads_per_step():
-    """sync="explicit" through Simulation with only the NaN checker: the device clears
-    velocity, stress and damage itself, so nothing is downloaded between steps."""
+    """sync="explicit" through Simulation with the activities that run every step of
+    every run (the NaN checker, the signal stop) and a wall-time limit: the device clears
+    velocity, stress and damage itself, and the stop checks read no state, so nothing is
+    downloaded between steps."""
+    from lagice.activities import WallTimeLimit
+
     m = model("cuda", sync="explicit")
     sim = Simulation(m, dt=DT, stop=STEPS * DT, progress=False)
+    sim.add(WallTimeLimit("1h"))
+    every_step = [sim.activities[k] for k in ("nan_checker", "signal_stop", "wall_time_limit")]
     stale = []
-    sim.activities["nan_checker"].run(sim)
+    for a in every_step:
+        a.run(sim)
     for _ in range(2):
         sim.model.step(DT)
-        sim.activities["nan_checker"].run(sim)
+        for a in every_step:
+            a.run(sim)
         stale.append(list(m.stepper.host_stale))
     return stale
 

@@ -241,8 +241,9 @@ def test_checkpoints_move_between_devices(sim_report):
 def test_simulator_errors_match_cpu(sim_report):
     """A mesh leaving the forcing grid raises the CPU's ForcingError text; a NaN velocity
     and an ice speed above the bound stop the run with the NaN checker's message, the
-    same on both devices; with nothing but the NaN checker scheduled, the device clears
-    velocity, stress and damage itself and nothing is downloaded between steps."""
+    same on both devices; with the activities every run has each step (the NaN checker,
+    the signal stop) and a wall-time limit, the device clears velocity, stress and damage
+    itself and nothing is downloaded between steps."""
     a, b = sim_report["outside_grid_messages"]
     assert a is not None and a == b and "lie outside the forcing grid" in a
     a, b = sim_report["nan_messages"]
