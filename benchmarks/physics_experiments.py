@@ -420,6 +420,23 @@ for _i in (1, 2, 3):
     EXPERIMENTS[f"W20-w{_i}"] = ("closed", [f"forcing.wind.seed={_i}"], 20e3, 28,
                                  f"as W20, weather of wind seed {_i} (same disorder)")
 
+
+def add_disorder_ensemble(month: str, wind_seed: int, seeds, what_suffix: str, group: str) -> None:
+    """Strength-disorder draws of the thick-and-thin set in one month, closed and strait:
+    ``F10-hthick-1125{month}-d{seed}`` and ``F10s-...`` with the wind pinned to
+    ``wind_seed``, the air temperature to 2026 and ``run.seed`` = seed; the group
+    ``{group}, {basin}`` holds the month's published run and draws 1-3."""
+    for i in seeds:
+        d = [f"forcing.wind.seed={wind_seed}", "forcing.air_temperature.seed=2026", f"run.seed={i}"]
+        for basin, p in (("closed", "F10"), ("strait", "F10s")):
+            base = f"{p}-hthick-1125{month}"
+            EXPERIMENTS[f"{base}-d{i}"] = (basin, from_spinup("H1125") + d, 10e3, 28,
+                                           f"{base}, strength disorder of run seed {i}{what_suffix}")
+    for basin, p in (("closed", "F10"), ("strait", "F10s")):
+        base = f"{p}-hthick-1125{month}"
+        ENSEMBLES[f"{group}, {basin}"] = [base] + [f"{base}-d{i}" for i in (1, 2, 3)]
+
+
 # --- 2026-11-26 (fifth session): strength-disorder realisations of the shipped flagship ----
 # The 20 km disorder ensemble (W20-d*) was made on an older pack and mesh; these repeat it at
 # 10 km on the shipped set: the scene's weather (wind seed 2026) and air temperature (seed
@@ -427,28 +444,12 @@ for _i in (1, 2, 3):
 # of how much one disorder realisation tells, not a candidate: nothing is chosen from it.
 # d2026 is the scene's own seed: the base run made again with today's code (a control: its
 # metrics must be those of F10-hthick-1125 / F10s-hthick-1125, made on 2026-11-25).
-for _i in (2026, 1, 2, 3):
-    _d = ["forcing.wind.seed=2026", "forcing.air_temperature.seed=2026", f"run.seed={_i}"]
-    EXPERIMENTS[f"F10-hthick-1125-d{_i}"] = ("closed", from_spinup("H1125") + _d, 10e3, 28,
-                                             f"F10-hthick-1125, strength disorder of run seed {_i} (same weather)")
-    EXPERIMENTS[f"F10s-hthick-1125-d{_i}"] = ("strait", from_spinup("H1125") + _d, 10e3, 28,
-                                              f"F10s-hthick-1125, strength disorder of run seed {_i} (same weather)")
-for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
-    ENSEMBLES[f"thick-and-thin disorder, {_basin}"] = [f"{_p}-hthick-1125"] + [f"{_p}-hthick-1125-d{i}"
-                                                                              for i in (1, 2, 3)]
+add_disorder_ensemble("", 2026, (2026, 1, 2, 3), " (same weather)", "thick-and-thin disorder")
 
 # The same three disorder draws in the calm month of wind seed 2028, where the shipped set
 # locks (0.0004 day-1 in both basins): is the lock a property of the weather and the pack,
 # or of one disorder draw (a weakest link)? A diagnostic; nothing is chosen from it.
-for _i in (1, 2, 3):
-    _d = ["forcing.wind.seed=2028", "forcing.air_temperature.seed=2026", f"run.seed={_i}"]
-    EXPERIMENTS[f"F10-hthick-1125-w2028-d{_i}"] = ("closed", from_spinup("H1125") + _d, 10e3, 28,
-                                                   f"F10-hthick-1125-w2028, strength disorder of run seed {_i}")
-    EXPERIMENTS[f"F10s-hthick-1125-w2028-d{_i}"] = ("strait", from_spinup("H1125") + _d, 10e3, 28,
-                                                    f"F10s-hthick-1125-w2028, strength disorder of run seed {_i}")
-for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
-    ENSEMBLES[f"thick-and-thin disorder, calm month 2028, {_basin}"] = [f"{_p}-hthick-1125-w2028"] + [
-        f"{_p}-hthick-1125-w2028-d{i}" for i in (1, 2, 3)]
+add_disorder_ensemble("-w2028", 2028, (1, 2, 3), "", "thick-and-thin disorder, calm month 2028")
 
 # (the pinning announced above: every experiment so far without a state file of its own)
 for _name, (_sc, _ov, _res, _days, _what) in list(EXPERIMENTS.items()):
