@@ -112,7 +112,7 @@ def timed(sim, steps):
     model.timings = dict.fromkeys(model.timings, 0.0)
     n_sub = [0]
     sim.add_callback(lambda s: n_sub.__setitem__(0, n_sub[0] + s.model.last_report["solver"].iterations),
-                     every="1 steps", name="substep_count")
+                     every="1 steps", name="substep_count", needs_host_state=False)
     t0 = time.perf_counter()
     sim.run(n_steps=steps)
     wall = time.perf_counter() - t0
@@ -218,7 +218,7 @@ def scene_days(n, device, a):
     model = sim.model
     n_sub = [0]
     sim.add_callback(lambda s: n_sub.__setitem__(0, n_sub[0] + s.model.last_report["solver"].iterations),
-                     every="1 steps", name="substep_count")
+                     every="1 steps", name="substep_count", needs_host_state=False)
     t0 = time.perf_counter()
     summ = sim.run()
     wall = time.perf_counter() - t0

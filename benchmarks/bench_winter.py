@@ -47,7 +47,9 @@ def bench(days: float, resolution_m: float, parallel, outputs: bool = True, extr
     st = model.stepper
     sim.run(n_steps=1)  # warm-up: kernels loaded, the kernel choice measured
     reset_timings(model)
-    rec = Recorder(sim, el_sub=lambda m: m.mesh.n_elements * m.last_report["solver"].iterations)
+    # reads the mesh and the step's report only: no state download on the GPU (before 2026-11-26,
+    # third session, it downloaded velocity, stress and damage every step: +3 uploads, +2 downloads)
+    rec = Recorder(sim, host_state=False, el_sub=lambda m: m.mesh.n_elements * m.last_report["solver"].iterations)
     wall = timed_run(sim)
     tm = dict(model.timings)
     kt = st.kernel_timings
@@ -76,7 +78,10 @@ def bench(days: float, resolution_m: float, parallel, outputs: bool = True, extr
             "substeps_per_step": es / steps / model.mesh.n_elements, "wall_s": wall, "split_s": split,
             "element_substeps_per_s_loop": es / sub_s, "element_substeps_per_s_wall": es / wall,
             "remesh_count": int(model.state.counters.get("remesh_count", 0)),
-            "wall_28d_extrapolated_s": wall * 28.0 / simulated_days}
+            "wall_28d_extrapolated_s": wall * 28.0 / simulated_days,
+            **({"host_path": {"direct_copies": st._io.fast, "prepared_launches": st._io.prepared_launches,
+                              "note": st._io.note,
+                              "per_step": {k: v / steps for k, v in st._io.counts.items()}}} if gpu else {})}
 
 
 def main(argv=None):

@@ -451,6 +451,25 @@ add_disorder_ensemble("", 2026, (2026, 1, 2, 3), " (same weather)", "thick-and-t
 # or of one disorder draw (a weakest link)? A diagnostic; nothing is chosen from it.
 add_disorder_ensemble("-w2028", 2028, (1, 2, 3), "", "thick-and-thin disorder, calm month 2028")
 
+# --- 2026-11-26 (sixth session): eight months, each with a strength disorder of its own ------
+# The published eight-month ensemble keeps the scene's one disorder (run.seed 2026) in every
+# month, so its spread is a lower bound (the disorder moves the tails and beta as much as the
+# weather, above). Here each of the seven other months gets its own disorder draw (run.seed
+# 11-17; the air temperature pinned to 2026, as in the disorder draws above); the month of
+# seed 2026 keeps the published run. A measurement; nothing is chosen from it.
+#: (wind seed, run seed) of the months with a disorder of their own
+OWN_DISORDER = tuple((s, s - 2016) for s in ENSEMBLE_SEEDS + MORE_SEEDS)
+for _seed, _d in OWN_DISORDER:
+    for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+        EXPERIMENTS[f"{_p}-hthick-1125-w{_seed}-d{_d}"] = (
+            _basin, from_spinup("H1125") + [f"forcing.wind.seed={_seed}", "forcing.air_temperature.seed=2026",
+                                            f"run.seed={_d}"], 10e3, 28,
+            f"F10{'s' if _basin == 'strait' else ''}-hthick-1125, the weather of wind seed {_seed}, "
+            f"the strength disorder of run seed {_d}")
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    ENSEMBLES[f"thick-and-thin, {_basin}, eight months, a disorder each"] = [f"{_p}-hthick-1125"] + [
+        f"{_p}-hthick-1125-w{s}-d{d}" for s, d in OWN_DISORDER]
+
 # (the pinning announced above: every experiment so far without a state file of its own)
 for _name, (_sc, _ov, _res, _days, _what) in list(EXPERIMENTS.items()):
     if not any(o.startswith("initial.state_file=") for o in _ov):

@@ -120,20 +120,27 @@ def reset_timings(model) -> None:
     if kt is not None:
         for k in kt:
             kt[k] = 0.0
+    io = getattr(model.stepper, "_io", None)  # the GPU stepper's copy and launch counts
+    if io is not None:
+        for k in io.counts:
+            io.counts[k] = 0
 
 
 class Recorder:
     """A callback activity that records named scalar functions of the model after
     every outer step (``every``), into lists: ``rec["name"]``, ``rec.time_s``.
     ``solver_info=True`` also keeps each step's :class:`~lagice.solvers.base.StepInfo`
-    (``rec.infos``: iterations, linear iterations, timings of the implicit stepper)."""
+    (``rec.infos``: iterations, linear iterations, timings of the implicit stepper).
+    ``host_state=False``: the functions read no velocity, stress or damage (on a GPU
+    stepper the recorder then downloads nothing; see :class:`lagice.activities.Callback`)."""
 
-    def __init__(self, sim, every="1 steps", solver_info: bool = False, name: str = "recorder", **functions):
+    def __init__(self, sim, every="1 steps", solver_info: bool = False, name: str = "recorder",
+                 host_state: bool = True, **functions):
         self.functions = functions
         self.values = {k: [] for k in functions}
         self.time_s = []
         self.infos = [] if solver_info else None
-        sim.add_callback(self, every=every, name=name)
+        sim.add_callback(self, every=every, name=name, needs_host_state=host_state)
 
     def __call__(self, sim):
         m = sim.model

@@ -303,13 +303,16 @@ class NaNChecker(Activity):
 
 
 class Callback(Activity):
-    """A user function ``fn(sim)`` called when due."""
+    """A user function ``fn(sim)`` called when due. ``needs_host_state=False`` declares
+    that ``fn`` reads no velocity, stress or damage of the state (the clock, the mesh,
+    the last step's report): on a GPU stepper nothing is then downloaded for it."""
 
     name = "callback"
 
-    def __init__(self, fn, schedule, name: str | None = None):
+    def __init__(self, fn, schedule, name: str | None = None, needs_host_state: bool = True):
         super().__init__(schedule)
         self.fn = fn
+        self.needs_host_state = bool(needs_host_state)
         if name:
             self.name = name
 

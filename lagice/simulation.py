@@ -145,9 +145,9 @@ class Simulation:
         """Checkpoints every ``every`` (simulated time, ``"N steps"`` or ``"wall 55min"``)."""
         return self.add(Checkpointer(every, path, keep))
 
-    def add_callback(self, fn, every, name: str | None = None):
-        """Call ``fn(sim)`` every ``every``."""
-        return self.add(Callback(fn, every, name or f"callback_{len(self.activities)}"))
+    def add_callback(self, fn, every, name: str | None = None, needs_host_state: bool = True):
+        """Call ``fn(sim)`` every ``every`` (``needs_host_state``: :class:`~lagice.activities.Callback`)."""
+        return self.add(Callback(fn, every, name or f"callback_{len(self.activities)}", needs_host_state))
 
     @property
     def checkpointer(self) -> Checkpointer | None:

@@ -236,16 +236,20 @@ def downloads_per_step():
     m = model("cuda", sync="explicit")
     sim = Simulation(m, dt=DT, stop=STEPS * DT, progress=False)
     sim.add(WallTimeLimit("1h"))
-    every_step = [sim.activities[k] for k in ("nan_checker", "signal_stop", "wall_time_limit")]
-    stale = []
+    # a callback that declares it reads no state (as the benchmarks' recorders do)
+    sim.add_callback(lambda s: s.model.mesh.n_elements, every="1 steps", name="counter", needs_host_state=False)
+    every_step = [sim.activities[k] for k in ("nan_checker", "signal_stop", "wall_time_limit", "counter")]
+    stale, counts = [], []
     for a in every_step:
         a.run(sim)
     for _ in range(2):
+        before = dict(m.stepper._io.counts)
         sim.model.step(DT)
         for a in every_step:
             a.run(sim)
         stale.append(list(m.stepper.host_stale))
-    return stale
+        counts.append({k: v - before[k] for k, v in m.stepper._io.counts.items()})
+    return stale, counts
 
 
 # -- the scene path: TOML, builder, Simulation, checkpoints moving between devices --------------
@@ -382,7 +386,15 @@ def main():
     rep["outside_grid_messages"] = [forcing_error("cpu"), forcing_error("cuda")]
     rep["nan_messages"] = [nan_checker_message("cpu", "nan"), nan_checker_message("cuda", "nan")]
     rep["speed_messages"] = [nan_checker_message("cpu", "speed"), nan_checker_message("cuda", "speed")]
-    rep["stale_after_nan_check"] = downloads_per_step()
+    rep["stale_after_nan_check"], rep["transfers_per_step"] = downloads_per_step()
+    # direct driver copies and prepared launches (cuda_host.py) against numba's own calls: bit for bit
+    # on a GPU (in the simulator both are numba's calls); with mesh motion, healing and remeshing
+    fast = model("cuda", heal=True, remesh=True, sync="explicit")
+    res_fast = run(fast)
+    slow = model("cuda", heal=True, remesh=True, sync="explicit", fast_host=False)
+    rep["host_path_fast_vs_numba"] = compare(res_fast, run(slow))
+    rep["host_path"] = {"fast": fast.stepper._io.fast, "note": fast.stepper._io.note,
+                        "counts": fast.stepper._io.counts, "numba_counts": slow.stepper._io.counts}
     for motion in ("translation", "rotation"):
         a, b = rigid_motion("cpu", motion), rigid_motion("cuda", motion)
         rep[f"rigid_{motion}"] = {**{k: v for k, v in b.items() if k not in ("transport", "nodes")},

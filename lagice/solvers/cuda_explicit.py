@@ -55,6 +55,7 @@ from ..forces import Coriolis, OceanDrag, WindStress, evaluate_vector
 from ..rheology import MaxwellEB
 from ..stability import effective_dx
 from .base import StepInfo
+from .cuda_host import HostPath, fast_host_wanted
 from .explicit import ExplicitSolver, check_substep_limit
 
 #: values of ``[solver] device``
@@ -223,7 +224,7 @@ class _NodeField:
             return
         if self.path == "host":
             vals = evaluate_vector(self.field, t, solver.mesh.nodes, self.name)
-            out.copy_to_device(np.ascontiguousarray(vals))
+            solver._io.h2d(out, np.ascontiguousarray(vals, np.float64))
             return
         f = self.field
         if self._axes is None:
@@ -303,6 +304,10 @@ class CudaExplicitSolver:
             (None: the compiler's choice, 86 on sm_90). A cap raises the number of
             co-resident blocks and may make ptxas spill to local memory; the
             results are the same (``docs/gpu.md``, "a register cap").
+        fast_host: copies through the CUDA driver directly and launches with prepared
+            arguments (:mod:`lagice.solvers.cuda_host`); None (default): on a GPU
+            unless ``LAGICE_CUDA_FAST_HOST=0``, never in the simulator; False: numba's
+            own copies and launches. Bit for bit the same results.
 
     After a step, ``state.velocity`` is the last sub-step's velocity (in
     ``sync="explicit"`` once downloaded), :attr:`transport_velocity` the mean
@@ -325,7 +330,7 @@ class CudaExplicitSolver:
                  heal_rate=None, safety: float = 0.7, allow_unstable: bool = False,
                  parallel: bool | None = None, *, sync: str = "step", launch: str = "auto",
                  threads_per_block: int = 128, max_blocks: int | None = None, substep_limit: str = "mesh",
-                 max_registers: int | None = None):
+                 max_registers: int | None = None, fast_host: bool | None = None):
         self.device_name = require_cuda("solver.device")
         if not isinstance(rheology, MaxwellEB):
             raise ConfigError(f"the explicit stepper solves the Maxwell-EB rheology; got {type(rheology).__name__}")
@@ -365,6 +370,13 @@ class CudaExplicitSolver:
         self.max_blocks = None if max_blocks is None else int(max_blocks)
         self.max_registers = None if max_registers is None else int(max_registers)
         self.kernel_timings = {k: 0.0 for k in KERNELS}
+        #: copies and launches (direct driver calls and prepared launches on a GPU: cuda_host.py)
+        self._io = HostPath((fast_host_wanted() and not simulator_enabled()) if fast_host is None
+                            else bool(fast_host))
+        self._cnt0 = np.zeros(K.N_COUNTERS, np.int64)
+        self._sc0 = np.zeros(K.N_SCALARS)
+        self._sc0[[K.S_E_MAX, K.S_STIFF_MAX]] = -math.inf
+        self._sc0[K.S_AREA_MIN] = math.inf
         self._checked = set()
         self.last_substeps = None
         self._d = {}
@@ -411,12 +423,13 @@ class CudaExplicitSolver:
         return nb if self.max_blocks is None else min(nb, self.max_blocks)
 
     def _launch(self, kernel, size: int, *args) -> None:
-        kernel[self._blocks(size), self.tpb](*args)
+        self._io.launch(kernel, self._blocks(size), self.tpb, args)
 
     # -- topology and geometry (the device node system) ---------------------------------
     def reset_topology(self, mesh) -> None:
         """New mesh (remesh, checkpoint load): drop every device array and rebuild the
         prescribed dofs; the next :meth:`step` uploads the whole state from the host."""
+        self._io.clear()
         self._d = {}
         self._resident = None
         self._host_stale = set()
@@ -475,14 +488,8 @@ class CudaExplicitSolver:
         self._index_dtype = idx
 
     def _reset_counters(self) -> None:
-        from . import cuda_kernels as K
-
-        self._d["counters"].copy_to_device(np.zeros(K.N_COUNTERS, np.int64))
-        sc = np.zeros(K.N_SCALARS)
-        sc[K.S_E_MAX] = -math.inf
-        sc[K.S_STIFF_MAX] = -math.inf
-        sc[K.S_AREA_MIN] = math.inf
-        self._d["scalars"].copy_to_device(sc)
+        self._io.h2d(self._d["counters"], self._cnt0)
+        self._io.h2d(self._d["scalars"], self._sc0)
 
     def update_geometry(self) -> None:
         """Nodes moved on the host (mesh motion): upload them and recompute shape
@@ -491,12 +498,12 @@ class CudaExplicitSolver:
 
         self._ensure_topology()
         d = self._d
-        d["nodes"].copy_to_device(np.ascontiguousarray(self.mesh.nodes, np.float64))
+        self._io.h2d(d["nodes"], np.ascontiguousarray(self.mesh.nodes, np.float64))
         self._reset_counters()
         self._launch(K.geometry_kernel, self.mesh.n_elements, d["nodes"], d["tri"], d["b"], d["c"], d["area"],
                      d["td"], float(self.rheology.params.shear_wave_speed), d["scalars"], d["counters"])
-        cnt = d["counters"].copy_to_host()
-        sc = d["scalars"].copy_to_host()
+        cnt = self._io.d2h(d["counters"])
+        sc = self._io.d2h(d["scalars"])
         self._geom_cache = {}
         if cnt[K.C_INVERTED]:
             raise SolverError(f"{int(cnt[K.C_INVERTED])} inverted elements in the mesh")
@@ -505,7 +512,7 @@ class CudaExplicitSolver:
 
     def _geom(self, key):
         if key not in self._geom_cache:
-            self._geom_cache[key] = self._d[key].copy_to_host()
+            self._geom_cache[key] = self._io.d2h(self._d[key])
         return self._geom_cache[key]
 
     area = property(lambda self: self._geom("area"), doc="element areas [m²] (host copy, cached)")
@@ -519,14 +526,14 @@ class CudaExplicitSolver:
         """(n, 2) [m s-1] mean of the last step's sub-step velocities (what moves the
         nodes; :class:`~lagice.solvers.base.TimeStepper`), None before a step."""
         if self._transport is None and self._have_results:
-            self._transport = self._d["mean_vel"].copy_to_host()
+            self._transport = self._io.d2h(self._d["mean_vel"])
         return self._transport
 
     @property
     def last_strain_rate(self):
         """(m, 3) [s-1] strain rate of :attr:`transport_velocity`, None before a step."""
         if self._strain is None and self._have_results:
-            self._strain = self._d["strain"].copy_to_host()
+            self._strain = self._io.d2h(self._d["strain"])
         return self._strain
 
     # -- sync API ---------------------------------------------------------------------------
@@ -548,7 +555,7 @@ class CudaExplicitSolver:
             return
         for f in fields:
             if f in self._host_stale:
-                arr = self._d[_DEV_KEY[f]].copy_to_host()
+                arr = self._io.d2h(self._d[_DEV_KEY[f]])
                 setattr(state, f, arr)
                 self._host_ref[f] = arr
                 self._host_stale.discard(f)
@@ -572,7 +579,7 @@ class CudaExplicitSolver:
             if arr.shape != shape:
                 raise SolverError(f"state.{f} has shape {arr.shape}; expected {shape} for this mesh "
                                   "(call reset_topology after replacing the mesh)")
-            self._d[_DEV_KEY[f]].copy_to_device(arr)
+            self._io.h2d(self._d[_DEV_KEY[f]], arr)
             self._host_ref[f] = host
             self._host_stale.discard(f)
         self._resident = state
@@ -687,7 +694,7 @@ class CudaExplicitSolver:
             heal = np.ascontiguousarray(self.heal_rate(state, t_s), np.float64)
             if heal.shape != (m,):
                 raise SolverError(f"heal_rate returned shape {heal.shape}; expected ({m},) [s-1]")
-            d["heal"].copy_to_device(heal)
+            self._io.h2d(d["heal"], heal)
             self._heal_const = None
         else:
             rate = float(rh.constant_heal_rate(1)[0])
@@ -705,8 +712,8 @@ class CudaExplicitSolver:
         kt["forcing"] = t2 - t1
 
         # -- mid-step sync: E_max, forcing checks, sub-step count ------------------------------
-        cnt = d["counters"].copy_to_host()
-        scal = d["scalars"].copy_to_host()
+        cnt = self._io.d2h(d["counters"])
+        scal = self._io.d2h(d["scalars"])
         E_max = float(scal[K.S_E_MAX]) if m else float(p.E0)
         self.dx_eff = (effective_dx(self.dx_min, E_max, float(scal[K.S_STIFF_MAX]))
                        if m and self.substep_limit == "element" else self.dx_min)
@@ -738,7 +745,7 @@ class CudaExplicitSolver:
                      d["flag"], d["mean_vel"], d["strain"], d["counters"], d["scalars"])
         if self._choose_launch(coop_args) == "cooperative":
             blocks = min(self._coop_max, self._blocks(max(n, m)))
-            K.cooperative_kernel(self.max_registers)[blocks, self.tpb](*coop_args)
+            self._io.launch(K.cooperative_kernel(self.max_registers), blocks, self.tpb, coop_args)
         else:
             elem_args = (d["tri"], d["b"], d["c"], d["vel_w"], d["sigma_w"], d["damage_w"], *mat, *consts,
                          d["flag"], d["counters"])
@@ -749,8 +756,8 @@ class CudaExplicitSolver:
                          d["scalars"])
             self._launch(K.finish_elements_kernel, m, d["tri"], d["b"], d["c"], d["mean_vel"], d["strain"],
                          d["flag"], d["sigma_w"], d["damage_w"], d["counters"])
-        cnt = d["counters"].copy_to_host()
-        speed2 = float(d["scalars"].copy_to_host()[K.S_SPEED2_MAX])
+        cnt = self._io.d2h(d["counters"])
+        speed2 = float(self._io.d2h(d["scalars"])[K.S_SPEED2_MAX])
         t4 = time.perf_counter()
         kt["substeps"] = t4 - t3
 
