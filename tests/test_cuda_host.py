@@ -135,3 +135,16 @@ def test_unknown_launch_call_turns_prepared_launches_off_after_one_launch(fast_p
     assert not fast_path.prepared_launches and "no known launch call" in fast_path.note
     fast_path.launch(kern, 1, 32, (a, 2.0))  # numba's own launch from now on
     assert [v for _, v in mod.calls] == [_reference((a, 1.0)), _reference((a, 2.0))]
+
+
+def test_the_switch_takes_0_or_1(monkeypatch):
+    from lagice.errors import ConfigError
+    from lagice.solvers.cuda_host import fast_host_wanted
+
+    monkeypatch.delenv("LAGICE_CUDA_FAST_HOST", raising=False)
+    assert fast_host_wanted()
+    monkeypatch.setenv("LAGICE_CUDA_FAST_HOST", "0")
+    assert not fast_host_wanted()
+    monkeypatch.setenv("LAGICE_CUDA_FAST_HOST", "yes")
+    with pytest.raises(ConfigError, match="LAGICE_CUDA_FAST_HOST = 'yes': expected 0 or 1"):
+        fast_host_wanted()

@@ -373,6 +373,7 @@ class CudaExplicitSolver:
         #: copies and launches (direct driver calls and prepared launches on a GPU: cuda_host.py)
         self._io = HostPath((fast_host_wanted() and not simulator_enabled()) if fast_host is None
                             else bool(fast_host))
+        self._io_logged = None
         self._cnt0 = np.zeros(K.N_COUNTERS, np.int64)
         self._sc0 = np.zeros(K.N_SCALARS)
         self._sc0[[K.S_E_MAX, K.S_STIFF_MAX]] = -math.inf
@@ -776,6 +777,16 @@ class CudaExplicitSolver:
             kt["transfer"] += time.perf_counter() - t4
         for k, v in kt.items():
             self.kernel_timings[k] += v
+        io_state = (self.launch_used, self._io.fast, self._io.prepared_launches, self._io.note)
+        if io_state != self._io_logged:  # the first step, and whenever the host path falls back
+            self._io_logged = io_state
+            import logging
+
+            logging.getLogger("lagice").info(
+                f"GPU stepper on {self.device_name}: launch {self.launch_used}; host path: "
+                f"{'direct driver copies' if self._io.fast else 'numba copies'}, "
+                f"{'prepared launches' if self._io.prepared_launches else 'numba launches'}"
+                + (f" ({self._io.note})" if self._io.note else ""))
         info = StepInfo(iterations=n_sub, residual=0.0, n_damaged=int(cnt[K.C_DAMAGED]), n_capped=n_capped)
         info.timings = {"assembly": kt["forcing"] + kt["setup"] + kt["transfer"], "solve": kt["substeps"],
                         "damage": 0.0}
