@@ -213,6 +213,14 @@ def test_cpu_serial_parallel_and_gpu_agree_on_a_damaging_run(sim_report):
     constant, compliance = r["heal_compliance_damage_mean"]
     assert compliance < 0.9 * constant  # the compliance branch heals (faster than the constant law here)
     assert r["remesh_explicit_sync"]["remeshes"][0] == r["remesh_explicit_sync"]["remeshes"][1] >= 2
+    # the host path (direct copies, prepared launches; on a GPU only) against numba's own calls:
+    # bit for bit, the same copies and launches, and on a GPU without a fallback
+    hp, fast = r["host_path_fast_vs_numba"], r["host_path"]
+    assert all(hp[f] == 0.0 for f in (*STATE, "transport", "strain", "nodes")), hp
+    assert hp["remeshes"][0] == hp["remeshes"][1] >= 2 and hp["substeps"][0] == hp["substeps"][1]
+    counts = {k: v for k, v in fast["counts"].items() if k != "prepared"}
+    assert counts == {k: v for k, v in fast["numba_counts"].items() if k != "prepared"}
+    assert fast["fast"] is GPU_REAL and fast["note"] == ""
 
 
 @pytest.mark.slow
@@ -251,6 +259,10 @@ def test_simulator_errors_match_cpu(sim_report):
     a, b = sim_report["speed_messages"]
     assert a is not None and a == b and "above the bound 0.001 m/s" in a
     assert sim_report["stale_after_nan_check"] == [["velocity", "stress", "damage"]] * 2
+    # steady state (the second step): the host-owned fields and the two counter resets of the step
+    # and of the geometry update go up, with the nodes; nothing of the state comes back
+    assert sim_report["transfers_per_step"][1]["uploads"] == 8
+    assert sim_report["transfers_per_step"][1]["downloads"] == 7
 
 
 @pytest.mark.slow
