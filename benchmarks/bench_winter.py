@@ -47,8 +47,8 @@ def bench(days: float, resolution_m: float, parallel, outputs: bool = True, extr
     st = model.stepper
     sim.run(n_steps=1)  # warm-up: kernels loaded, the kernel choice measured
     reset_timings(model)
-    # reads the mesh and the step's report only: no state download on the GPU (before 2026-11-26,
-    # third session, it downloaded velocity, stress and damage every step: +3 uploads, +2 downloads)
+    # reads the mesh and the step's report only: no state download on the GPU (until 2026-11-26,
+    # sixth session, it downloaded velocity, stress and damage every step: +3 uploads, +2 downloads)
     rec = Recorder(sim, host_state=False, el_sub=lambda m: m.mesh.n_elements * m.last_report["solver"].iterations)
     wall = timed_run(sim)
     tm = dict(model.timings)

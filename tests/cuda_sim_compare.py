@@ -228,9 +228,10 @@ def nan_checker_message(kind, how):
 
 def downloads_per_step():
     """sync="explicit" through Simulation with the activities that run every step of
-    every run (the NaN checker, the signal stop) and a wall-time limit: the device clears
-    velocity, stress and damage itself, and the stop checks read no state, so nothing is
-    downloaded between steps."""
+    every run (the NaN checker, the signal stop), a wall-time limit and a callback declared
+    stateless: the device clears velocity, stress and damage itself, and the stop checks
+    and the callback read no state, so nothing is downloaded between steps. Also returns
+    the copies and launches of each step (``HostPath.counts``)."""
     from lagice.activities import WallTimeLimit
 
     m = model("cuda", sync="explicit")
