@@ -27,8 +27,13 @@ path off (for measurements). Every copy and launch is counted (:attr:`HostPath.c
 from __future__ import annotations
 
 import os
+import threading
 
 import numpy as np
+
+#: held while a first launch has numba's launch function replaced by a recorder (that
+#: function is a module global: two threads must not swap it at the same time)
+_PATCH_LOCK = threading.Lock()
 
 
 def fast_host_wanted() -> bool:
@@ -149,34 +154,35 @@ class HostPath:
 
         from numba import typeof
 
-        seen = {}
-        patched = []
-        mod = sys.modules.get(type(kernel).__module__)
-        core_launch = getattr(mod, "launch", None) if mod is not None and hasattr(mod, "LaunchConfig") else None
-        if callable(core_launch):
-            def record_core(stream, config, kern, *kernelargs):
-                seen.update(launch=core_launch, head=(stream, config, kern), kw={},
-                            values=[_value(a) for a in kernelargs])
-                return core_launch(stream, config, kern, *kernelargs)
+        with _PATCH_LOCK:  # numba's launch functions are module globals: one first launch at a time
+            seen = {}
+            patched = []
+            mod = sys.modules.get(type(kernel).__module__)
+            core_launch = getattr(mod, "launch", None) if mod is not None and hasattr(mod, "LaunchConfig") else None
+            if callable(core_launch):
+                def record_core(stream, config, kern, *kernelargs):
+                    seen.update(launch=core_launch, head=(stream, config, kern), kw={},
+                                values=[_value(a) for a in kernelargs])
+                    return core_launch(stream, config, kern, *kernelargs)
 
-            patched.append((mod, "launch", core_launch, record_core))
-        drv_launch = getattr(self._drv, "launch_kernel", None)
-        if callable(drv_launch):
-            def record_drv(handle, gx, gy, gz, bx, by, bz, sharedmem, stream, kernelargs, cooperative=False):
-                if sharedmem == 0:
-                    seen.update(launch=_driver_launch(drv_launch), head=(handle, gx, gy, gz, bx, by, bz, 0, stream),
-                                kw={"cooperative": cooperative}, values=[_value(a) for a in kernelargs])
-                return drv_launch(handle, gx, gy, gz, bx, by, bz, sharedmem, stream, kernelargs,
-                                  cooperative=cooperative)
+                patched.append((mod, "launch", core_launch, record_core))
+            drv_launch = getattr(self._drv, "launch_kernel", None)
+            if callable(drv_launch):
+                def record_drv(handle, gx, gy, gz, bx, by, bz, sharedmem, stream, kernelargs, cooperative=False):
+                    if sharedmem == 0:
+                        seen.update(launch=_driver_launch(drv_launch), head=(handle, gx, gy, gz, bx, by, bz, 0, stream),
+                                    kw={"cooperative": cooperative}, values=[_value(a) for a in kernelargs])
+                    return drv_launch(handle, gx, gy, gz, bx, by, bz, sharedmem, stream, kernelargs,
+                                      cooperative=cooperative)
 
-            patched.append((self._drv, "launch_kernel", drv_launch, record_drv))
-        for owner, name, _, rec in patched:
-            setattr(owner, name, rec)
-        try:
-            kernel[griddim, blockdim](*args)
-        finally:
-            for owner, name, orig, _ in patched:
-                setattr(owner, name, orig)
+                patched.append((self._drv, "launch_kernel", drv_launch, record_drv))
+            for owner, name, _, rec in patched:
+                setattr(owner, name, rec)
+            try:
+                kernel[griddim, blockdim](*args)
+            finally:
+                for owner, name, orig, _ in patched:
+                    setattr(owner, name, orig)
         # from here on the kernel has run: any failure only turns the fast path off
         if not seen:
             raise _Unsupported("no known launch call (cuda.core's launch, the driver's launch_kernel) was seen",
