@@ -49,7 +49,7 @@ def bench(days: float, resolution_m: float, parallel, outputs: bool = True, extr
     reset_timings(model)
     # reads the mesh and the step's report only: no state download on the GPU (until 2026-11-26,
     # sixth session, it downloaded velocity, stress and damage every step: +3 uploads, +2 downloads)
-    rec = Recorder(sim, host_state=False, el_sub=lambda m: m.mesh.n_elements * m.last_report["solver"].iterations)
+    rec = Recorder(sim, needs_host_state=False, el_sub=lambda m: m.mesh.n_elements * m.last_report["solver"].iterations)
     wall = timed_run(sim)
     tm = dict(model.timings)
     kt = st.kernel_timings

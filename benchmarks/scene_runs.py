@@ -131,16 +131,16 @@ class Recorder:
     every outer step (``every``), into lists: ``rec["name"]``, ``rec.time_s``.
     ``solver_info=True`` also keeps each step's :class:`~lagice.solvers.base.StepInfo`
     (``rec.infos``: iterations, linear iterations, timings of the implicit stepper).
-    ``host_state=False``: the functions read no velocity, stress or damage (on a GPU
+    ``needs_host_state=False``: the functions read no velocity, stress or damage (on a GPU
     stepper the recorder then downloads nothing; see :class:`lagice.activities.Callback`)."""
 
     def __init__(self, sim, every="1 steps", solver_info: bool = False, name: str = "recorder",
-                 host_state: bool = True, **functions):
+                 needs_host_state: bool = True, **functions):
         self.functions = functions
         self.values = {k: [] for k in functions}
         self.time_s = []
         self.infos = [] if solver_info else None
-        sim.add_callback(self, every=every, name=name, needs_host_state=host_state)
+        sim.add_callback(self, every=every, name=name, needs_host_state=needs_host_state)
 
     def __call__(self, sim):
         m = sim.model

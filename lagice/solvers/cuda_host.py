@@ -30,6 +30,7 @@ import os
 import threading
 
 import numpy as np
+from numba import typeof
 
 #: held while a first launch has numba's launch function replaced by a recorder (that
 #: function is a module global: two threads must not swap it at the same time)
@@ -134,8 +135,6 @@ class HostPath:
                 prepare(types[i], v, 0, [], kernelargs)
                 continue
             if held[i] is not v:  # another device array at this position (the swapped work arrays)
-                from numba import typeof
-
                 if typeof(v) != types[i]:
                     self._packs[key] = self._first_launch(kernel, griddim, blockdim, args)
                     return
@@ -151,8 +150,6 @@ class HostPath:
         pack from the compiled kernel and check that it converts the arguments to the
         same values."""
         import sys
-
-        from numba import typeof
 
         with _PATCH_LOCK:  # numba's launch functions are module globals: one first launch at a time
             seen = {}
