@@ -91,15 +91,15 @@ def kernel_bytes(st, mesh) -> dict:
     n, m = mesh.n_nodes, mesh.n_elements
     ptr, elems, tri = st._indices(mesh) if hasattr(st, "_indices") else (*mesh.node_elements[:2], mesh.triangles)
     f8 = 8
-    node = (ptr.nbytes + elems.nbytes + 2 * len(elems) * f8   # adjacency: ptr, elems, wb, wc
+    node = (ptr.nbytes + elems.nbytes + 2 * len(elems) * f8   # adjacency: ptr, elems, w (wb, wc)
             + n * (2 * f8 * 2 * 2                                # vel, vel_sum: read + write
-                   + f8 + 2 * f8 + f8 + 2 * f8 + f8)             # m_dt, fext, cda, current, half_mf
+                   + 8 * f8)                                     # nc: m_dt, cda, half_mf, fext, current, pad
             + n * 2                                              # fixed (int8)
             + m * 3 * f8)                                        # sigma gathered (read once)
     elem = (tri.nbytes + 2 * m * 3 * f8                          # tri, b, c
             + n * 2 * f8                                         # vel gathered (read once)
             + m * 3 * f8 * 2                                     # sigma read + write
-            + m * f8 * 7)                                        # damage, sig_c, sig_t, td, heal, e_dt, gamma
+            + m * f8 * 5)                                        # damage, conc_factor, cohesion, td, heal
     return {"node_bytes": node / m, "element_bytes": elem / m, "total_bytes": (node + elem) / m,
             "index_bytes": (ptr.nbytes + elems.nbytes + tri.nbytes) / m}
 
@@ -115,6 +115,7 @@ def element_kernel_rates(n_target: int = 50_000, reps: int = 20) -> dict:
     from lagice.mesh import generate_mesh, renumber_for_locality
     from lagice.rheology import MaxwellEB
     from lagice.solvers.explicit import element_stress_damage_kernel_serial as kernel
+    from lagice.solvers.explicit import envelope_factors
 
     rheo = MaxwellEB()
     p = rheo.params
@@ -130,9 +131,9 @@ def element_kernel_rates(n_target: int = 50_000, reps: int = 20) -> dict:
         sigma = rng.normal(0, 1e4, (m, 3))
         damage = np.full(m, d0)
         cohv = np.full(m, coh)
-        sc = 2 * cohv / rheo._denom
-        args = (tri, b, c, vel, sigma, damage, np.ones(m), cohv, sc, sc / rheo.q, np.full(m, 20.0),
-                np.full(m, heal), np.full(m, 4.0 * p.E0), np.full(m, 0.99), None, 4.0, 1.1, 0.3, 0.7, rheo.q,
+        kc, kt = envelope_factors(rheo)
+        args = (tri, b, c, vel, sigma, damage, np.ones(m), cohv, kc, kt, np.full(m, 20.0),
+                np.full(m, heal), None, 4.0, 1.1, 0.3, 0.7, rheo.q,
                 rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, np.zeros(m, np.int8))
         kernel(*args)
         t0 = time.process_time()

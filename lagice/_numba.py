@@ -39,6 +39,25 @@ def serial_copy(py_func, **njit_kw):
     return njit(cache=True, **njit_kw)(ser)
 
 
+def specialised_copy(py_func, suffix: str, constants: dict, parallel: bool = False, **njit_kw):
+    """A numba dispatcher of ``py_func`` in which the module globals named in ``constants``
+    take the given values (numba freezes globals at compile time, so a branch on such a
+    constant is removed, and a global kernel can be swapped for another). The copy gets
+    ``suffix`` on its name and qualname (numba's disk cache is keyed by qualname); its
+    globals are a snapshot taken now, so make copies after every name it uses exists."""
+    py_func = getattr(py_func, "py_func", py_func)
+    missing = [k for k in constants if k not in py_func.__globals__]
+    if missing:
+        raise KeyError(f"{py_func.__qualname__}: no module global {missing}")
+    glob = {**py_func.__globals__, **constants}
+    f = types.FunctionType(py_func.__code__, glob, py_func.__name__ + suffix, py_func.__defaults__,
+                           py_func.__closure__)
+    f.__qualname__ = py_func.__qualname__ + suffix
+    f.__module__ = py_func.__module__
+    f.__doc__ = py_func.__doc__
+    return njit(cache=True, parallel=parallel, **njit_kw)(f)
+
+
 def serial_and_parallel(py_func, **njit_kw):
     """``(serial, parallel)`` numba dispatchers of ``py_func``."""
     py_func = getattr(py_func, "py_func", py_func)

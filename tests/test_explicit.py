@@ -7,10 +7,17 @@ import numpy as np
 import pytest
 
 from lagice.errors import ConfigError, LagiceError
+from lagice.fem import strain_rate
 from lagice.mesh import generate_mesh, rectangle_domain
 from lagice.rheology import MaxwellEB
 from lagice.solvers import SOLVERS, ExplicitSolver, VelocityBC
-from lagice.solvers.explicit import element_stress_damage_kernel, element_stress_damage_kernel_serial
+from lagice.solvers.explicit import (
+    element_stress_damage_kernel,
+    element_stress_damage_kernel_a4,
+    element_stress_damage_kernel_a4_serial,
+    element_stress_damage_kernel_serial,
+    envelope_factors,
+)
 from lagice.stability import StabilityWarning, explicit_substep_limit, load_limits
 from lagice.state import IceState
 
@@ -25,10 +32,12 @@ def linear_velocity(comp):
 
 @pytest.mark.parametrize("kernel", [element_stress_damage_kernel, element_stress_damage_kernel_serial])
 def test_element_kernel_damage_matches_rheology(kernel):
-    """With zero strain rate and γ = 1 the element kernel is the rheology's damage/healing
-    update (same formulas; to round-off, since the kernel may fuse a multiply-add into one
-    FMA, ``explicit.KERNEL_FASTMATH``): the same elements damage, and stress and damage
-    agree to 1e-13 relative (a wrong factor or a missed correction is ≥ 1e-3 off)."""
+    """With zero strain rate and γ = 1 (λ0 so large that λ/(λ+Δt) rounds to 1) the element
+    kernel is the rheology's damage/healing update (same formulas; to round-off, since the
+    kernel may fuse a multiply-add into one FMA, ``explicit.KERNEL_FASTMATH``): the same
+    elements damage, and stress and damage agree to 1e-13 relative (a wrong factor or a
+    missed correction is ≥ 1e-3 off). The kernel's cheap inside-the-envelope test
+    (``envelope_factors``) must not change which elements damage."""
     rng = np.random.default_rng(0)
     m = 500
     rheo = MaxwellEB()
@@ -46,23 +55,135 @@ def test_element_kernel_damage_matches_rheology(kernel):
     zeros3 = np.zeros((m, 3))
     flag = np.zeros(m, np.int8)
     p = rheo.params
-    e_dt, gam = np.zeros(m), np.ones(m)
-    sig_c = 2.0 * coh / rheo._denom
-    kernel(tri, zeros3, zeros3, np.zeros((1, 2)), s2, d2, conc_factor, coh, sig_c, sig_c / rheo.q, td,
-           heal, e_dt, gam, None,
-           7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s,
-           p.alpha, flag)
+    kc, kt = envelope_factors(rheo)
+    kernel(tri, zeros3, zeros3, np.zeros((1, 2)), s2, d2, conc_factor, coh, kc, kt, td, heal, None,
+           7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0, 1e300, p.alpha, flag)
     assert (dc < 1).sum() > 100
     assert np.allclose(s2, s1, rtol=1e-13, atol=1e-13 * np.abs(s1).max())
     assert np.allclose(d2, d1, rtol=1e-13, atol=1e-15)
     assert not np.allclose(s1, sigma, rtol=1e-6)  # the correction acted
     assert np.array_equal(flag.astype(bool), dc < 1)
-    # moduli refreshed where damage changed, as the rheology computes them
-    E, lam = rheo.moduli(d1, np.ones(m))
-    ch = d1 != damage
-    assert ch.sum() > 100
-    assert np.allclose(e_dt[ch], 7.0 * E[ch], rtol=1e-13, atol=0)
-    assert np.allclose(gam[ch], lam[ch] / (lam[ch] + 7.0), rtol=1e-13, atol=0)
+
+
+@pytest.mark.parametrize("kernel", [element_stress_damage_kernel, element_stress_damage_kernel_serial,
+                                    element_stress_damage_kernel_a4, element_stress_damage_kernel_a4_serial])
+def test_element_kernel_stress_update_uses_rheology_moduli(kernel):
+    """One sub-step on damaged, partly open ice with a strain rate and no damage event
+    (huge cohesion, no healing): σ = γ (σ0 + Δt_s E K:ε̇) with E and λ from
+    ``MaxwellEB.moduli`` (γ = λ/(λ+Δt_s)), to 1e-13 relative, for α = 4 (the kernel's
+    product form) and α = 4.5 (the power form; general builds only)."""
+    from lagice.fem import shape_gradients
+    from lagice.mesh import renumber_for_locality
+
+    poly, _ = rectangle_domain(40e3, 40e3)
+    mesh = renumber_for_locality(generate_mesh(poly, 8e3))[0]
+    m, n = mesh.n_elements, mesh.n_nodes
+    rng = np.random.default_rng(3)
+    b, c, _ = shape_gradients(mesh.nodes, mesh.triangles)
+    vel = rng.normal(0, 0.05, (n, 2))
+    a4 = kernel in (element_stress_damage_kernel_a4, element_stress_damage_kernel_a4_serial)
+    for alpha in (4.0,) if a4 else (4.0, 4.5):
+        rheo = MaxwellEB(alpha=alpha)
+        p = rheo.params
+        damage = rng.uniform(0, 0.95, m)
+        conc = rng.uniform(0.8, 1.0, m)
+        conc_factor = np.exp(-p.concentration_c * (1.0 - conc))
+        sigma0 = rng.normal(0, 1e4, (m, 3))
+        sigma, d = sigma0.copy(), damage.copy()
+        dt_s = 3.0
+        kc, kt = envelope_factors(rheo)
+        kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, conc_factor, np.full(m, 1e15), kc, kt,
+               np.full(m, 20.0), np.zeros(m), None, dt_s, *rheo.K[0, :2], rheo.K[2, 2], rheo.q, rheo._denom,
+               p.max_damage, p.E0, p.relaxation_time_s, float(alpha), np.zeros(m, np.int8))
+        E, lam = rheo.moduli(damage, conc)
+        eps = strain_rate(mesh.triangles, b, c, vel)
+        ref = (lam / (lam + dt_s))[:, None] * (sigma0 + dt_s * E[:, None] * (eps @ rheo.K.T))
+        assert np.array_equal(d, damage)
+        assert np.allclose(sigma, ref, rtol=1e-13, atol=1e-13 * np.abs(ref).max())
+        assert not np.allclose(sigma, sigma0, rtol=1e-3)  # the strain rate acted
+
+
+def test_alpha4_builds_equal_general_builds():
+    """The α = 4 builds (λ = λ0 x³ compiled in) give bit for bit what the general kernel
+    gives with α = 4, on a sub-step where some elements damage and others heal."""
+    rng = np.random.default_rng(5)
+    poly, _ = rectangle_domain(40e3, 40e3)
+    from lagice.fem import shape_gradients
+
+    mesh = generate_mesh(poly, 6e3)
+    m, n = mesh.n_elements, mesh.n_nodes
+    b, c, _ = shape_gradients(mesh.nodes, mesh.triangles)
+    rheo = MaxwellEB()
+    p = rheo.params
+    kc, kt = envelope_factors(rheo)
+    vel = rng.normal(0, 0.2, (n, 2))
+    sigma0 = rng.normal(0, 3e4, (m, 3))
+    damage0 = rng.uniform(0, 1, m)
+    coh = rng.uniform(1e4, 4e4, m)
+    out = []
+    for kernel in (element_stress_damage_kernel_serial, element_stress_damage_kernel_a4_serial,
+                   element_stress_damage_kernel, element_stress_damage_kernel_a4):
+        sigma, d, flag = sigma0.copy(), damage0.copy(), np.zeros(m, np.int8)
+        capped = kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, np.full(m, 0.9),
+                        coh, kc, kt, np.full(m, 30.0), np.full(m, 1e-6), None, 20.0, *rheo.K[0, :2], rheo.K[2, 2],
+                        rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
+        out.append((sigma, d, flag, capped))
+    assert 0 < out[0][2].sum() < m  # some elements damage, some do not
+    assert np.any(out[0][1] < damage0)  # some heal
+    for o in out[1:]:
+        assert np.array_equal(o[0], out[0][0]) and np.array_equal(o[1], out[0][1])
+        assert np.array_equal(o[2], out[0][2]) and o[3] == out[0][3]
+
+
+def test_node_kernel_matches_general_2x2_solve():
+    """The node kernel solves its 2×2 system as a scaled rotation; the general solve
+    (``lagice.fem.solve_node_2x2``, as the CUDA kernel and mEVP do) of the same system, with
+    free, half-prescribed and prescribed nodes and a turning angle, gives the same velocity
+    to 1e-13 relative, and the gathered force is −Σ w·σ."""
+    from lagice.fem import solve_node_2x2
+    from lagice.solvers.explicit import node_constants, node_velocity_kernel_serial
+
+    poly, _ = rectangle_domain(40e3, 40e3)
+    mesh = generate_mesh(poly, 6e3)
+    ptr, elems, _local = mesh.node_elements
+    n, m = mesh.n_nodes, mesh.n_elements
+    rng = np.random.default_rng(11)
+    sigma = rng.normal(0, 2e4, (m, 3))
+    w = rng.normal(0, 1e7, (len(elems), 2))
+    m_dt, cda, mass = rng.uniform(1e5, 1e6, n), rng.uniform(1e5, 1e7, n), rng.uniform(1e9, 1e10, n)
+    cor = np.full(n, 1.4e-4)
+    fext, cur = rng.normal(0, 1e6, (n, 2)), rng.normal(0, 0.1, (n, 2))
+    fixed = np.zeros((n, 2), np.int8)
+    fixed[::7, 0] = 1
+    fixed[::5, 1] = 1
+    pres0, pres1 = rng.normal(0, 0.1, (n, 2)), rng.normal(0, 0.1, (n, 2))
+    vel0 = rng.normal(0, 0.2, (n, 2))
+    cos_t, sin_t = np.cos(0.4), np.sin(0.4)
+    vel, vsum = vel0.copy(), np.zeros((n, 2))
+    node_velocity_kernel_serial(vel, vsum, sigma, ptr.astype(np.int32), elems.astype(np.int32), w,
+                                node_constants(m_dt, cda, mass, cor, fext, cur), cos_t, sin_t, fixed, pres0, pres1,
+                                0.25)
+    ref = np.empty((n, 2))
+    for i in range(n):
+        pu, pv = pres0[i] + 0.25 * (pres1[i] - pres0[i])
+        if fixed[i, 0] and fixed[i, 1]:
+            ref[i] = pu, pv
+            continue
+        f = np.zeros(2)
+        for p in range(ptr[i], ptr[i + 1]):
+            sxx, syy, sxy = sigma[elems[p]]
+            f -= (w[p, 0] * sxx + w[p, 1] * sxy, w[p, 0] * sxy + w[p, 1] * syy)
+        u, v = vel0[i]
+        cd = cda[i] * np.hypot(cur[i, 0] - u, cur[i, 1] - v)
+        hf = 0.5 * mass[i] * cor[i]
+        a11 = a22 = m_dt[i] + cd * cos_t
+        a12, a21 = -cd * sin_t - hf, cd * sin_t + hf
+        rx = m_dt[i] * u + f[0] + fext[i, 0] + cd * (cos_t * cur[i, 0] - sin_t * cur[i, 1]) + hf * v
+        ry = m_dt[i] * v + f[1] + fext[i, 1] + cd * (sin_t * cur[i, 0] + cos_t * cur[i, 1]) - hf * u
+        ref[i] = solve_node_2x2(a11, a12, a21, a22, rx, ry, fixed[i, 0], fixed[i, 1], pu, pv)
+    assert fixed[:, 0].sum() and fixed[:, 1].sum() and (fixed.sum(axis=1) == 2).sum()
+    assert np.allclose(vel, ref, rtol=1e-13, atol=1e-13 * np.abs(ref).max())
+    assert np.array_equal(vsum, vel)
 
 
 def test_patch_uniform_strain_rate(plate_mesh):

@@ -117,7 +117,9 @@ def damage_step_dev(d, dc, dt, td, heal_rate, max_damage):
 @cuda.jit(device=True)
 def node_update(i, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
                 half_mf, fixed, pres0, pres1, w_time):
-    """One node of :func:`lagice.solvers.explicit._node_velocity` (same expressions)."""
+    """One node of :func:`lagice.solvers.explicit._node_velocity`: the same expressions, with
+    the weights and per-node constants in separate arrays and the general 2×2 solve
+    (:func:`lagice.fem.solve_node_2x2`; the CPU kernel's rotation form gives the same numbers)."""
     fx0 = fixed[i, 0]
     fx1 = fixed[i, 1]
     if fx0 and fx1:
@@ -165,7 +167,12 @@ def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigm
                    lambda0, alpha, damaged_flag):
     """One element of :func:`lagice.solvers.explicit._element_stress_damage`
     (same expressions; ``use_pmax`` = 1: neXtSIM's compressive term with ``pmax``);
-    returns 1 when the damage cap acted."""
+    returns 1 when the damage cap acted. Δt_s E and γ are read from ``e_dt``/``gamma``,
+    refreshed here where damage changes (the CPU kernel computes them from the damage
+    every sub-step since 2026-11-26, seventh session: equal to round-off, not bit for bit,
+    because the set-up's first values come from ``MaxwellEB.moduli``), and the envelope
+    test reads σc, σT per element (the CPU kernel scales the cohesion; both only shortcut
+    ``_dcrit``, which decides)."""
     exx, eyy, exy = strain_rate_dev(tri, b, c, vel, e)
     ed = e_dt[e]
     g = gamma[e]

@@ -78,13 +78,13 @@ def _element_evp(tri, b, c, vel, S, P, alpha_e, alpha, adapt_coef, e2inv, delta_
         S[e, 2] += (sxy - S[e, 2]) * inv
 
 
-def _node_evp(vel, vel_n, S, ptr, elems, wb, wc, alpha_e, beta, m_dt, fext, cda, current, cos_t, sin_t,
+def _node_evp(vel, vel_n, S, ptr, elems, w, alpha_e, beta, m_dt, fext, cda, current, cos_t, sin_t,
               mf, fixed, pres):
     """One mEVP velocity update in place on ``vel`` (n, 2) (module doc, step 2).
 
     m_dt = m/Δt [kg s-1]; fext = a τa [N]; cda = a ρw Cw [kg m-1]; mf = m f
-    [kg s-1] (Coriolis Crank–Nicolson: ½ m f k×(u^{p+1} + u^n)); wb, wc = area ∂φ/∂x,
-    area ∂φ/∂y per adjacency entry [m]; β_i =
+    [kg s-1] (Coriolis Crank–Nicolson: ½ m f k×(u^{p+1} + u^n)); w (nnz, 2) = (area ∂φ/∂x,
+    area ∂φ/∂y) per adjacency entry [m]; β_i =
     max(beta, α_e of its elements). Returns max |u^{p+1} − u^p| [m s-1]."""
     n = ptr.shape[0] - 1
     dmax = 0.0
@@ -102,8 +102,10 @@ def _node_evp(vel, vel_n, S, ptr, elems, wb, wc, alpha_e, beta, m_dt, fext, cda,
         bi = beta
         for p in range(ptr[i], ptr[i + 1]):
             e = elems[p]
-            fx -= wb[p] * S[e, 0] + wc[p] * S[e, 2]
-            fy -= wb[p] * S[e, 2] + wc[p] * S[e, 1]
+            wb = w[p, 0]
+            wc = w[p, 1]
+            fx -= wb * S[e, 0] + wc * S[e, 2]
+            fy -= wb * S[e, 2] + wc * S[e, 1]
             if alpha_e[e] > bi:
                 bi = alpha_e[e]
         md = m_dt[i]
@@ -281,7 +283,7 @@ class EVPSolver:
             elem_k(tri, b, c, vel, S, P, alpha_e, self.alpha, adapt, e2inv, vp.delta_min,
                    vp.replacement_pressure)
             tb = time.perf_counter()
-            res = node_k(vel, vel_n, S, ptr, elems, su.wb, su.wc, alpha_e, self.beta, su.m_dt, su.fext, su.cda,
+            res = node_k(vel, vel_n, S, ptr, elems, su.w, alpha_e, self.beta, su.m_dt, su.fext, su.cda,
                          terms.current, terms.cos_turn, terms.sin_turn, mf, ns.fixed, pres)
             tc = time.perf_counter()
             tm += tb - ta

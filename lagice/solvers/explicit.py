@@ -26,8 +26,8 @@ both parallel over their *own* entities so that no loop scatters:
    ``_dcrit`` (a test checks both agree to round-off, 1e-13 relative:
    the kernels fuse multiply-adds, see ``KERNEL_FASTMATH``). E = E0 (1−d) g and
    λ = λ0 ((1−d) g)^(α−1), g = exp(−c*(1−A)) (the rheology's formulas; a test
-   checks them against ``MaxwellEB.moduli``) are recomputed only where damage
-   changed.
+   checks the stress update against ``MaxwellEB.moduli``) are computed per element
+   from its damage at the start of each sub-step.
 
 Stability: the sub-step is limited by elastic waves, Δt_s ≲ C Δx / sqrt(E/ρ);
 C was measured (``benchmarks/stability.py``) and ships in
@@ -42,9 +42,9 @@ import time
 import numpy as np
 from numba import njit, prange
 
-from .._numba import PARALLEL_MIN_SIZE, autotune, serial_copy
+from .._numba import PARALLEL_MIN_SIZE, autotune, serial_copy, specialised_copy
 from ..errors import ConfigError
-from ..fem import STRAIN_RATE, NodeSystem, element_strain_rate, solve_node_2x2
+from ..fem import STRAIN_RATE, NodeSystem, element_strain_rate
 from ..forces import explicit_terms
 from ..rheology import MaxwellEB, _dcrit, damage_step
 from ..stability import effective_dx
@@ -93,15 +93,45 @@ AUTOTUNE_FIRST_INTERVAL_S = 10.0
 KERNEL_FASTMATH = {"contract"}
 
 
-def _node_velocity(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
-                   half_mf, fixed, pres0, pres1, w_time):
+#: columns of the per-node constants array ``nc`` (n, 8) of :func:`_node_velocity`: one row
+#: of 64 B per node instead of five arrays (m/Δt_s, a ρw Cw, ½ m f, a τ (2), Uw (2); the last
+#: column is padding). +1.5 % for the node kernel on 2 threads (docs/benchmarks.md).
+NODE_CONSTANTS = ("m_dt", "cda", "half_mf", "fext_x", "fext_y", "current_x", "current_y", "pad")
+
+
+@njit(cache=True)
+def node_constants(m_dt, cda, mass, coriolis, fext, current):
+    """The (n, 8) per-node constants of one outer step (:data:`NODE_CONSTANTS`); ½ m f from
+    the lumped mass m [kg] and the Coriolis parameter f [s-1] (n,)."""
+    n = m_dt.shape[0]
+    nc = np.empty((n, 8))
+    for i in range(n):
+        nc[i, 0] = m_dt[i]
+        nc[i, 1] = cda[i]
+        nc[i, 2] = 0.5 * mass[i] * coriolis[i]
+        nc[i, 3] = fext[i, 0]
+        nc[i, 4] = fext[i, 1]
+        nc[i, 5] = current[i, 0]
+        nc[i, 6] = current[i, 1]
+        nc[i, 7] = 0.0
+    return nc
+
+
+def _node_velocity(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, w_time):
     """One semi-implicit momentum sub-step in place on ``vel`` (n, 2) (module doc, step 1).
 
-    m_dt = m/Δt_s [kg s-1]; fext = a τ [N] (velocity-independent);
-    cda = a ρw Cw [kg m-1]; current Uw [m s-1]; half_mf = ½ m f [kg s-1];
-    fixed (n, 2) int8 flags of prescribed components; pres0/pres1 their values at
-    the start/end of the outer step, weighted (1 − w_time, w_time). The new
-    velocity is also added to ``vel_sum`` (outer-step mean velocity).
+    w (nnz, 2): adjacency weights (:func:`lagice.fem._adjacency_weights`); nc (n, 8): the
+    per-node constants (:data:`NODE_CONSTANTS`): m_dt = m/Δt_s [kg s-1], cda = a ρw Cw
+    [kg m-1], half_mf = ½ m f [kg s-1], fext = a τ [N] (velocity-independent), current Uw
+    [m s-1]; fixed (n, 2) int8 flags of prescribed components; pres0/pres1 their values at
+    the start/end of the outer step, weighted (1 − w_time, w_time). The new velocity is
+    also added to ``vel_sum`` (outer-step mean velocity).
+
+    The 2×2 matrix is a scaled rotation, [[a, −s], [s, a]] with a = m/Δt_s + c_d cosθ and
+    s = c_d sinθ + ½ m f, so it is solved as (a r_x + s r_y, a r_y − s r_x)/(a² + s²): the
+    solution of :func:`lagice.fem.solve_node_2x2` with a22 = a11 and a21 = −a12 (a > 0: the
+    lumped mass is positive), bit for bit on the kernel arguments of the benchmark box and
+    the flagship (docs/benchmarks.md); a test checks it to 1e-13.
     """
     n = ptr.shape[0] - 1
     for i in prange(n):
@@ -120,55 +150,89 @@ def _node_velocity(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, cur
             sxx = sigma[e, 0]
             syy = sigma[e, 1]
             sxy = sigma[e, 2]
-            fx -= wb[p] * sxx + wc[p] * sxy
-            fy -= wb[p] * sxy + wc[p] * syy
+            wb = w[p, 0]
+            wc = w[p, 1]
+            fx -= wb * sxx + wc * sxy
+            fy -= wb * sxy + wc * syy
         u = vel[i, 0]
         v = vel[i, 1]
-        md = m_dt[i]
-        uwx = current[i, 0]
-        uwy = current[i, 1]
+        md = nc[i, 0]
+        uwx = nc[i, 5]
+        uwy = nc[i, 6]
         ru = uwx - u
         rv = uwy - v
-        cd = cda[i] * math.sqrt(ru * ru + rv * rv)
-        hf = half_mf[i]
+        cd = nc[i, 1] * math.sqrt(ru * ru + rv * rv)
+        hf = nc[i, 2]
         a11 = md + cd * cos_t
         a12 = -cd * sin_t - hf
-        a21 = cd * sin_t + hf
-        a22 = md + cd * cos_t
-        rx = md * u + fx + fext[i, 0] + cd * (cos_t * uwx - sin_t * uwy) + hf * v
-        ry = md * v + fy + fext[i, 1] + cd * (sin_t * uwx + cos_t * uwy) - hf * u
-        pu = pres0[i, 0] + w_time * (pres1[i, 0] - pres0[i, 0]) if fx0 else 0.0
-        pv = pres0[i, 1] + w_time * (pres1[i, 1] - pres0[i, 1]) if fx1 else 0.0
-        un, vn = solve_node_2x2(a11, a12, a21, a22, rx, ry, fx0, fx1, pu, pv)
+        rx = md * u + fx + nc[i, 3] + cd * (cos_t * uwx - sin_t * uwy) + hf * v
+        ry = md * v + fy + nc[i, 4] + cd * (sin_t * uwx + cos_t * uwy) - hf * u
+        if fx0:
+            un = pres0[i, 0] + w_time * (pres1[i, 0] - pres0[i, 0])
+            vn = (ry + a12 * un) / a11
+        elif fx1:
+            vn = pres0[i, 1] + w_time * (pres1[i, 1] - pres0[i, 1])
+            un = (rx - a12 * vn) / a11
+        else:
+            det = a11 * a11 + a12 * a12
+            un = (a11 * rx - a12 * ry) / det
+            vn = (a11 * ry + a12 * rx) / det
         vel[i, 0] = un
         vel[i, 1] = vn
         vel_sum[i, 0] += un
         vel_sum[i, 1] += vn
 
 
-def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c, sigma_t,
-                           td, heal_rate, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q, denom,
+def envelope_factors(rheology):
+    """(kc, kt) [-] of the element kernel's cheap inside-the-envelope test: σc = 2C/denom and
+    σT = σc/q (Dansereau et al. 2016 eqs. 4, 6) are taken as C·kc and C·kt, lowered by
+    1e-12 relative so that the test is strictly conservative (an element it passes is
+    inside the exact envelope; the rest go to ``_dcrit``, which decides exactly)."""
+    kc = 2.0 / rheology._denom * (1.0 - 1e-12)
+    return kc, kc / rheology.q
+
+
+#: False in the general element kernel; True in its α = 4 builds (:func:`lagice._numba.specialised_copy`),
+#: where numba then compiles λ = λ0 x³ without the branch on α: a branch on α inside the
+#: element loop cost the kernel 3-4 % on 2 threads (docs/benchmarks.md)
+_ALPHA_IS_4 = False
+
+
+def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion, kc, kt,
+                           td, heal_rate, pmax, dt_s, kxx, kxy, kss, q, denom,
                            max_damage, E0, lambda0, alpha, damaged_flag):
     """Maxwell stress update and damage/healing of one sub-step, in place (module doc, step 2).
 
-    e_dt = Δt_s E [Pa s], gamma = λ/(λ+Δt_s) per element, refreshed here where
-    damage changes from E = E0 (1−d) g, λ = λ0 ((1−d) g)^(α−1) with
-    g = conc_factor = exp(−c*(1−A)) (rheology.young_modulus/relaxation_time;
-    an integer α−1 is taken as repeated products). kxx = 1/(1−ν²), kxy = ν/(1−ν²), kss = (1−ν)/(1−ν²) are the
-    entries of K; sigma_c = 2C/denom and sigma_t = sigma_c/q [Pa] (Dansereau et al. 2016 eqs. 4, 6)
-    per element. pmax [Pa]: neXtSIM's compressive term (rheology.max_pressure; None: off,
-    and numba prunes the branch when it compiles the NoneType signature, so the default
-    path pays nothing for it): where the mean stress σn of the previous sub-step is compressive, the
-    relaxation factor is λ/(λ + Δt_s (1 − P̃)), P̃ = min(1, pmax/(−σn)), computed from
-    γ = λ/(λ+Δt_s) as γ/(γ + (1 − γ)(1 − P̃)) (neXtSIM's ``updateSigmaDamage``).
+    The moduli come from the element's damage at the start of the sub-step:
+    E = E0 (1−d) g and λ = λ0 ((1−d) g)^(α−1) with g = conc_factor = exp(−c*(1−A))
+    (rheology.young_modulus/relaxation_time; an integer α−1 is taken as repeated
+    products), then Δt_s E and γ = λ/(λ+Δt_s). Recomputing them costs one division per
+    element; reading them from two arrays refreshed where damage changed was 8 % slower on
+    2 threads (docs/benchmarks.md). kxx = 1/(1−ν²), kxy = ν/(1−ν²), kss = (1−ν)/(1−ν²) are
+    the entries of K; kc, kt: :func:`envelope_factors`. pmax [Pa]: neXtSIM's compressive
+    term (rheology.max_pressure; None: off, and numba prunes the branch when it compiles the
+    NoneType signature, so the default path pays nothing for it): where the mean stress σn
+    of the previous sub-step is compressive, the relaxation factor is
+    λ/(λ + Δt_s (1 − P̃)), P̃ = min(1, pmax/(−σn)), computed from γ as
+    γ/(γ + (1 − γ)(1 − P̃)) (neXtSIM's ``updateSigmaDamage``).
     Returns the number of elements whose damage hit the cap.
     """
     m = tri.shape[0]
     n_capped = 0
     for e in prange(m):
         exx, eyy, exy = element_strain_rate(tri, b, c, vel, e)
-        ed = e_dt[e]
-        g = gamma[e]
+        d0 = damage[e]
+        x = (1.0 - d0) * conc_factor[e]
+        if _ALPHA_IS_4:  # a compile-time constant: True only in the α = 4 builds
+            lam = lambda0 * (x * x * x)
+        elif alpha == 4.0:
+            lam = lambda0 * (x * x * x)
+        elif alpha == 5.0:
+            lam = lambda0 * (x * x) * (x * x)
+        else:
+            lam = lambda0 * x ** (alpha - 1.0)
+        ed = dt_s * (E0 * x)
+        g = lam / (lam + dt_s)
         if pmax is not None:
             sn = -0.5 * (sigma[e, 0] + sigma[e, 1])
             if sn > 0.0:
@@ -179,19 +243,19 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
         sxy = (sigma[e, 2] + ed * (kss * exy)) * g
         # damage and stress correction: rheology.damage_step (both healing forms, by the sign of
         # heal_rate), as in rheology.damage_update_kernel.
-        # Cheap test first: strictly inside the envelope (s1 < σT and q s1 − s2 < σc, with
-        # σc = 2C/denom, σT = σc/q precomputed) _dcrit returns exactly 1. With s1,2 = m ± r
-        # the two conditions are r < σT − m and (q + 1) r < σc − (q − 1) m, tested on squares
-        # (no square root for the ~all elements inside: +7 % for the kernel).
+        # Cheap test first: strictly inside the envelope (s1 < σT and q s1 − s2 < σc) _dcrit
+        # returns exactly 1. With s1,2 = m ± r the two conditions are r < σT − m and
+        # (q + 1) r < σc − (q − 1) m, tested on squares (no square root for the ~all elements
+        # inside: +7 % for the kernel), with σc, σT slightly lowered (envelope_factors).
         mm = 0.5 * (sxx + syy)
         r2 = 0.25 * (sxx - syy) ** 2 + sxy * sxy
-        at = sigma_t[e] - mm
-        ac = sigma_c[e] - (q - 1.0) * mm
+        ce = cohesion[e]
+        at = ce * kt - mm
+        ac = ce * kc - (q - 1.0) * mm
         if at > 0.0 and ac > 0.0 and r2 < at * at and (q + 1.0) * (q + 1.0) * r2 < ac * ac:
             dc = 1.0
         else:
-            dc = _dcrit(sxx, syy, sxy, cohesion[e], q, denom)
-        d0 = damage[e]
+            dc = _dcrit(sxx, syy, sxy, ce, q, denom)
         d, f, capped = damage_step(d0, dc, dt_s, td[e], heal_rate[e], max_damage)
         if dc < 1.0:
             sxx *= f
@@ -204,15 +268,6 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
         sigma[e, 2] = sxy
         if d != d0:
             damage[e] = d
-            x = (1.0 - d) * conc_factor[e]
-            if alpha == 4.0:
-                lam = lambda0 * (x * x * x)
-            elif alpha == 5.0:
-                lam = lambda0 * (x * x) * (x * x)
-            else:
-                lam = lambda0 * x ** (alpha - 1.0)
-            e_dt[e] = dt_s * (E0 * x)
-            gamma[e] = lam / (lam + dt_s)
     return n_capped
 
 
@@ -232,39 +287,65 @@ PARALLEL_MIN_ELEMENTS = PARALLEL_MIN_SIZE
 
 
 @njit(cache=True, error_model="numpy")
-def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
-                      half_mf, fixed, pres0, pres1, tri, b, c, damage, conc_factor, coh, sig_c, sig_t, td,
-                      heal, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
+                      c, damage, conc_factor, coh, kc, kt, td, heal, pmax, dt_s, kxx, kxy, kss, q, denom,
+                      max_damage, E0, lambda0, alpha, flag):
     """All ``n_sub`` sub-steps of one outer step in compiled code (one call per outer
     step, no Python per sub-step): the node kernel then the element kernel, serial
     builds; the same calls as a Python loop over the kernels, bit-identical results."""
     n_capped = 0
     for k in range(n_sub):
-        node_velocity_kernel_serial(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
-                                    half_mf, fixed, pres0, pres1, (k + 1) / n_sub)
+        node_velocity_kernel_serial(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
+                                    (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel_serial(
-            tri, b, c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy,
-            kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, pmax, dt_s, kxx, kxy, kss, q, denom,
+            max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
 
 @njit(cache=True, error_model="numpy")
-def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
-                      half_mf, fixed, pres0, pres1, tri, b, c, damage, conc_factor, coh, sig_c, sig_t, td,
-                      heal, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
+                      c, damage, conc_factor, coh, kc, kt, td, heal, pmax, dt_s, kxx, kxy, kss, q, denom,
+                      max_damage, E0, lambda0, alpha, flag):
     """:func:`substeps_serial` with the parallel kernel builds (one fork/join per
     kernel and sub-step, launched from compiled code)."""
     n_capped = 0
     for k in range(n_sub):
-        node_velocity_kernel(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t,
-                             half_mf, fixed, pres0, pres1, (k + 1) / n_sub)
+        node_velocity_kernel(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
+                             (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel(
-            tri, b, c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy,
-            kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, pmax, dt_s, kxx, kxy, kss, q, denom,
+            max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
 
 SUBSTEPS = (substeps_serial, substeps_parallel)
+
+#: the α = 4 builds (Dansereau et al. 2016's value, the default): the element kernel with
+#: λ = λ0 x³ compiled in, and sub-step loops that call it
+element_stress_damage_kernel_a4 = specialised_copy(
+    _element_stress_damage, "_a4", {"_ALPHA_IS_4": True}, parallel=True, error_model="numpy",
+    fastmath=KERNEL_FASTMATH)
+element_stress_damage_kernel_a4_serial = specialised_copy(
+    _element_stress_damage, "_a4_serial", {"_ALPHA_IS_4": True}, error_model="numpy", fastmath=KERNEL_FASTMATH)
+SUBSTEPS_A4 = (
+    specialised_copy(substeps_serial, "_a4", {"element_stress_damage_kernel_serial":
+                                              element_stress_damage_kernel_a4_serial}, error_model="numpy"),
+    specialised_copy(substeps_parallel, "_a4", {"element_stress_damage_kernel": element_stress_damage_kernel_a4},
+                     error_model="numpy"))
+
+
+def substep_loops(alpha: float):
+    """(serial, parallel) sub-step loops for the rheology's α: the α = 4 builds or the
+    general ones (identical results where both apply; a test checks it)."""
+    return SUBSTEPS_A4 if alpha == 4.0 else SUBSTEPS
+
+
+def element_kernels(alpha: float):
+    """(serial, parallel) element kernels for the rheology's α (see :func:`substep_loops`)."""
+    if alpha == 4.0:
+        return element_stress_damage_kernel_a4_serial, element_stress_damage_kernel_a4
+    return element_stress_damage_kernel_serial, element_stress_damage_kernel
 
 
 class ExplicitSolver:
@@ -444,8 +525,10 @@ class ExplicitSolver:
             scratch = tuple(a.copy() if isinstance(a, np.ndarray) and a.flags.writeable else a for a in args)
             n_trial = int(min(20, max(2, math.ceil(AUTOTUNE_WORK / max(m, 1)))))
 
+            loops = substep_loops(float(self.rheology.params.alpha))
+
             def trial(par):
-                SUBSTEPS[int(par)](n_trial, *scratch)
+                loops[int(par)](n_trial, *scratch)
 
             n_tunes = self.kernel_choice["n_measurements"] if self.kernel_choice else 0
             self.kernel_choice = autotune(trial, m, what="explicit kernels")
@@ -456,20 +539,18 @@ class ExplicitSolver:
 
     def _profiled_substeps(self, par, n_sub, args):
         """The sub-step loop in Python with each kernel timed (``profile_kernels``)."""
-        (vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t, half_mf, fixed, pres0,
-         pres1, tri, b, c, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q,
-         denom, max_damage, E0, lambda0, alpha, flag) = args
+        (vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b, c, damage, conc_factor,
+         coh, kc, kt, td, heal, pmax, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag) = args
         node_k = node_velocity_kernel if par else node_velocity_kernel_serial
-        elem_k = element_stress_damage_kernel if par else element_stress_damage_kernel_serial
+        elem_k = element_kernels(alpha)[int(par)]
         n_capped = 0
         tn = tm = 0.0
         for k in range(n_sub):
             ta = time.perf_counter()
-            node_k(vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current, cos_t, sin_t, half_mf,
-                   fixed, pres0, pres1, (k + 1) / n_sub)
+            node_k(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, (k + 1) / n_sub)
             tb = time.perf_counter()
-            n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, sig_c, sig_t, td, heal, e_dt,
-                               gamma, pmax, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, pmax, dt_s,
+                               kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
             tc = time.perf_counter()
             tn += tb - ta
             tm += tc - tb
@@ -483,7 +564,9 @@ class ExplicitSolver:
         ns = self.nodes
         mesh, p = ns.mesh, self.rheology.params
         t0 = time.perf_counter()
-        E, lam = self.rheology.moduli(state.damage, state.concentration)
+        damage = np.array(state.damage, np.float64)  # a copy: the state is left untouched if the step fails
+        conc_factor = np.exp(-p.concentration_c * (1.0 - np.asarray(state.concentration, np.float64)))
+        E = p.E0 * (1.0 - damage) * conc_factor  # rheology.young_modulus, the same arithmetic
         E_max = float(E.max()) if len(E) else p.E0
         self.dx_eff = (effective_dx(self.dx_min, E_max, float((E / ns.area).max()))
                        if len(E) and self.substep_limit == "element" else self.dx_min)
@@ -500,9 +583,7 @@ class ExplicitSolver:
         tri = mesh.triangles
         su = ns.setup(state.thickness, terms, p.rho_ice, dt_s, True)
         par = su.parallel
-        half_mf = 0.5 * su.mass * terms.coriolis
-        e_dt = dt_s * E
-        gamma = lam / (lam + dt_s)
+        nc = node_constants(su.m_dt, su.cda, su.mass, terms.coriolis, su.fext, terms.current)
         rh = self.rheology
         pmax = rh.max_pressure(state.thickness, state.concentration)  # None: off
         pmax = None if pmax is None else np.ascontiguousarray(pmax, np.float64)
@@ -512,22 +593,18 @@ class ExplicitSolver:
         nu = p.poisson
         kxx, kxy, kss = 1.0 / (1.0 - nu * nu), nu / (1.0 - nu * nu), (1.0 - nu) / (1.0 - nu * nu)
         vel = np.ascontiguousarray(state.velocity, np.float64).copy()
-        sigma = np.array(state.stress, np.float64, order="C")  # copies: the state is left
-        damage = np.array(state.damage, np.float64)  # untouched if the step fails
-        conc_factor = np.exp(-p.concentration_c * (1.0 - np.asarray(state.concentration, np.float64)))
+        sigma = np.array(state.stress, np.float64, order="C")  # a copy (as damage)
         coh = np.ascontiguousarray(state.cohesion, np.float64)
-        sig_c = 2.0 * coh / rh._denom
-        sig_t = sig_c / rh.q
+        k_c, k_t = envelope_factors(rh)
         flag = np.zeros(mesh.n_elements, np.int8)
         vel_sum = np.zeros_like(vel)
         t2 = time.perf_counter()
         kt["setup"] = t2 - t1
 
         ptr32, elems32, tri32 = self._indices(mesh)
-        args = (vel, vel_sum, sigma, ptr32, elems32, su.wb, su.wc, su.m_dt, su.fext, su.cda, terms.current,
-                terms.cos_turn, terms.sin_turn, half_mf, ns.fixed, pres0, pres1, tri32, ns.b, ns.c, damage,
-                conc_factor, coh, sig_c, sig_t, self.td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, rh.q,
-                rh._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), flag)
+        args = (vel, vel_sum, sigma, ptr32, elems32, su.w, nc, terms.cos_turn, terms.sin_turn, ns.fixed, pres0,
+                pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, k_c, k_t, self.td, heal, pmax, dt_s, kxx, kxy, kss,
+                rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), flag)
         if self.kernel_choice is None or (
                 self.parallel_setting is None
                 and time.perf_counter() - self._tuned_at > (
@@ -541,7 +618,7 @@ class ExplicitSolver:
             kt["node_velocity"] = tn
             kt["element_stress_damage"] = tm
         else:
-            n_capped = SUBSTEPS[int(par)](n_sub, *args)
+            n_capped = substep_loops(float(p.alpha))[int(par)](n_sub, *args)
         kt["substeps"] = time.perf_counter() - ta
         state.velocity = vel
         state.stress = sigma
