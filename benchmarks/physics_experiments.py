@@ -486,6 +486,23 @@ add_weather_ensemble("P", PMAX + from_spinup("H1126-P"), "with neXtSIM's compres
                      "thick-and-thin + compressive term", ENSEMBLE_SEEDS + MORE_SEEDS, ", eight months")
 
 
+# --- 2026-11-26 (seventh session): a wider strength disorder at the same mean strength ------
+# docs/physics.md §5 lists "stronger strength heterogeneity" as not tried. The disorder factor
+# 1 + d U (U uniform in [0, 1)) has d = 1 in the shipped set (a factor 2 between the weakest
+# and the strongest element, the convention of Dansereau et al. 2016 and Girard et al. 2011;
+# no observation fixes it). Here d = 3 (a factor 4), with the laboratory cohesion scaled by
+# (1 + 1/2)/(1 + 3/2) = 0.6 so that the mean strength is the shipped one: only the spread
+# changes. From the shipped spin-up state (made with d = 1), both basins, the four months of
+# the first weather ensemble (wind seeds 2026-2029).
+# Rule, written before the runs: a four-month screen. It passes if the four-month medians put
+# more bands inside than the shipped set's same four months in both basins (3 closed, 2
+# strait) and neither beta nor the rate moves further from its band. Passing would call for
+# the eight months and a spin-up made with d = 3, not for adoption. Failing ends the lead.
+WIDE_DISORDER = ["rheology.strength_disorder=3", "rheology.strength_lab_pa=1.68e6"]
+add_weather_ensemble("dis3", WIDE_DISORDER + from_spinup("H1125"),
+                     "with a disorder factor of 4 (d = 3) at the shipped mean strength",
+                     "thick-and-thin, disorder d = 3", ENSEMBLE_SEEDS)
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
