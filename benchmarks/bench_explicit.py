@@ -114,11 +114,11 @@ def element_kernel_rates(n_target: int = 50_000, reps: int = 20) -> dict:
     from lagice.fem import shape_gradients
     from lagice.mesh import generate_mesh, renumber_for_locality
     from lagice.rheology import MaxwellEB
-    from lagice.solvers.explicit import element_stress_damage_kernel_serial as kernel
-    from lagice.solvers.explicit import envelope_factors
+    from lagice.solvers.explicit import element_kernels, envelope_factors
 
     rheo = MaxwellEB()
     p = rheo.params
+    kernel = element_kernels(float(p.alpha))[0]  # the serial build a run with this α uses
     mesh = renumber_for_locality(generate_mesh(shapely.box(0, 0, DOMAIN_M, DOMAIN_M), resolution_for(n_target)))[0]
     m, n = mesh.n_elements, mesh.n_nodes
     b, c, _ = shape_gradients(mesh.nodes, mesh.triangles)
@@ -134,7 +134,7 @@ def element_kernel_rates(n_target: int = 50_000, reps: int = 20) -> dict:
         kc, kt = envelope_factors(rheo)
         args = (tri, b, c, vel, sigma, damage, np.ones(m), cohv, kc, kt, np.full(m, 20.0),
                 np.full(m, heal), None, 4.0, 1.1, 0.3, 0.7, rheo.q,
-                rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, np.zeros(m, np.int8))
+                rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), np.zeros(m, np.int8))
         kernel(*args)
         t0 = time.process_time()
         for _ in range(reps):
