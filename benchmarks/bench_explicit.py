@@ -99,7 +99,7 @@ def kernel_bytes(st, mesh) -> dict:
     elem = (tri.nbytes + 2 * m * 3 * f8                          # tri, b, c
             + n * 2 * f8                                         # vel gathered (read once)
             + m * 3 * f8 * 2                                     # sigma read + write
-            + m * f8 * 5)                                        # damage, conc_factor, cohesion, td, heal
+            + m * f8 * 6)                                        # damage, cohesion, td, heal, e_dt, gamma
     return {"node_bytes": node / m, "element_bytes": elem / m, "total_bytes": (node + elem) / m,
             "index_bytes": (ptr.nbytes + elems.nbytes + tri.nbytes) / m}
 
@@ -133,7 +133,7 @@ def element_kernel_rates(n_target: int = 50_000, reps: int = 20) -> dict:
         cohv = np.full(m, coh)
         kc, kt = envelope_factors(rheo)
         args = (tri, b, c, vel, sigma, damage, np.ones(m), cohv, kc, kt, np.full(m, 20.0),
-                np.full(m, heal), None, 4.0, 1.1, 0.3, 0.7, rheo.q,
+                np.full(m, heal), np.full(m, 4.0 * p.E0), np.full(m, 0.99), None, 4.0, 1.1, 0.3, 0.7, rheo.q,
                 rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), np.zeros(m, np.int8))
         kernel(*args)
         t0 = time.process_time()

@@ -32,8 +32,8 @@ def linear_velocity(comp):
 
 @pytest.mark.parametrize("kernel", [element_stress_damage_kernel, element_stress_damage_kernel_serial])
 def test_element_kernel_damage_matches_rheology(kernel):
-    """With zero strain rate and γ = 1 (λ0 so large that λ/(λ+Δt) rounds to 1) the element
-    kernel is the rheology's damage/healing update (same formulas; to round-off, since the
+    """With zero strain rate and γ = 1 the element kernel is the rheology's damage/healing
+    update (same formulas; to round-off, since the
     kernel may fuse a multiply-add into one FMA, ``explicit.KERNEL_FASTMATH``): the same
     elements damage, and stress and damage agree to 1e-13 relative (a wrong factor or a
     missed correction is ≥ 1e-3 off). The kernel's cheap inside-the-envelope test
@@ -56,22 +56,29 @@ def test_element_kernel_damage_matches_rheology(kernel):
     flag = np.zeros(m, np.int8)
     p = rheo.params
     kc, kt = envelope_factors(rheo)
-    kernel(tri, zeros3, zeros3, np.zeros((1, 2)), s2, d2, conc_factor, coh, kc, kt, td, heal, None,
-           7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0, 1e300, p.alpha, flag)
+    e_dt, gam = np.zeros(m), np.ones(m)
+    kernel(tri, zeros3, zeros3, np.zeros((1, 2)), s2, d2, conc_factor, coh, kc, kt, td, heal, e_dt, gam, None,
+           7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, p.alpha, flag)
     assert (dc < 1).sum() > 100
     assert np.allclose(s2, s1, rtol=1e-13, atol=1e-13 * np.abs(s1).max())
     assert np.allclose(d2, d1, rtol=1e-13, atol=1e-15)
     assert not np.allclose(s1, sigma, rtol=1e-6)  # the correction acted
     assert np.array_equal(flag.astype(bool), dc < 1)
+    # moduli refreshed where damage changed, as the rheology computes them
+    E, lam = rheo.moduli(d1, np.ones(m))
+    ch = d1 != damage
+    assert ch.sum() > 100
+    assert np.allclose(e_dt[ch], 7.0 * E[ch], rtol=1e-13, atol=0)
+    assert np.allclose(gam[ch], lam[ch] / (lam[ch] + 7.0), rtol=1e-13, atol=0)
 
 
 @pytest.mark.parametrize("kernel", [element_stress_damage_kernel, element_stress_damage_kernel_serial,
                                     element_stress_damage_kernel_a4, element_stress_damage_kernel_a4_serial])
 def test_element_kernel_stress_update_uses_rheology_moduli(kernel):
     """One sub-step on damaged, partly open ice with a strain rate and no damage event
-    (huge cohesion, no healing): σ = γ (σ0 + Δt_s E K:ε̇) with E and λ from
-    ``MaxwellEB.moduli`` (γ = λ/(λ+Δt_s)), to 1e-13 relative, for α = 4 (the kernel's
-    product form) and α = 4.5 (the power form; general builds only)."""
+    (huge cohesion, no healing), with Δt_s E and γ = λ/(λ+Δt_s) from ``MaxwellEB.moduli``
+    as the stepper's set-up gives them: σ = γ (σ0 + Δt_s E K:ε̇) to 1e-13 relative
+    (K and the strain rate as the rheology defines them), for α = 4 and 4.5."""
     from lagice.fem import shape_gradients
     from lagice.mesh import renumber_for_locality
 
@@ -92,10 +99,11 @@ def test_element_kernel_stress_update_uses_rheology_moduli(kernel):
         sigma, d = sigma0.copy(), damage.copy()
         dt_s = 3.0
         kc, kt = envelope_factors(rheo)
-        kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, conc_factor, np.full(m, 1e15), kc, kt,
-               np.full(m, 20.0), np.zeros(m), None, dt_s, *rheo.K[0, :2], rheo.K[2, 2], rheo.q, rheo._denom,
-               p.max_damage, p.E0, p.relaxation_time_s, float(alpha), np.zeros(m, np.int8))
         E, lam = rheo.moduli(damage, conc)
+        kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, conc_factor, np.full(m, 1e15), kc, kt,
+               np.full(m, 20.0), np.zeros(m), dt_s * E, lam / (lam + dt_s), None, dt_s, *rheo.K[0, :2],
+               rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, float(alpha),
+               np.zeros(m, np.int8))
         eps = strain_rate(mesh.triangles, b, c, vel)
         ref = (lam / (lam + dt_s))[:, None] * (sigma0 + dt_s * E[:, None] * (eps @ rheo.K.T))
         assert np.array_equal(d, damage)
@@ -105,7 +113,8 @@ def test_element_kernel_stress_update_uses_rheology_moduli(kernel):
 
 def test_alpha4_builds_equal_general_builds():
     """The α = 4 builds (λ = λ0 x³ compiled in) give bit for bit what the general kernel
-    gives with α = 4, on a sub-step where some elements damage and others heal."""
+    gives with α = 4 (stress, damage, flags and the refreshed moduli), on a sub-step where
+    some elements damage and others heal."""
     rng = np.random.default_rng(5)
     poly, _ = rectangle_domain(40e3, 40e3)
     from lagice.fem import shape_gradients
@@ -120,19 +129,24 @@ def test_alpha4_builds_equal_general_builds():
     sigma0 = rng.normal(0, 3e4, (m, 3))
     damage0 = rng.uniform(0, 1, m)
     coh = rng.uniform(1e4, 4e4, m)
+    dt_s = 20.0
+    E, lam = rheo.moduli(damage0, np.full(m, 0.99))
     out = []
     for kernel in (element_stress_damage_kernel_serial, element_stress_damage_kernel_a4_serial,
                    element_stress_damage_kernel, element_stress_damage_kernel_a4):
         sigma, d, flag = sigma0.copy(), damage0.copy(), np.zeros(m, np.int8)
+        e_dt, gam = dt_s * E, lam / (lam + dt_s)
         capped = kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, np.full(m, 0.9),
-                        coh, kc, kt, np.full(m, 30.0), np.full(m, 1e-6), None, 20.0, *rheo.K[0, :2], rheo.K[2, 2],
-                        rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
-        out.append((sigma, d, flag, capped))
+                        coh, kc, kt, np.full(m, 30.0), np.full(m, 1e-6), e_dt, gam, None, dt_s, *rheo.K[0, :2],
+                        rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
+        out.append((sigma, d, flag, capped, e_dt, gam))
     assert 0 < out[0][2].sum() < m  # some elements damage, some do not
     assert np.any(out[0][1] < damage0)  # some heal
+    assert not np.array_equal(out[0][4], dt_s * E)  # the moduli were refreshed
     for o in out[1:]:
         assert np.array_equal(o[0], out[0][0]) and np.array_equal(o[1], out[0][1])
         assert np.array_equal(o[2], out[0][2]) and o[3] == out[0][3]
+        assert np.array_equal(o[4], out[0][4]) and np.array_equal(o[5], out[0][5])
 
 
 def test_node_kernel_matches_general_2x2_solve():

@@ -167,12 +167,9 @@ def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigm
                    lambda0, alpha, damaged_flag):
     """One element of :func:`lagice.solvers.explicit._element_stress_damage`
     (same expressions; ``use_pmax`` = 1: neXtSIM's compressive term with ``pmax``);
-    returns 1 when the damage cap acted. Δt_s E and γ are read from ``e_dt``/``gamma``,
-    refreshed here where damage changes (the CPU kernel computes them from the damage
-    every sub-step since 2026-11-26, seventh session: equal to round-off, not bit for bit,
-    because the set-up's first values come from ``MaxwellEB.moduli``), and the envelope
-    test reads σc, σT per element (the CPU kernel scales the cohesion; both only shortcut
-    ``_dcrit``, which decides)."""
+    returns 1 when the damage cap acted. The envelope test reads σc, σT per element (the
+    CPU kernel scales the cohesion since 2026-11-26; both only shortcut ``_dcrit``, which
+    decides, so the results are the same)."""
     exx, eyy, exy = strain_rate_dev(tri, b, c, vel, e)
     ed = e_dt[e]
     g = gamma[e]

@@ -26,8 +26,8 @@ both parallel over their *own* entities so that no loop scatters:
    ``_dcrit`` (a test checks both agree to round-off, 1e-13 relative:
    the kernels fuse multiply-adds, see ``KERNEL_FASTMATH``). E = E0 (1−d) g and
    λ = λ0 ((1−d) g)^(α−1), g = exp(−c*(1−A)) (the rheology's formulas; a test
-   checks the stress update against ``MaxwellEB.moduli``) are computed per element
-   from its damage at the start of each sub-step.
+   checks them against ``MaxwellEB.moduli``) are recomputed only where damage
+   changed.
 
 Stability: the sub-step is limited by elastic waves, Δt_s ≲ C Δx / sqrt(E/ρ);
 C was measured (``benchmarks/stability.py``) and ships in
@@ -199,17 +199,18 @@ _ALPHA_IS_4 = False
 
 
 def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion, kc, kt,
-                           td, heal_rate, pmax, dt_s, kxx, kxy, kss, q, denom,
+                           td, heal_rate, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q, denom,
                            max_damage, E0, lambda0, alpha, damaged_flag):
     """Maxwell stress update and damage/healing of one sub-step, in place (module doc, step 2).
 
-    The moduli come from the element's damage at the start of the sub-step:
-    E = E0 (1−d) g and λ = λ0 ((1−d) g)^(α−1) with g = conc_factor = exp(−c*(1−A))
-    (rheology.young_modulus/relaxation_time; an integer α−1 is taken as repeated
-    products), then Δt_s E and γ = λ/(λ+Δt_s). Recomputing them costs one division per
-    element; reading them from two arrays refreshed where damage changed was 8 % slower on
-    2 threads (docs/benchmarks.md). kxx = 1/(1−ν²), kxy = ν/(1−ν²), kss = (1−ν)/(1−ν²) are
-    the entries of K; kc, kt: :func:`envelope_factors`. pmax [Pa]: neXtSIM's compressive
+    e_dt = Δt_s E [Pa s], gamma = λ/(λ+Δt_s) per element, refreshed here where damage
+    changes from E = E0 (1−d) g, λ = λ0 ((1−d) g)^(α−1) with g = conc_factor =
+    exp(−c*(1−A)) (rheology.young_modulus/relaxation_time; an integer α−1 is taken as
+    repeated products; the set-up fills them from ``MaxwellEB.moduli``). Computing them
+    from the damage every sub-step instead ran 8 % faster on 2 threads but changes the
+    results at round-off, and a 28-day month then ends elsewhere (docs/benchmarks.md), so
+    the published runs would no longer be reproduced bit for bit. kxx = 1/(1−ν²),
+    kxy = ν/(1−ν²), kss = (1−ν)/(1−ν²) are the entries of K; kc, kt: :func:`envelope_factors`. pmax [Pa]: neXtSIM's compressive
     term (rheology.max_pressure; None: off, and numba prunes the branch when it compiles the
     NoneType signature, so the default path pays nothing for it): where the mean stress σn
     of the previous sub-step is compressive, the relaxation factor is
@@ -221,18 +222,8 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     n_capped = 0
     for e in prange(m):
         exx, eyy, exy = element_strain_rate(tri, b, c, vel, e)
-        d0 = damage[e]
-        x = (1.0 - d0) * conc_factor[e]
-        if _ALPHA_IS_4:  # a compile-time constant: True only in the α = 4 builds
-            lam = lambda0 * (x * x * x)
-        elif alpha == 4.0:
-            lam = lambda0 * (x * x * x)
-        elif alpha == 5.0:
-            lam = lambda0 * (x * x) * (x * x)
-        else:
-            lam = lambda0 * x ** (alpha - 1.0)
-        ed = dt_s * (E0 * x)
-        g = lam / (lam + dt_s)
+        ed = e_dt[e]
+        g = gamma[e]
         if pmax is not None:
             sn = -0.5 * (sigma[e, 0] + sigma[e, 1])
             if sn > 0.0:
@@ -256,6 +247,7 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
             dc = 1.0
         else:
             dc = _dcrit(sxx, syy, sxy, ce, q, denom)
+        d0 = damage[e]
         d, f, capped = damage_step(d0, dc, dt_s, td[e], heal_rate[e], max_damage)
         if dc < 1.0:
             sxx *= f
@@ -268,6 +260,17 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
         sigma[e, 2] = sxy
         if d != d0:
             damage[e] = d
+            x = (1.0 - d) * conc_factor[e]
+            if _ALPHA_IS_4:  # a compile-time constant: True only in the α = 4 builds
+                lam = lambda0 * (x * x * x)
+            elif alpha == 4.0:
+                lam = lambda0 * (x * x * x)
+            elif alpha == 5.0:
+                lam = lambda0 * (x * x) * (x * x)
+            else:
+                lam = lambda0 * x ** (alpha - 1.0)
+            e_dt[e] = dt_s * (E0 * x)
+            gamma[e] = lam / (lam + dt_s)
     return n_capped
 
 
@@ -288,8 +291,8 @@ PARALLEL_MIN_ELEMENTS = PARALLEL_MIN_SIZE
 
 @njit(cache=True, error_model="numpy")
 def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
-                      c, damage, conc_factor, coh, kc, kt, td, heal, pmax, dt_s, kxx, kxy, kss, q, denom,
-                      max_damage, E0, lambda0, alpha, flag):
+                      c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q,
+                      denom, max_damage, E0, lambda0, alpha, flag):
     """All ``n_sub`` sub-steps of one outer step in compiled code (one call per outer
     step, no Python per sub-step): the node kernel then the element kernel, serial
     builds; the same calls as a Python loop over the kernels, bit-identical results."""
@@ -298,15 +301,15 @@ def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t,
         node_velocity_kernel_serial(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
                                     (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel_serial(
-            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, pmax, dt_s, kxx, kxy, kss, q, denom,
-            max_damage, E0, lambda0, alpha, flag)
+            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy,
+            kss, q, denom, max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
 
 @njit(cache=True, error_model="numpy")
 def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
-                      c, damage, conc_factor, coh, kc, kt, td, heal, pmax, dt_s, kxx, kxy, kss, q, denom,
-                      max_damage, E0, lambda0, alpha, flag):
+                      c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q,
+                      denom, max_damage, E0, lambda0, alpha, flag):
     """:func:`substeps_serial` with the parallel kernel builds (one fork/join per
     kernel and sub-step, launched from compiled code)."""
     n_capped = 0
@@ -314,8 +317,8 @@ def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_
         node_velocity_kernel(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
                              (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel(
-            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, pmax, dt_s, kxx, kxy, kss, q, denom,
-            max_damage, E0, lambda0, alpha, flag)
+            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy,
+            kss, q, denom, max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
 
@@ -540,7 +543,8 @@ class ExplicitSolver:
     def _profiled_substeps(self, par, n_sub, args):
         """The sub-step loop in Python with each kernel timed (``profile_kernels``)."""
         (vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b, c, damage, conc_factor,
-         coh, kc, kt, td, heal, pmax, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag) = args
+         coh, kc, kt, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha,
+         flag) = args
         node_k = node_velocity_kernel if par else node_velocity_kernel_serial
         elem_k = element_kernels(alpha)[int(par)]
         n_capped = 0
@@ -549,8 +553,8 @@ class ExplicitSolver:
             ta = time.perf_counter()
             node_k(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, (k + 1) / n_sub)
             tb = time.perf_counter()
-            n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, pmax, dt_s,
-                               kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma,
+                               pmax, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
             tc = time.perf_counter()
             tn += tb - ta
             tm += tc - tb
@@ -564,9 +568,7 @@ class ExplicitSolver:
         ns = self.nodes
         mesh, p = ns.mesh, self.rheology.params
         t0 = time.perf_counter()
-        damage = np.array(state.damage, np.float64)  # a copy: the state is left untouched if the step fails
-        conc_factor = np.exp(-p.concentration_c * (1.0 - np.asarray(state.concentration, np.float64)))
-        E = p.E0 * (1.0 - damage) * conc_factor  # rheology.young_modulus, the same arithmetic
+        E, lam = self.rheology.moduli(state.damage, state.concentration)
         E_max = float(E.max()) if len(E) else p.E0
         self.dx_eff = (effective_dx(self.dx_min, E_max, float((E / ns.area).max()))
                        if len(E) and self.substep_limit == "element" else self.dx_min)
@@ -584,6 +586,8 @@ class ExplicitSolver:
         su = ns.setup(state.thickness, terms, p.rho_ice, dt_s, True)
         par = su.parallel
         nc = node_constants(su.m_dt, su.cda, su.mass, terms.coriolis, su.fext, terms.current)
+        e_dt = dt_s * E
+        gamma = lam / (lam + dt_s)
         rh = self.rheology
         pmax = rh.max_pressure(state.thickness, state.concentration)  # None: off
         pmax = None if pmax is None else np.ascontiguousarray(pmax, np.float64)
@@ -593,7 +597,9 @@ class ExplicitSolver:
         nu = p.poisson
         kxx, kxy, kss = 1.0 / (1.0 - nu * nu), nu / (1.0 - nu * nu), (1.0 - nu) / (1.0 - nu * nu)
         vel = np.ascontiguousarray(state.velocity, np.float64).copy()
-        sigma = np.array(state.stress, np.float64, order="C")  # a copy (as damage)
+        sigma = np.array(state.stress, np.float64, order="C")  # copies: the state is left
+        damage = np.array(state.damage, np.float64)  # untouched if the step fails
+        conc_factor = np.exp(-p.concentration_c * (1.0 - np.asarray(state.concentration, np.float64)))
         coh = np.ascontiguousarray(state.cohesion, np.float64)
         k_c, k_t = envelope_factors(rh)
         flag = np.zeros(mesh.n_elements, np.int8)
@@ -603,8 +609,8 @@ class ExplicitSolver:
 
         ptr32, elems32, tri32 = self._indices(mesh)
         args = (vel, vel_sum, sigma, ptr32, elems32, su.w, nc, terms.cos_turn, terms.sin_turn, ns.fixed, pres0,
-                pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, k_c, k_t, self.td, heal, pmax, dt_s, kxx, kxy, kss,
-                rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), flag)
+                pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, k_c, k_t, self.td, heal, e_dt, gamma, pmax, dt_s,
+                kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), flag)
         if self.kernel_choice is None or (
                 self.parallel_setting is None
                 and time.perf_counter() - self._tuned_at > (
