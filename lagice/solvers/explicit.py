@@ -193,8 +193,8 @@ def envelope_factors(rheology):
 
 
 #: False in the general element kernel; True in its α = 4 builds (:func:`lagice._numba.specialised_copy`),
-#: where numba then compiles λ = λ0 x³ without the branch on α: a branch on α inside the
-#: element loop cost the kernel 3-4 % on 2 threads (docs/benchmarks.md)
+#: where numba then compiles λ = λ0 x³ without the branch on α. Healing ice refreshes its moduli
+#: every sub-step, and a branch on α there cost the kernel 3-4 % on 2 threads (docs/benchmarks.md)
 _ALPHA_IS_4 = False
 
 
@@ -210,10 +210,11 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     from the damage every sub-step instead ran 8 % faster on 2 threads but changes the
     results at round-off, and a 28-day month then ends elsewhere (docs/benchmarks.md), so
     the published runs would no longer be reproduced bit for bit. kxx = 1/(1−ν²),
-    kxy = ν/(1−ν²), kss = (1−ν)/(1−ν²) are the entries of K; kc, kt: :func:`envelope_factors`. pmax [Pa]: neXtSIM's compressive
-    term (rheology.max_pressure; None: off, and numba prunes the branch when it compiles the
-    NoneType signature, so the default path pays nothing for it): where the mean stress σn
-    of the previous sub-step is compressive, the relaxation factor is
+    kxy = ν/(1−ν²), kss = (1−ν)/(1−ν²) are the entries of K; kc, kt: :func:`envelope_factors`.
+    pmax [Pa]: neXtSIM's compressive term (rheology.max_pressure; None: off, and numba
+    prunes the branch when it compiles the NoneType signature, so the default path pays
+    nothing for it): where the mean stress σn of the previous sub-step is compressive, the
+    relaxation factor is
     λ/(λ + Δt_s (1 − P̃)), P̃ = min(1, pmax/(−σn)), computed from γ as
     γ/(γ + (1 − γ)(1 − P̃)) (neXtSIM's ``updateSigmaDamage``).
     Returns the number of elements whose damage hit the cap.
