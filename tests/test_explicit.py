@@ -33,11 +33,11 @@ def linear_velocity(comp):
 @pytest.mark.parametrize("kernel", [element_stress_damage_kernel, element_stress_damage_kernel_serial])
 def test_element_kernel_damage_matches_rheology(kernel):
     """With zero strain rate and γ = 1 the element kernel is the rheology's damage/healing
-    update (same formulas; to round-off, since the
-    kernel may fuse a multiply-add into one FMA, ``explicit.KERNEL_FASTMATH``): the same
-    elements damage, and stress and damage agree to 1e-13 relative (a wrong factor or a
-    missed correction is ≥ 1e-3 off). The kernel's cheap inside-the-envelope test
-    (``envelope_factors``) must not change which elements damage."""
+    update (same formulas; to round-off, since the kernel may fuse a multiply-add into one
+    FMA, ``explicit.KERNEL_FASTMATH``): the same elements damage, and stress and damage
+    agree to 1e-13 relative (a wrong factor or a missed correction is ≥ 1e-3 off). The
+    kernel's cheap inside-the-envelope test (``envelope_factors``) must not change which
+    elements damage."""
     rng = np.random.default_rng(0)
     m = 500
     rheo = MaxwellEB()
