@@ -214,9 +214,8 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     pmax [Pa]: neXtSIM's compressive term (rheology.max_pressure; None: off, and numba
     prunes the branch when it compiles the NoneType signature, so the default path pays
     nothing for it): where the mean stress σn of the previous sub-step is compressive, the
-    relaxation factor is
-    λ/(λ + Δt_s (1 − P̃)), P̃ = min(1, pmax/(−σn)), computed from γ as
-    γ/(γ + (1 − γ)(1 − P̃)) (neXtSIM's ``updateSigmaDamage``).
+    relaxation factor is λ/(λ + Δt_s (1 − P̃)), P̃ = min(1, pmax/(−σn)), computed from γ
+    as γ/(γ + (1 − γ)(1 − P̃)) (neXtSIM's ``updateSigmaDamage``).
     Returns the number of elements whose damage hit the cap.
     """
     m = tri.shape[0]
@@ -262,9 +261,7 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
         if d != d0:
             damage[e] = d
             x = (1.0 - d) * conc_factor[e]
-            if _ALPHA_IS_4:  # a compile-time constant: True only in the α = 4 builds
-                lam = lambda0 * (x * x * x)
-            elif alpha == 4.0:
+            if _ALPHA_IS_4 or alpha == 4.0:  # _ALPHA_IS_4: a compile-time constant, True in the α = 4 builds
                 lam = lambda0 * (x * x * x)
             elif alpha == 5.0:
                 lam = lambda0 * (x * x) * (x * x)
