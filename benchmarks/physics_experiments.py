@@ -503,6 +503,26 @@ add_weather_ensemble("dis3", WIDE_DISORDER + from_spinup("H1125"),
                      "with a disorder factor of 4 (d = 3) at the shipped mean strength",
                      "thick-and-thin, disorder d = 3", ENSEMBLE_SEEDS)
 
+# --- 2026-11-26 (eighth session): spatially correlated strength -------------------------------
+# docs/physics.md §5 lists spatially correlated strength heterogeneity as not tried. Sea-ice
+# strength varies smoothly over tens to hundreds of km with ice age, brine volume and
+# temperature (Timco & Weeks 2010, "A review of the engineering properties of sea ice"); a
+# scenario, not a calibration. The cohesion is multiplied by g = 1 + a(2Φ(G) − 1), G a
+# Gaussian random field with correlation length ℓ = 50 km (patches of 100-150 km, inside the
+# 10-300 km range over which β is fitted) and a = 0.5 (g uniform on [0.5, 1.5], a factor 3
+# between weak and strong regions), mean 1 so the mean strength is the shipped one; the white
+# disorder (d = 1) stays. g is carried by the ice and remapped (lagice/strength.py). From the
+# shipped spin-up state, both basins, the four months of the first weather ensemble.
+# Rule, written before the runs (as for d = 3): the screen passes if the four-month medians put
+# more bands inside than the shipped set's same four months in both basins (3 closed, 2
+# strait) and neither beta nor the rate moves further from its band. Passing would call for
+# the eight months and a spin-up made with the field; failing ends the lead. One (ℓ, a) only:
+# nothing is tuned on the result.
+CORRELATED_STRENGTH = ["rheology.strength_correlation_m=5e4", "rheology.strength_correlated_amplitude=0.5"]
+add_weather_ensemble("cor50", CORRELATED_STRENGTH + from_spinup("H1125"),
+                     "with a correlated strength factor (ℓ = 50 km, g in [0.5, 1.5]) at the shipped mean strength",
+                     "thick-and-thin, correlated strength ℓ = 50 km", ENSEMBLE_SEEDS)
+
 # --- 2026-11-26 (seventh session): the published month with this session's CPU kernels -------
 # -k7-roundoff: the validation month of both basins made with the first version of this
 # session's kernels (commit 4011699), whose element kernel computed dt E and gamma from the

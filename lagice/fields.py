@@ -82,6 +82,9 @@ FIELDS: dict[str, FieldSpec] = {f.name: f for f in (
     FieldSpec("cohesion", ELEMENT, "Pa", "cohesion of the Mohr-Coulomb envelope", valid_min=0.0),
     FieldSpec("snow", ELEMENT, "m", "snow volume per unit area", "surface_snow_thickness", valid_min=0.0,
               optional=True),
+    FieldSpec("strength_factor", ELEMENT, "1",
+              "spatially correlated strength factor (multiplies the cohesion; carried by the ice)",
+              valid_min=0.0, optional=True),
 )}
 
 

@@ -20,7 +20,9 @@ class IceState:
     Element fields: ``thickness`` h = ice volume per unit area [m],
     ``concentration`` A [-], ``damage`` d [-] (0 undamaged), ``stress``
     (m, 3) = (σxx, σyy, σxy) [Pa, tension positive], ``cohesion`` C [Pa],
-    ``snow`` hs snow volume per unit area [m].
+    ``snow`` hs snow volume per unit area [m]. ``strength_factor`` g [-]: the
+    spatially correlated part of the strength (:mod:`lagice.strength`), carried by
+    the ice and remapped like the other element fields; ``None`` without one.
     ``node_id`` (n,) int64: persistent node identifiers. Remeshing keeps the
     identifiers of the nodes it keeps and gives new nodes new ones
     (``counters["next_node_id"]``), so Lagrangian diagnostics can follow the
@@ -37,6 +39,7 @@ class IceState:
     cohesion: np.ndarray
     snow: np.ndarray | None = None
     node_id: np.ndarray | None = None
+    strength_factor: np.ndarray | None = None
     counters: dict = field(default_factory=dict)
 
     @classmethod

@@ -32,8 +32,24 @@ as an area-weighted mean would instead shrink its spread in every remeshed patch
 (averaging several independent values) until the pack became homogeneous. No extra
 field is stored: C is saved with the state, U_e is recomputed from the ids.
 
+Correlated heterogeneity (optional, ``strength_correlation_m`` ℓ > 0). Sea-ice
+strength also varies smoothly over tens to hundreds of kilometres (ice age, brine
+volume and temperature: first-year against multi-year ice; Timco & Weeks 2010, "A
+review of the engineering properties of sea ice", Cold Reg. Sci. Technol. 60). A factor
+g_e = 1 + a·(2Φ(G(x_e)) − 1) then multiplies C_e, with G a stationary Gaussian random
+field of unit variance and covariance exp(−r²/(2ℓ²)) (random Fourier features,
+Rahimi & Recht 2007, "Random features for large-scale kernel machines", NIPS 20;
+deterministic from the run seed), Φ the standard normal distribution function and a =
+``strength_correlated_amplitude``: g is uniform on [1 − a, 1 + a], mean 1, so the mean
+strength is unchanged. g is laid on the ice at the start of a run (element centroids
+at t = 0) and is then a material property: it is stored in the state
+(``state.strength_factor``), checkpointed, and remapped at each remesh as an
+area-weighted mean (∫ g da conserved exactly). Unlike the white disorder, remapping
+does not erase it: over a new element (Δx ≪ ℓ) g hardly varies, so the mean equals
+the point value to O((Δx/ℓ)²).
+
 After every remesh :meth:`StrengthLaw.apply` sets C of every element from its
-current size and its factor (a hook of the ``remeshing`` component,
+current size and its factors (a hook of the ``remeshing`` component,
 :attr:`lagice.remesh.Remesher.after_remesh`, set by the scene builder). Between
 remeshes C is a material property of the element and is not changed by the
 Lagrangian motion.
@@ -49,7 +65,11 @@ from .components import RateComponent
 from .errors import ConfigError, check_range
 
 #: keys of ``[rheology]`` handled here, not by MaxwellEBParams
-RHEOLOGY_KEYS = ("strength_law", "strength_lab_pa", "strength_lab_scale_m", "strength_disorder")
+RHEOLOGY_KEYS = ("strength_law", "strength_lab_pa", "strength_lab_scale_m", "strength_disorder",
+                 "strength_correlation_m", "strength_correlated_amplitude")
+#: random Fourier modes of the correlated strength field (the sample variance of G at a
+#: point is 1 ± O(1/sqrt(N)) over the domain)
+N_MODES = 512
 LAWS = ("uniform", "scaled")
 
 
@@ -97,22 +117,70 @@ def element_uniforms(node_id: np.ndarray, triangles: np.ndarray, seed: int) -> n
     return (h >> np.uint64(11)).astype(np.float64) * (1.0 / 9007199254740992.0)  # 53-bit mantissa
 
 
+def _normal_cdf(z: np.ndarray) -> np.ndarray:
+    """Φ(z), the standard normal distribution function."""
+    from scipy.special import ndtr
+
+    return ndtr(z)
+
+
 @dataclass(frozen=True)
 class StrengthLaw:
-    """C_e = ``lab_cohesion_pa`` · sqrt(``lab_scale_m``/Δx_e) · (1 + ``disorder`` U_e).
+    """C_e = ``lab_cohesion_pa`` · sqrt(``lab_scale_m``/Δx_e) · (1 + ``disorder`` U_e) · g_e.
 
     ``lab_cohesion_pa`` is in lagice's (Dansereau et al. 2016) criterion form; convert
-    neXtSIM's values with :func:`from_nextsim`."""
+    neXtSIM's values with :func:`from_nextsim`. g_e = 1 without a correlated field
+    (``correlation_m = 0``, the default), else see :meth:`correlated_factor`."""
 
     lab_cohesion_pa: float = 2.0e6 / math.sqrt(1.0 - 0.49)
     lab_scale_m: float = 0.1
     disorder: float = 1.0
     seed: int = 0
+    correlation_m: float = 0.0
+    correlated_amplitude: float | None = None
 
     def __post_init__(self):
         check_range("rheology.strength_lab_pa", self.lab_cohesion_pa, 1e4, 1e8, unit="Pa")
         check_range("rheology.strength_lab_scale_m", self.lab_scale_m, 1e-3, 10.0, unit="m")
         check_range("rheology.strength_disorder", self.disorder, 0.0, 10.0)
+        if self.correlation_m != 0.0:
+            check_range("rheology.strength_correlation_m", self.correlation_m, 1.0e3, 1.0e7, unit="m")
+            check_range("rheology.strength_correlated_amplitude", self.amplitude, 0.0, 0.95)
+        elif self.correlated_amplitude is not None:
+            raise ConfigError(f"rheology.strength_correlated_amplitude = {self.correlated_amplitude} is set but "
+                              "rheology.strength_correlation_m is 0 (no correlated field); set "
+                              "strength_correlation_m to a length in [1000, 1e7] m to use it")
+
+    @property
+    def amplitude(self) -> float:
+        """a of g = 1 + a(2Φ(G) − 1) [-] (default 0.5: a factor 3 between the weakest and
+        the strongest regions)."""
+        return 0.5 if self.correlated_amplitude is None else float(self.correlated_amplitude)
+
+    @property
+    def correlated(self) -> bool:
+        return self.correlation_m > 0.0
+
+    def gaussian_field(self, x_m, y_m) -> np.ndarray:
+        """G at points (x, y) [m]: a stationary Gaussian random field of unit variance and
+        covariance exp(−r²/(2ℓ²)), as N_MODES random Fourier features
+        sqrt(2/N) Σ cos(k_j·x + φ_j), k_j ~ N(0, I/ℓ²), φ_j ~ U[0, 2π) (drawn from the
+        run seed)."""
+        rng = np.random.default_rng([int(self.seed) & 0xFFFFFFFF, 0x5354524E])  # "STRN"
+        k = rng.normal(0.0, 1.0 / self.correlation_m, size=(N_MODES, 2))
+        phi = rng.uniform(0.0, 2.0 * np.pi, N_MODES)
+        x = np.asarray(x_m, np.float64)
+        y = np.asarray(y_m, np.float64)
+        out = np.zeros(x.shape)
+        for j in range(N_MODES):  # modes, not elements: each term is an array operation
+            out += np.cos(k[j, 0] * x + k[j, 1] * y + phi[j])
+        return out * math.sqrt(2.0 / N_MODES)
+
+    def correlated_factor(self, x_m, y_m) -> np.ndarray:
+        """g = 1 + a(2Φ(G) − 1) at points (x, y) [m]: uniform on [1 − a, 1 + a], mean 1."""
+        if not self.correlated:
+            raise ConfigError("correlated_factor needs rheology.strength_correlation_m > 0")
+        return 1.0 + self.amplitude * (2.0 * _normal_cdf(self.gaussian_field(x_m, y_m)) - 1.0)
 
     def scale_factor(self, size_m):
         """sqrt(L_lab/Δx) [-]."""
@@ -122,15 +190,21 @@ class StrengthLaw:
         """f_e = 1 + disorder · U_e [-]."""
         return 1.0 + self.disorder * element_uniforms(node_id, triangles, self.seed)
 
-    def cohesion(self, nodes, triangles, node_id) -> np.ndarray:
-        """C_e [Pa] of every element from its size and its disorder factor."""
-        return (self.lab_cohesion_pa * self.scale_factor(element_size(nodes, triangles))
-                * self.disorder_factor(node_id, triangles))
+    def cohesion(self, nodes, triangles, node_id, factor=None) -> np.ndarray:
+        """C_e [Pa] of every element from its size, its disorder factor and (when given)
+        its correlated factor g_e."""
+        c = (self.lab_cohesion_pa * self.scale_factor(element_size(nodes, triangles))
+             * self.disorder_factor(node_id, triangles))
+        return c if factor is None else c * factor
 
     def apply(self, state) -> None:
-        """Set ``state.cohesion`` of every element from its current size (after a remesh)."""
+        """Set ``state.cohesion`` of every element from its current size and factors
+        (after a remesh; ``state.strength_factor`` has been remapped with the ice)."""
         m = state.mesh
-        state.cohesion = self.cohesion(m.nodes, m.triangles, state.node_id)
+        if self.correlated and state.strength_factor is None:
+            raise ConfigError("rheology.strength_correlation_m > 0 but the state carries no strength_factor")
+        state.cohesion = self.cohesion(m.nodes, m.triangles, state.node_id,
+                                       state.strength_factor if self.correlated else None)
 
 
 def from_config(rheology: dict, seed: int) -> StrengthLaw | None:
@@ -141,14 +215,15 @@ def from_config(rheology: dict, seed: int) -> StrengthLaw | None:
     if law not in LAWS:
         raise ConfigError(f"rheology.strength_law = {law!r}: expected one of {list(LAWS)}")
     if law == "uniform":
-        for k in RHEOLOGY_KEYS[1:4]:
+        for k in RHEOLOGY_KEYS[1:]:
             if rheology.get(k) is not None:
                 raise ConfigError(f"rheology.{k} is set but rheology.strength_law = 'uniform'; "
                                   "set strength_law = 'scaled' to use it")
         return None
     kw = {"seed": int(seed)}
     for key, name in (("strength_lab_pa", "lab_cohesion_pa"), ("strength_lab_scale_m", "lab_scale_m"),
-                      ("strength_disorder", "disorder")):
+                      ("strength_disorder", "disorder"), ("strength_correlation_m", "correlation_m"),
+                      ("strength_correlated_amplitude", "correlated_amplitude")):
         if rheology.get(key) is not None:
             kw[name] = rheology[key]
     return StrengthLaw(**kw)

@@ -115,7 +115,78 @@ def test_after_a_remesh_every_element_carries_the_strength_of_its_size():
     assert abs(new.std() - math.sqrt(1 / 12)) < 0.04
 
 
+def test_correlated_factor_statistics():
+    """g = 1 + a(2Φ(G) − 1): uniform on [1 − a, 1 + a] with mean 1 (the mean strength is
+    kept), G's correlation at lag r follows exp(−r²/(2ℓ²)) and is gone at 4ℓ, and the
+    field is a function of the seed."""
+    law = StrengthLaw(correlation_m=50e3, correlated_amplitude=0.4, seed=7)
+    x, y = np.meshgrid(np.linspace(-1.5e6, 1.5e6, 601), np.linspace(-1.5e6, 1.5e6, 601))
+    g = law.correlated_factor(x, y)
+    assert 0.6 <= g.min() and g.max() <= 1.4
+    assert abs(g.mean() - 1.0) < 0.03 and abs(g.std() - 0.4 / math.sqrt(3)) < 0.02
+    hist = np.histogram(g, bins=8, range=(0.6, 1.4))[0] / g.size
+    assert np.all(np.abs(hist - 1 / 8) < 0.03)  # uniform
+    G = law.gaussian_field(x, y)
+    for lag in (5, 10, 20):  # grid spacing 5 km: 25, 50, 100 km
+        r = np.corrcoef(G[:, :-lag].ravel(), G[:, lag:].ravel())[0, 1]
+        assert r == pytest.approx(math.exp(-(lag * 5e3) ** 2 / (2 * 50e3 ** 2)), abs=0.05)
+    assert abs(np.corrcoef(G[:, :-40].ravel(), G[:, 40:].ravel())[0, 1]) < 0.15
+    np.testing.assert_array_equal(g, StrengthLaw(correlation_m=50e3, correlated_amplitude=0.4,
+                                                 seed=7).correlated_factor(x, y))
+    assert np.abs(g - StrengthLaw(correlation_m=50e3, correlated_amplitude=0.4, seed=8).correlated_factor(x, y)
+                  ).max() > 0.5
+
+
+def test_correlated_factor_is_carried_remapped_and_checkpointed(tmp_path):
+    """winter_basin_pack at 60 km with a correlated factor over ℓ = 300 km: at the start
+    C = C_lab sqrt(L/Δx) f g with g the field at the centroids; after a global remesh ∫ g da
+    is conserved to round-off, every element has C from its own size, disorder and
+    remapped g, g of the new elements is the field at their place (the ice moved less
+    than ℓ/30) and its spread is kept; a checkpoint written and read back carries g."""
+    from lagice.io.checkpoint import read_checkpoint, write_checkpoint
+    from lagice.scenes.builder import build_model
+    from lagice.scenes.config import load_scene
+
+    over = {"domain.resolution_m": 60e3, "run.duration": "1h", "solver.dt": "1h",
+            "rheology.strength_correlation_m": 300e3, "rheology.strength_correlated_amplitude": 0.5}
+    model = build_model(load_scene("winter_basin_pack", over))
+    st = model.state
+    law = from_config(model.config["rheology"], model.config["run"]["seed"])
+    m = st.mesh
+    c = m.centroids()
+    np.testing.assert_allclose(st.strength_factor, law.correlated_factor(c[:, 0], c[:, 1]), rtol=1e-12)
+    np.testing.assert_allclose(st.cohesion, law.cohesion(m.nodes, m.triangles, st.node_id) * st.strength_factor,
+                               rtol=1e-12)
+    std_before = st.strength_factor.std()
+    inner = np.ones(m.n_nodes, bool)
+    inner[np.unique(m.boundary_edges)] = False
+    m.nodes[inner, 0] += 8e3 * np.sin(m.nodes[inner, 1] / 80e3)
+    total = np.sum(st.strength_factor * m.areas())  # ∫ g da over the moved (Lagrangian) elements
+    rem = model.component("remeshing")
+    rem.options["force_global"] = True
+    ev = rem.advance(model, 3600.0)
+    assert ev is not None and ev.kind == "global"
+    nm = st.mesh
+    assert np.sum(st.strength_factor * nm.areas()) == pytest.approx(total, rel=1e-12)
+    dx = element_size(nm.nodes, nm.triangles)
+    np.testing.assert_allclose(st.cohesion, 2.8e6 * np.sqrt(0.1 / dx) * law.disorder_factor(st.node_id, nm.triangles)
+                               * st.strength_factor, rtol=1e-12)
+    k0 = len(ev.kept_elements)
+    nc = nm.centroids()[k0:]
+    assert np.abs(st.strength_factor[k0:] - law.correlated_factor(nc[:, 0], nc[:, 1])).max() < 0.1
+    assert st.strength_factor.std() > 0.9 * std_before
+    write_checkpoint(tmp_path, 1, model.state_arrays(), model.state_meta())
+    arrays, meta = read_checkpoint(next(tmp_path.glob("*.npz")))
+    fresh = build_model(load_scene("winter_basin_pack", over))
+    fresh.load_state(arrays, meta)
+    np.testing.assert_array_equal(fresh.state.strength_factor, st.strength_factor)
+
+
 @pytest.mark.parametrize("key,value,fragment", [
+    ("strength_correlation_m", 10.0, "rheology.strength_correlation_m = 10.0 m is out of range; expected a value "
+                                     "in [1000, 1e+07]"),
+    ("strength_correlated_amplitude", 1.5, "rheology.strength_correlated_amplitude = 1.5 is set but "
+                                           "rheology.strength_correlation_m is 0"),
     ("strength_lab_pa", 5.0, "rheology.strength_lab_pa = 5.0 Pa is out of range; expected a value in [10000, 1e+08]"),
     ("strength_disorder", -0.5, "rheology.strength_disorder = -0.5 is out of range; expected a value in [0, 10]"),
     ("strength_lab_scale_m", 100.0, "rheology.strength_lab_scale_m = 100.0 m is out of range"),
@@ -132,6 +203,26 @@ def test_bad_strength_parameters_fail_before_meshing(monkeypatch, key, value, fr
     with pytest.raises(ConfigError) as exc:
         builder.build_model(cfg)
     assert fragment in str(exc.value)
+
+
+def test_bad_correlated_strength_fails_before_meshing(monkeypatch):
+    """An amplitude out of range, and a correlated field with the cohesion set by hand."""
+    from lagice.scenes import builder, config
+
+    def boom(*a, **k):
+        raise AssertionError("meshing must not start")
+
+    monkeypatch.setattr(builder, "generate_mesh", boom)
+    for over, fragment in (({"rheology.strength_correlated_amplitude": 1.5},
+                            "rheology.strength_correlated_amplitude = 1.5 is out of range; expected a value in "
+                            "[0, 0.95]"),
+                           ({"initial.cohesion_pa": 2e4},
+                            "rheology.strength_correlation_m = 50000 m needs the cohesion from the strength law, "
+                            "but initial.cohesion_pa = 20000.0")):
+        cfg = config.load_scene("winter_basin_pack", {"rheology.strength_correlation_m": 5e4, **over})
+        with pytest.raises(ConfigError) as exc:
+            builder.build_model(cfg)
+        assert fragment in str(exc.value)
 
 
 def test_unknown_law_and_orphan_keys():

@@ -274,7 +274,11 @@ def validate_config(cfg: dict) -> None:
                           f"solver.dt = {dt:g} s")
     check_range("run.max_speed_m_s", cfg["run"]["max_speed_m_s"], 0.0, None, low_open=True, unit="m s-1")
     rheo = build_rheology(cfg)
-    strength_law(cfg)
+    law = strength_law(cfg)
+    if law is not None and law.correlated and cfg["initial"]["cohesion_pa"] != "random":
+        raise ConfigError(f"rheology.strength_correlation_m = {law.correlation_m:g} m needs the cohesion from the "
+                          f"strength law, but initial.cohesion_pa = {cfg['initial']['cohesion_pa']!r}; "
+                          "leave initial.cohesion_pa at 'random'")
     from ..mesh.generate import check_mesh_algorithm
     from ..mesh.perturb import check_jitter
 
@@ -469,8 +473,8 @@ def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
     x, y = c[:, 0], c[:, 1]
     ini = cfg["initial"]
     coh = ini["cohesion_pa"]
+    law = strength_law(cfg)
     if coh == "random":
-        law = strength_law(cfg)
         if not isinstance(rheo, MaxwellEB):
             cohesion = np.zeros(mesh.n_elements)
         elif law is not None:  # C from each element's size and its disorder factor (issue 12)
@@ -488,6 +492,10 @@ def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
 
     state = IceState.uniform(mesh, thickness_m=field("thickness_m"), concentration=field("concentration"),
                              damage=field("damage"), cohesion_pa=cohesion)
+    if coh == "random" and law is not None and isinstance(rheo, MaxwellEB) and law.correlated:
+        # the correlated strength factor, laid on the ice at its start positions (then carried)
+        state.strength_factor = law.correlated_factor(x, y)
+        state.cohesion = state.cohesion * state.strength_factor
     if ini["snow_m"] is not None:
         state.snow = spatial_values(ini["snow_m"], x, y, "initial.snow_m")
     sp = ini["stress_pa"]
