@@ -522,6 +522,18 @@ CORRELATED_STRENGTH = ["rheology.strength_correlation_m=5e4", "rheology.strength
 add_weather_ensemble("cor50", CORRELATED_STRENGTH + from_spinup("H1125"),
                      "with a correlated strength factor (ℓ = 50 km, g in [0.5, 1.5]) at the shipped mean strength",
                      "thick-and-thin, correlated strength ℓ = 50 km", ENSEMBLE_SEEDS)
+# The four-month screen passed its rule (closed 4 bands inside against 3, strait 4 against 2;
+# β +0.010/+0.022 and the rate ×1.5/×1.4, both towards their bands). Second stage, its rule
+# written before its runs: the same set-up over the eight months of the shipped ensemble (the
+# four more wind seeds of MORE_SEEDS, still from the shipped spin-up state). It passes if the
+# eight-month medians put more bands inside than the shipped set's eight months in both basins
+# (3 closed, 3 strait) and neither β nor the rate moves further from its band. Passing would
+# call for a spin-up made with the field and the validation regenerated from it before the
+# field is shipped; failing ends the lead.
+add_weather_ensemble("cor50", CORRELATED_STRENGTH + from_spinup("H1125"),
+                     "with a correlated strength factor (ℓ = 50 km, g in [0.5, 1.5]) at the shipped mean strength",
+                     "thick-and-thin, correlated strength ℓ = 50 km", ENSEMBLE_SEEDS + MORE_SEEDS,
+                     suffix=", eight months")
 
 # --- 2026-11-26 (seventh session): the published month with this session's CPU kernels -------
 # -k7-roundoff: the validation month of both basins made with the first version of this
@@ -705,6 +717,47 @@ def spread() -> str:
     return "\n".join(lines)
 
 
+def figure_strength(name: str = "F10-hthick-cor50", ref: str = "F10-hthick-1125", days: float = 28,
+                    buffer_m: float = 100e3) -> Path:
+    """docs/figures/``name``.png: the cohesion at the start and the shear of the storm window
+    (the window with the highest mean rate in ``ref``) of runs ``ref`` and ``name``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import xarray as xr
+    from validate import DAY, analyse_run
+
+    runs = [(ref, OUT / ref), (name, OUT / name)]
+    res = {n: analyse_run(r, days, buffer_m) for n, r in runs}
+    k = int(np.argmax([w["interior"]["mean_total_s"] for w in res[ref]["windows"]]))
+    fig, axes = plt.subplots(2, 2, figsize=(11, 10))
+    for col, (n, r) in enumerate(runs):
+        with xr.open_dataset(r / "snapshots" / "snapshot_00000000.nc") as ds:
+            xy = np.column_stack([ds["mesh_node_x"].values, ds["mesh_node_y"].values]) / 1e3
+            tri = ds["mesh_face_nodes"].values.astype(np.int64)
+            coh = ds["cohesion"].values[0] / 1e3
+        ax = axes[0, col]
+        tp = ax.tripcolor(xy[:, 0], xy[:, 1], tri, facecolors=coh, cmap="viridis", vmin=5, vmax=40)
+        ax.set_title(f"{n}: cohesion at day 0 (kPa)", fontsize=9)
+        fig.colorbar(tp, ax=ax, shrink=0.8)
+        w = res[n]["windows"][k]
+        mxy, mtri, shear = w["interior"]["_map"]
+        ax = axes[1, col]
+        tp = ax.tripcolor(mxy[:, 0] / 1e3, mxy[:, 1] / 1e3, mtri, facecolors=np.log10(np.maximum(shear * DAY, 1e-4)),
+                          cmap="magma", vmin=-4, vmax=0)
+        ax.set_title(f"{n}: log10 shear (day$^{{-1}}$), days {w['start_day']:.0f}–{w['end_day']:.0f}", fontsize=9)
+        fig.colorbar(tp, ax=ax, shrink=0.8)
+    for ax in axes.ravel():
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (km)")
+    fig.tight_layout()
+    path = ROOT / "docs" / "figures" / f"{name}.png"
+    fig.savefig(path, dpi=90)
+    print(f"physics: wrote {path.relative_to(ROOT)}")
+    return path
+
+
 def spinup(name="shipped", days=14):
     """Spin-up state ``name`` (SPINUPS): ``examples/winter_basin_spinup.toml`` (pristine
     ice, seed 2025) with its overrides for ``days``, then its last snapshot → its file
@@ -729,7 +782,7 @@ def spinup(name="shipped", days=14):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("what", choices=("list", "run", "table", "spread", "spinup", "analyse"))
+    ap.add_argument("what", choices=("list", "run", "table", "spread", "spinup", "analyse", "figure"))
     ap.add_argument("names", nargs="*")
     ap.add_argument("--force", action="store_true", help="run again even if the run finished")
     args = ap.parse_args(argv)
@@ -748,6 +801,8 @@ def main(argv=None):
             spinup(n)
     elif args.what == "spread":
         print(spread())
+    elif args.what == "figure":  # the cohesion and a storm window's shear: run NAME against run REF
+        figure_strength(*args.names)
     else:
         print(table())
 
