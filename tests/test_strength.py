@@ -231,6 +231,14 @@ def test_unknown_law_and_orphan_keys():
     with pytest.raises(ConfigError, match="strength_disorder is set but rheology.strength_law = 'uniform'"):
         from_config({"strength_law": "uniform", "strength_disorder": 0.5}, 0)
     assert from_config({"strength_law": "uniform"}, 0) is None
+    with pytest.raises(ConfigError, match="strength_correlation_m is set but rheology.strength_law = 'uniform'"):
+        from_config({"strength_law": "uniform", "strength_correlation_m": 5e4}, 0)
+    from lagice.scenes import builder, config
+
+    # the scene schema's defaults (every key present, unset ones None) leave a uniform law valid
+    cfg = config.load_scene("uniaxial_compression")
+    assert cfg["rheology"]["strength_law"] == "uniform" and cfg["rheology"]["strength_correlation_m"] is None
+    builder.validate_config(cfg)
 
 
 def test_scene_uses_the_law():

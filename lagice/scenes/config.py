@@ -69,7 +69,7 @@ SCHEMA = {
         "strength_law": (str, "uniform"), "strength_lab_pa": (NUM, None), "strength_lab_scale_m": (NUM, None),
         "strength_disorder": (NUM, None),
         # spatially correlated strength factor g = 1 + a(2Φ(G) − 1), G correlated over ℓ (0: none)
-        "strength_correlation_m": (NUM, 0.0), "strength_correlated_amplitude": (NUM, None),
+        "strength_correlation_m": (NUM, None), "strength_correlated_amplitude": (NUM, None),
     },
     "solver": {
         "name": (str, "implicit"), "dt": (EXPR, None), "substeps": (int, None),
@@ -135,7 +135,7 @@ LEGACY_VALUES = {
     "rheology.strength_lab_pa": (None,),
     "rheology.strength_lab_scale_m": (None,),
     "rheology.strength_disorder": (None,),
-    "rheology.strength_correlation_m": (0.0, 0),      # 2026-11-26: no correlated strength field
+    "rheology.strength_correlation_m": (None, 0.0, 0),  # 2026-11-26: no correlated strength field
     "rheology.strength_correlated_amplitude": (None,),
     "rheology.stress_correction": ("origin",),       # 2026-11-24: scaling towards the origin
     "rheology.stress_correction_mean_fraction": (None,),
