@@ -3,7 +3,8 @@
 A spin-up run (e.g. ``examples/winter_basin_spinup.toml``: 14 days of the winter wind
 climatology on pristine ice) leaves a heterogeneous, partly damaged pack.
 :func:`save_spinup` keeps its element fields at the last snapshot (centroids,
-damage, thickness, concentration; float32) in a small ``.npz``; the scene hooks
+damage, thickness, concentration; float32; and the correlated strength factor
+``strength_factor`` with its ℓ and a when the run had one) in a small ``.npz``; the scene hooks
 :func:`winter_basin_damage`, :func:`winter_basin_thickness`,
 :func:`winter_basin_concentration` read ``data_stubs/winter_basin_spinup.npz`` and give
 each new element the value of the nearest spin-up centroid, so they serve any
@@ -28,10 +29,32 @@ from .errors import ConfigError
 ROOT = Path(__file__).resolve().parents[1]
 WINTER_BASIN = ROOT / "data_stubs" / "winter_basin_spinup.npz"
 FIELDS = ("damage", "thickness", "concentration")
+#: fields a state file may hold: the correlated strength factor g (lagice.strength), with the
+#: scalars ``strength_correlation_m`` and ``strength_correlated_amplitude`` of the run that made it
+OPTIONAL_FIELDS = ("strength_factor",)
+CORRELATION_KEYS = ("strength_correlation_m", "strength_correlated_amplitude")
+
+
+def _correlation_of_run(run_dir: Path) -> dict:
+    """ℓ and a of the correlated strength field of ``run_dir`` (from its newest checkpoint's
+    configuration, with the law's defaults)."""
+    from .io.checkpoint import read_checkpoint
+    from .strength import StrengthLaw
+
+    cks = sorted((run_dir / "checkpoints").glob("*.npz")) if (run_dir / "checkpoints").exists() else []
+    if not cks:
+        raise ConfigError(f"{run_dir}: its snapshots carry a correlated strength factor but the run has no "
+                          "checkpoint to tell its strength_correlation_m and strength_correlated_amplitude")
+    rh = read_checkpoint(cks[-1])[1]["config"]["rheology"]
+    law = StrengthLaw(correlation_m=float(rh["strength_correlation_m"]),
+                      correlated_amplitude=rh.get("strength_correlated_amplitude"))
+    return {"strength_correlation_m": np.float64(law.correlation_m),
+            "strength_correlated_amplitude": np.float64(law.amplitude)}
 
 
 def save_spinup(run_dir, out_path) -> Path:
-    """Element centroids and FIELDS of the last snapshot of ``run_dir`` → ``out_path``."""
+    """Element centroids and FIELDS (and OPTIONAL_FIELDS the run has) of the last snapshot
+    of ``run_dir`` → ``out_path``."""
     import xarray as xr
 
     run_dir = Path(run_dir)
@@ -40,7 +63,9 @@ def save_spinup(run_dir, out_path) -> Path:
     with xr.open_dataset(run_dir / "snapshots" / last["file"], decode_times=False) as ds:
         nodes = np.column_stack([ds["mesh_node_x"].values, ds["mesh_node_y"].values])
         tri = ds["mesh_face_nodes"].values.astype(np.int64)
-        arrays = {k: ds[k].values[0].astype(np.float32) for k in FIELDS}
+        arrays = {k: ds[k].values[0].astype(np.float32) for k in FIELDS + OPTIONAL_FIELDS if k in ds}
+    if "strength_factor" in arrays:
+        arrays.update(_correlation_of_run(run_dir))
     c = nodes[tri].mean(axis=1)
     out = Path(out_path)
     np.savez_compressed(out, centroid_x_m=c[:, 0].astype(np.float32), centroid_y_m=c[:, 1].astype(np.float32),
@@ -49,7 +74,8 @@ def save_spinup(run_dir, out_path) -> Path:
 
 
 #: valid range of each field of a state file (inclusive)
-RANGES = {"damage": (0.0, 1.0), "thickness": (0.0, 100.0), "concentration": (0.0, 1.0)}
+RANGES = {"damage": (0.0, 1.0), "thickness": (0.0, 100.0), "concentration": (0.0, 1.0),
+          "strength_factor": (0.0, 2.0)}
 
 
 def resolve_state_path(spec) -> Path:
@@ -64,7 +90,8 @@ def resolve_state_path(spec) -> Path:
 def load_state_file(spec, key: str = "initial.state_file"):
     """(centroid tree, {field: float64 values}) of a spin-up state, checked: the file
     exists and holds the centroids and FIELDS, finite and inside RANGES (a ConfigError
-    names ``key``, the file, the field, the bad value and the range)."""
+    names ``key``, the file, the field, the bad value and the range). OPTIONAL_FIELDS the
+    file holds are checked alike and returned, with the CORRELATION_KEYS scalars."""
     p = resolve_state_path(spec)
     if not p.exists():
         raise ConfigError(f"{key} = {str(spec)!r}: spin-up state {p} does not exist; make it with "
@@ -88,7 +115,7 @@ def _load(path: str, mtime_ns: int, key: str):
     if len(xy) == 0 or not np.isfinite(xy).all():
         raise ConfigError(f"{key}: {path}: centroids are empty or not finite")
     fields = {}
-    for k in FIELDS:
+    for k in FIELDS + tuple(f for f in OPTIONAL_FIELDS if f in names):
         v = z[k].astype(np.float64)
         lo, hi = RANGES[k]
         if v.shape != (len(xy),):
@@ -98,6 +125,11 @@ def _load(path: str, mtime_ns: int, key: str):
             raise ConfigError(f"{key}: {path}: field {k!r} has {int(bad.sum())} values outside [{lo:g}, {hi:g}] "
                               f"(first: {v[bad][0]!r})")
         fields[k] = v
+    if "strength_factor" in fields:
+        if set(CORRELATION_KEYS) - names:
+            raise ConfigError(f"{key}: {path} holds strength_factor but lacks {sorted(set(CORRELATION_KEYS) - names)}")
+        for k in CORRELATION_KEYS:
+            fields[k] = float(z[k])
     return cKDTree(xy), fields
 
 

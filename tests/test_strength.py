@@ -358,3 +358,48 @@ def test_nextsim_healing_component_in_the_model():
               / (25 * 86400.0 * 20.0))
     np.testing.assert_allclose(r, expect, rtol=1e-12)
     assert model.stepper.heal_rate == comp.rate
+
+
+def test_spinup_state_carries_the_correlated_factor(tmp_path, monkeypatch):
+    """A spin-up made with a correlated strength factor saves g with its ℓ and a; a run
+    from that state carries the spin-up's g on (nearest spin-up centroid, like damage),
+    not a fresh draw of its own seed; a run without the same ℓ and a is refused before
+    any mesh work, naming the file and the values."""
+    from lagice.scenes import builder, config
+    from lagice.spinup import field_from_spinup, save_spinup
+
+    from helpers import scene_sim
+
+    cor = {"rheology.strength_correlation_m": 300e3, "rheology.strength_correlated_amplitude": 0.4}
+    sim = scene_sim("winter_basin_pack", tmp_path / "run", {"domain.resolution_m": 80e3, "run.duration": "1h",
+                                                            "solver.dt": "1h", "output.every": "1h",
+                                                            "drifters.count": 0, **cor})
+    sim.run()
+    sim.write_checkpoint()
+    npz = save_spinup(tmp_path / "run", tmp_path / "s.npz")
+    z = np.load(npz)
+    assert float(z["strength_correlation_m"]) == 300e3 and float(z["strength_correlated_amplitude"]) == 0.4
+    np.testing.assert_allclose(np.sort(z["strength_factor"]), np.sort(sim.model.state.strength_factor), rtol=1e-6)
+    over = {"domain.resolution_m": 60e3, "run.duration": "1h", "solver.dt": "1h", "initial.state_file": str(npz),
+            "run.seed": 99}
+    model = builder.build_model(config.load_scene("winter_basin_pack", {**over, **cor}))
+    st = model.state
+    c = st.mesh.centroids()
+    g = field_from_spinup(npz, "strength_factor", c[:, 0], c[:, 1])
+    np.testing.assert_array_equal(st.strength_factor, g)
+    law = from_config(model.config["rheology"], 99)
+    np.testing.assert_allclose(st.cohesion, law.cohesion(st.mesh.nodes, st.mesh.triangles, st.node_id) * g,
+                               rtol=1e-12)
+    assert np.abs(g - law.correlated_factor(c[:, 0], c[:, 1])).max() > 0.2  # not the run seed's own draw
+
+    def boom(*a, **k):
+        raise AssertionError("meshing must not start")
+
+    monkeypatch.setattr(builder, "generate_mesh", boom)
+    for extra, fragment in (({}, "carries a correlated strength factor (ℓ = 300000 m, a = 0.4) but "
+                                 "rheology.strength_correlation_m is not set"),
+                            ({**cor, "rheology.strength_correlated_amplitude": 0.5},
+                             "strength_correlated_amplitude = 0.5, but initial.state_file")):
+        with pytest.raises(ConfigError) as exc:
+            builder.build_model(config.load_scene("winter_basin_pack", {**over, **extra}))
+        assert fragment in str(exc.value)

@@ -9,6 +9,7 @@ stores the validated config and ``"lagice.scenes.builder:build_simulation"``, so
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -275,6 +276,7 @@ def validate_config(cfg: dict) -> None:
     check_range("run.max_speed_m_s", cfg["run"]["max_speed_m_s"], 0.0, None, low_open=True, unit="m s-1")
     rheo = build_rheology(cfg)
     law = strength_law(cfg)
+    check_state_file_strength(cfg, law)
     if law is not None and law.correlated and cfg["initial"]["cohesion_pa"] != "random":
         raise ConfigError(f"rheology.strength_correlation_m = {law.correlation_m:g} m needs the cohesion from the "
                           f"strength law, but initial.cohesion_pa = {cfg['initial']['cohesion_pa']!r}; "
@@ -465,6 +467,36 @@ def check_initial_state_file(ini: dict) -> list[str]:
     return keys
 
 
+def state_file_strength(cfg: dict) -> dict | None:
+    """The spin-up state file's correlated strength factor ({"strength_factor": g,
+    "strength_correlation_m": ℓ, "strength_correlated_amplitude": a}), or None when the
+    scene reads no state file or the file has none."""
+    ini = cfg["initial"]
+    if not ini.get("state_file") or not any(ini.get(k) == "from_state" for k in FROM_STATE):
+        return None
+    fields = load_state_file(ini["state_file"], "initial.state_file")[1]
+    return fields if "strength_factor" in fields else None
+
+
+def check_state_file_strength(cfg: dict, law) -> None:
+    """A state file made with a correlated strength factor is read only by a run with the
+    same ℓ and a (its factor is then carried on; without them it would be ignored)."""
+    sf = state_file_strength(cfg)
+    if sf is None:
+        return
+    f = cfg["initial"]["state_file"]
+    ell, a = sf["strength_correlation_m"], sf["strength_correlated_amplitude"]
+    if law is None or not law.correlated:
+        raise ConfigError(f"initial.state_file = {f!r} carries a correlated strength factor (ℓ = {ell:g} m, "
+                          f"a = {a:g}) but rheology.strength_correlation_m is not set: set "
+                          f"rheology.strength_correlation_m = {ell:g} and strength_correlated_amplitude = {a:g}, "
+                          "or start from a state file without one")
+    if not (math.isclose(law.correlation_m, ell, rel_tol=1e-9) and math.isclose(law.amplitude, a, rel_tol=1e-9)):
+        raise ConfigError(f"rheology.strength_correlation_m = {law.correlation_m:g} m and "
+                          f"strength_correlated_amplitude = {law.amplitude:g}, but initial.state_file = {f!r} "
+                          f"carries a factor made with {ell:g} m and {a:g}; use the state file's values")
+
+
 def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
     """The scene's initial state on ``mesh``; ``order`` (see :func:`build_mesh`): random
     cohesion is drawn in the mesh generator's element order, then permuted, so the
@@ -493,8 +525,12 @@ def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
     state = IceState.uniform(mesh, thickness_m=field("thickness_m"), concentration=field("concentration"),
                              damage=field("damage"), cohesion_pa=cohesion)
     if coh == "random" and law is not None and isinstance(rheo, MaxwellEB) and law.correlated:
-        # the correlated strength factor, laid on the ice at its start positions (then carried)
-        state.strength_factor = law.correlated_factor(x, y)
+        # the correlated strength factor: the spin-up's, carried on with its ice (nearest
+        # spin-up centroid, like its other fields), else laid on the ice at its start positions
+        if state_file_strength(cfg) is not None:
+            state.strength_factor = field_from_spinup(ini["state_file"], "strength_factor", x, y)
+        else:
+            state.strength_factor = law.correlated_factor(x, y)
         state.cohesion = state.cohesion * state.strength_factor
     if ini["snow_m"] is not None:
         state.snow = spatial_values(ini["snow_m"], x, y, "initial.snow_m")
