@@ -534,6 +534,15 @@ add_weather_ensemble("cor50", CORRELATED_STRENGTH + from_spinup("H1125"),
                      "with a correlated strength factor (ℓ = 50 km, g in [0.5, 1.5]) at the shipped mean strength",
                      "thick-and-thin, correlated strength ℓ = 50 km", ENSEMBLE_SEEDS + MORE_SEEDS,
                      suffix=", eight months")
+# Third stage (if the second passes): the same set-up from its own spin-up, made with the field
+# (the spin-up scene with CORRELATED_STRENGTH; its state carries g, and the runs carry it on),
+# over the eight months. This is the ensemble the validation would be regenerated from if the
+# field were shipped.
+SPINUPS["H1125-cor50"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + CORRELATED_STRENGTH,
+                          OUT / "spinup-H1125-cor50.npz", 10e3)
+add_weather_ensemble("cor50sp", CORRELATED_STRENGTH + from_spinup("H1125-cor50"),
+                     "with a correlated strength factor (ℓ = 50 km, g in [0.5, 1.5]) from its own spin-up",
+                     "thick-and-thin, correlated strength ℓ = 50 km, own spin-up", ENSEMBLE_SEEDS + MORE_SEEDS)
 
 # --- 2026-11-26 (seventh session): the published month with this session's CPU kernels -------
 # -k7-roundoff: the validation month of both basins made with the first version of this
