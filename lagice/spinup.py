@@ -63,7 +63,8 @@ def save_spinup(run_dir, out_path) -> Path:
     with xr.open_dataset(run_dir / "snapshots" / last["file"], decode_times=False) as ds:
         nodes = np.column_stack([ds["mesh_node_x"].values, ds["mesh_node_y"].values])
         tri = ds["mesh_face_nodes"].values.astype(np.int64)
-        arrays = {k: ds[k].values[0].astype(np.float32) for k in FIELDS + OPTIONAL_FIELDS if k in ds}
+        arrays = {k: ds[k].values[0].astype(np.float32) for k in FIELDS}
+        arrays.update({k: ds[k].values[0].astype(np.float32) for k in OPTIONAL_FIELDS if k in ds})
     if "strength_factor" in arrays:
         arrays.update(_correlation_of_run(run_dir))
     c = nodes[tri].mean(axis=1)
