@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import shlex
 import subprocess
@@ -726,6 +727,59 @@ def spread() -> str:
     return "\n".join(lines)
 
 
+def band_distance(key: str, value: float) -> float:
+    """How far ``value`` lies outside the observed band of metric ``key`` (0 inside): in
+    the metric's units, except the rate, whose distance is in log10 (a factor)."""
+    lo, hi = TARGETS[key]
+    if key == "mean_total_deformation_rate_per_day":
+        return max(math.log10(lo / value), 0.0, math.log10(value / hi))
+    return max(lo - value, 0.0, value - hi)
+
+
+def screen_verdict(candidate: dict, reference: dict, beta_tolerance: float = 0.0,
+                   rate_tolerance_factor: float = 1.0) -> dict:
+    """A screen rule as the sessions wrote them, made mechanical. ``candidate`` and
+    ``reference`` map each metric of TARGETS to a median over months. The screen passes if
+    the candidate puts more bands inside than the reference and neither β nor the rate
+    moves further from its band than the tolerances: β by more than ``beta_tolerance``, the
+    rate by more than the factor ``rate_tolerance_factor``. The rules of 2026-11-26 had no
+    tolerance (0 and 1); a rule should state them before its runs."""
+    inside = {k: sum(band_distance(k, m[k]) == 0.0 for k in TARGETS) for k, m in
+              (("candidate", candidate), ("reference", reference))}
+    beta_move = (band_distance("beta_space", candidate["beta_space"])
+                 - band_distance("beta_space", reference["beta_space"]))
+    k = "mean_total_deformation_rate_per_day"
+    rate_move = band_distance(k, candidate[k]) - band_distance(k, reference[k])
+    ok_beta = beta_move <= beta_tolerance
+    ok_rate = rate_move <= math.log10(rate_tolerance_factor)
+    return {"bands_inside": inside, "beta_further_by": beta_move, "rate_further_by_factor": 10.0 ** rate_move,
+            "beta_ok": ok_beta, "rate_ok": ok_rate,
+            "passes": inside["candidate"] > inside["reference"] and ok_beta and ok_rate}
+
+
+def group_medians(group: str) -> dict:
+    """The median over the members of :data:`ENSEMBLES` ``group`` of each metric (what
+    :func:`spread` prints)."""
+    allr = json.loads((OUT / "experiments.json").read_text())
+    if group not in ENSEMBLES:
+        raise SystemExit(f"physics: unknown group {group!r}; known: {list(ENSEMBLES)}")
+    missing = [n for n in ENSEMBLES[group] if n not in allr]
+    if missing:
+        raise SystemExit(f"physics: group {group!r} lacks runs {missing}; run them first")
+    return {k: float(np.median([allr[n]["median"][k] for n in ENSEMBLES[group]])) for k in TARGETS}
+
+
+def screen(candidate: str, reference: str, beta_tolerance: float, rate_tolerance_factor: float) -> dict:
+    """Print and return :func:`screen_verdict` of two groups of :data:`ENSEMBLES`."""
+    v = screen_verdict(group_medians(candidate), group_medians(reference), beta_tolerance, rate_tolerance_factor)
+    b = v["bands_inside"]
+    print(f"physics: screen {candidate!r} against {reference!r}: bands inside {b['candidate']} against "
+          f"{b['reference']}; β further from its band by {v['beta_further_by']:+.4f} (tolerance "
+          f"{beta_tolerance:g}; negative: closer), the rate by ×{v['rate_further_by_factor']:.3f} (tolerance "
+          f"×{rate_tolerance_factor:g}; below 1: closer): " + ("PASSES" if v["passes"] else "FAILS"))
+    return v
+
+
 def figure_strength(name: str = "F10-hthick-cor50", ref: str = "F10-hthick-1125", days: float = 28,
                     buffer_m: float = 100e3) -> Path:
     """docs/figures/``name``.png: the cohesion at the start and the shear of the storm window
@@ -791,9 +845,13 @@ def spinup(name="shipped", days=14):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("what", choices=("list", "run", "table", "spread", "spinup", "analyse", "figure"))
+    ap.add_argument("what", choices=("list", "run", "table", "spread", "spinup", "analyse", "figure", "screen"))
     ap.add_argument("names", nargs="*")
     ap.add_argument("--force", action="store_true", help="run again even if the run finished")
+    ap.add_argument("--beta-tolerance", type=float, default=0.0,
+                    help="screen: how much further from its band β may move (state it before the runs)")
+    ap.add_argument("--rate-tolerance", type=float, default=1.0,
+                    help="screen: by what factor further from its band the rate may move (>= 1)")
     args = ap.parse_args(argv)
     if args.what in ("run", "spinup"):
         prepare_inputs()
@@ -810,6 +868,10 @@ def main(argv=None):
             spinup(n)
     elif args.what == "spread":
         print(spread())
+    elif args.what == "screen":  # CANDIDATE_GROUP REFERENCE_GROUP
+        if len(args.names) != 2:
+            raise SystemExit("physics: screen needs two groups of ENSEMBLES: CANDIDATE REFERENCE")
+        screen(*args.names, args.beta_tolerance, args.rate_tolerance)
     elif args.what == "figure":  # the cohesion and a storm window's shear: run NAME against run REF
         figure_strength(*args.names)
     else:

@@ -5,6 +5,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
@@ -27,3 +28,32 @@ def test_reused_gmsh_mesh_is_the_mesh_gmsh_gives_and_is_not_shared(monkeypatch):
         assert np.array_equal(getattr(second, name), getattr(fresh, name)), name
     other, _ = builder.build_mesh(scene_config("wind_square", {"domain.resolution_m": 80e3}))
     assert stats["gmsh_calls"] == 2 and other.n_elements < fresh.n_elements
+
+
+def test_screen_verdict_counts_bands_and_applies_the_stated_tolerances():
+    """The screen rule of the physics experiments, made mechanical: more bands inside than
+    the reference, and neither β nor the rate further from its band than the tolerances
+    (the rate's distance is a factor). The eighth session's second stage: 4 bands against
+    3, but β 0.0550 against 0.0552, 0.0002 further, fails with no tolerance and passes
+    with one of 0.01."""
+    from physics_experiments import TARGETS, band_distance, screen_verdict
+
+    ref = {"beta_space": 0.0552, "pdf_tail_exponent_shear": 2.24, "pdf_tail_exponent_divergence": 2.16,
+           "localisation_half_shear_area_fraction": 0.051, "shear_divergence_r2": 0.731,
+           "mean_total_deformation_rate_per_day": 0.00215}
+    cand = {**ref, "beta_space": 0.0550, "pdf_tail_exponent_divergence": 2.51,
+            "mean_total_deformation_rate_per_day": 0.00261}
+    assert set(ref) == set(TARGETS)
+    v = screen_verdict(cand, ref)
+    assert v["bands_inside"] == {"candidate": 4, "reference": 3}
+    assert v["beta_further_by"] == pytest.approx(0.0002) and not v["beta_ok"] and not v["passes"]
+    assert v["rate_ok"] and v["rate_further_by_factor"] == pytest.approx(0.00215 / 0.00261)
+    assert screen_verdict(cand, ref, beta_tolerance=0.01)["passes"]
+    # the rate's distance is a factor: 0.005 is ×2 below the band's 0.01, as 0.1 is ×2 above 0.05
+    assert band_distance("mean_total_deformation_rate_per_day", 0.005) == pytest.approx(
+        band_distance("mean_total_deformation_rate_per_day", 0.1))
+    slower = {**cand, "beta_space": 0.06, "mean_total_deformation_rate_per_day": 0.0015}
+    v = screen_verdict(slower, ref)
+    assert v["beta_ok"] and not v["rate_ok"] and not v["passes"]
+    assert screen_verdict(slower, ref, rate_tolerance_factor=1.5)["passes"]
+    assert not screen_verdict(ref, ref, beta_tolerance=1.0, rate_tolerance_factor=10.0)["passes"]  # no band gained
