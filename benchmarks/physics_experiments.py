@@ -538,7 +538,9 @@ add_weather_ensemble("cor50", CORRELATED_STRENGTH + from_spinup("H1125"),
 # Third stage (if the second passes): the same set-up from its own spin-up, made with the field
 # (the spin-up scene with CORRELATED_STRENGTH; its state carries g, and the runs carry it on),
 # over the eight months. This is the ensemble the validation would be regenerated from if the
-# field were shipped.
+# field were shipped. The second stage failed by its rule (the strait's median β moved 0.0002
+# further from its band; `screen`), so the lead ended there; only the spin-up and the seed-2026
+# pair (F10-hthick-cor50sp, F10s-hthick-cor50sp) were run, as information.
 SPINUPS["H1125-cor50"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + CORRELATED_STRENGTH,
                           OUT / "spinup-H1125-cor50.npz", 10e3)
 add_weather_ensemble("cor50sp", CORRELATED_STRENGTH + from_spinup("H1125-cor50"),
