@@ -403,3 +403,39 @@ def test_spinup_state_carries_the_correlated_factor(tmp_path, monkeypatch):
         with pytest.raises(ConfigError) as exc:
             builder.build_model(config.load_scene("winter_basin_pack", {**over, **extra}))
         assert fragment in str(exc.value)
+
+
+def test_a_branch_applies_its_strength_law_at_the_branch_point(tmp_path):
+    """A branch that changes the strength law (here: a correlated factor on a checkpoint
+    without one, then none on a checkpoint with one) sets the cohesion of every element
+    from its own law at the branch point, instead of keeping the parent's until the first
+    remesh (which, with a factor the state lacked, would have failed mid-run); a branch
+    that leaves the law alone keeps the checkpoint's fields bit for bit."""
+    from lagice.scenes.builder import branch_simulation
+
+    from helpers import scene_sim
+
+    base = {"domain.resolution_m": 80e3, "run.duration": "1h", "solver.dt": "1h", "output.every": "1h",
+            "drifters.count": 0}
+    sim = scene_sim("winter_basin_pack", tmp_path / "parent", base)
+    sim.run()
+    ck = sim.write_checkpoint()
+    parent_c = sim.model.state.cohesion.copy()
+    cor = {"rheology.strength_correlation_m": 300e3, "run.duration": "2h"}
+    br = branch_simulation(ck, tmp_path / "cor", cor)
+    st = br.model.state
+    law = from_config(br.model.config["rheology"], br.model.config["run"]["seed"])
+    c = st.mesh.centroids()
+    np.testing.assert_allclose(st.strength_factor, law.correlated_factor(c[:, 0], c[:, 1]), rtol=1e-12)
+    np.testing.assert_allclose(st.cohesion, law.cohesion(st.mesh.nodes, st.mesh.triangles, st.node_id)
+                               * st.strength_factor, rtol=1e-12)
+    assert np.abs(st.cohesion / parent_c - 1.0).max() > 0.3
+    br.run()  # steps (and would remesh) with the factor it carries
+    ck2 = br.write_checkpoint()
+    same = branch_simulation(ck2, tmp_path / "same", {"run.duration": "3h"})
+    np.testing.assert_array_equal(same.model.state.strength_factor, br.model.state.strength_factor)
+    np.testing.assert_array_equal(same.model.state.cohesion, br.model.state.cohesion)
+    off = branch_simulation(ck2, tmp_path / "off", {"rheology.strength_correlation_m": 0.0, "run.duration": "3h"})
+    so = off.model.state
+    assert so.strength_factor is None
+    np.testing.assert_allclose(so.cohesion, law.cohesion(so.mesh.nodes, so.mesh.triangles, so.node_id), rtol=1e-12)

@@ -765,14 +765,53 @@ def branch_simulation(checkpoint, out_dir=None, overrides=None, progress: bool |
         rundir.claim(out_dir, overwrite)
     sim = build_simulation(cfg, out_dir, progress)
     fresh = sim.model.load_state(arrays, meta, fresh_components=True)
-    if fresh:
-        import logging
+    import logging
 
+    if fresh:
         logging.getLogger("lagice").info(f"branch: component(s) {', '.join(fresh)} start fresh (not in the parent)")
+    changed = branch_strength(sim.model.state, override_config_of(meta), cfg)
+    if changed:
+        logging.getLogger("lagice").info(f"branch: the strength law changed ({changed}); the cohesion of every "
+                                         "element is set from the branch's law at the branch point")
     if abs(meta["simulation"]["dt_s"] - sim.dt) > 1e-12 * sim.dt:  # pragma: no cover - solver.dt is fixed above
         raise RestartError("the branch's time step differs from the checkpoint's")
     sim.branched_from = {"checkpoint": str(path), "sha256": cfg["_parent"]["sha256"]}
     return sim
+
+
+def override_config_of(meta: dict) -> dict:
+    """The configuration of a checkpoint (``meta``), with the defaults of keys added since."""
+    from .config import override_config
+
+    return override_config(meta["config"], {})
+
+
+def branch_strength(state, parent_cfg: dict, cfg: dict) -> str:
+    """Apply the branch's strength law to ``state`` (loaded from the parent's checkpoint)
+    when it differs from the parent's: its keys or the run seed (the disorder's) changed.
+    Otherwise the cohesion would keep the parent's values until the first remesh and then
+    jump to the new law's. A correlated factor is laid on the ice at the branch point when
+    the branch asks for one the parent did not have (or another ℓ or a), and dropped when
+    the branch has none. Returns what changed ("" when nothing did)."""
+    old, new = strength_law(parent_cfg), strength_law(cfg)
+    if old == new or new is None:
+        if new is None and state.strength_factor is not None:
+            state.strength_factor = None  # the branch's law has no correlated factor to carry
+            return "no correlated strength factor"
+        return ""
+    what = ", ".join(f"{k}: {getattr(old, k, None)!r} -> {getattr(new, k)!r}"
+                     for k in ("lab_cohesion_pa", "lab_scale_m", "disorder", "seed", "correlation_m",
+                               "correlated_amplitude") if getattr(old, k, None) != getattr(new, k))
+    if new.correlated:
+        same_field = (old is not None and old.correlated and old.seed == new.seed
+                      and old.correlation_m == new.correlation_m and old.amplitude == new.amplitude)
+        if not same_field or state.strength_factor is None:
+            c = state.mesh.centroids()
+            state.strength_factor = new.correlated_factor(c[:, 0], c[:, 1])
+    else:
+        state.strength_factor = None
+    new.apply(state)
+    return what
 
 
 def finish(sim: Simulation, plot: bool = True) -> dict:
