@@ -117,13 +117,6 @@ def element_uniforms(node_id: np.ndarray, triangles: np.ndarray, seed: int) -> n
     return (h >> np.uint64(11)).astype(np.float64) * (1.0 / 9007199254740992.0)  # 53-bit mantissa
 
 
-def _normal_cdf(z: np.ndarray) -> np.ndarray:
-    """Φ(z), the standard normal distribution function."""
-    from scipy.special import ndtr
-
-    return ndtr(z)
-
-
 @dataclass(frozen=True)
 class StrengthLaw:
     """C_e = ``lab_cohesion_pa`` · sqrt(``lab_scale_m``/Δx_e) · (1 + ``disorder`` U_e) · g_e.
@@ -180,7 +173,9 @@ class StrengthLaw:
         """g = 1 + a(2Φ(G) − 1) at points (x, y) [m]: uniform on [1 − a, 1 + a], mean 1."""
         if not self.correlated:
             raise ConfigError("correlated_factor needs rheology.strength_correlation_m > 0")
-        return 1.0 + self.amplitude * (2.0 * _normal_cdf(self.gaussian_field(x_m, y_m)) - 1.0)
+        from scipy.special import ndtr  # Φ, the standard normal distribution function
+
+        return 1.0 + self.amplitude * (2.0 * ndtr(self.gaussian_field(x_m, y_m)) - 1.0)
 
     def scale_factor(self, size_m):
         """sqrt(L_lab/Δx) [-]."""

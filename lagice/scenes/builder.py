@@ -524,7 +524,7 @@ def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
 
     state = IceState.uniform(mesh, thickness_m=field("thickness_m"), concentration=field("concentration"),
                              damage=field("damage"), cohesion_pa=cohesion)
-    if coh == "random" and law is not None and isinstance(rheo, MaxwellEB) and law.correlated:
+    if coh == "random" and law is not None and law.correlated:  # a law only for Maxwell-EB (strength_law)
         # the correlated strength factor: the spin-up's, carried on with its ice (nearest
         # spin-up centroid, like its other fields), else laid on the ice at its start positions
         if state_file_strength(cfg) is not None:
@@ -669,6 +669,13 @@ def run_scene(name_or_path, out_dir=None, overrides=None, progress=None, overwri
 BRANCH_FIXED = ("domain", "initial", "solver.dt", "run.start_date")
 
 
+def override_config_of(meta: dict) -> dict:
+    """The configuration of a checkpoint (``meta``), with the defaults of keys added since."""
+    from .config import override_config
+
+    return override_config(meta["config"], {})
+
+
 def resume_simulation(checkpoint, overrides=None, progress: bool | None = None, config: dict | None = None
                       ) -> Simulation:
     """Continue the run of ``checkpoint`` (a file, or the newest usable one in a
@@ -681,7 +688,7 @@ def resume_simulation(checkpoint, overrides=None, progress: bool | None = None, 
     from .config import changed_keys, length_dependent_forcing, override_config
 
     path, arrays, meta = load_checkpoint(checkpoint)
-    old = override_config(meta["config"], {})  # keys added since the checkpoint's version get their defaults
+    old = override_config_of(meta)
     if config is not None:  # a full scene config (lagice run SCENE --out DIR --resume)
         cfg = {**config, **{k: v for k, v in old.items() if k.startswith("_")}}
     else:
@@ -719,7 +726,7 @@ def branch_config(checkpoint, meta: dict, overrides=None, sha256: str | None = N
     from ..io.checkpoint import file_sha256
     from .config import changed_keys, override_config
 
-    old = override_config(meta["config"], {})  # keys added since the checkpoint's version get their defaults
+    old = override_config_of(meta)
     cfg = override_config(old, overrides)
     for key in changed_keys({k: v for k, v in old.items() if not k.startswith("_")},
                             {k: v for k, v in cfg.items() if not k.startswith("_")}):
@@ -777,13 +784,6 @@ def branch_simulation(checkpoint, out_dir=None, overrides=None, progress: bool |
         raise RestartError("the branch's time step differs from the checkpoint's")
     sim.branched_from = {"checkpoint": str(path), "sha256": cfg["_parent"]["sha256"]}
     return sim
-
-
-def override_config_of(meta: dict) -> dict:
-    """The configuration of a checkpoint (``meta``), with the defaults of keys added since."""
-    from .config import override_config
-
-    return override_config(meta["config"], {})
 
 
 def branch_strength(state, parent_cfg: dict, cfg: dict) -> str:
