@@ -13,6 +13,7 @@
                                                           deformation statistics (JSON + PNG)
     lagice diagnose OUTPUT --window-days D [--start-day S] [--coast-buffer-km B]
                                                           statistics over back-to-back windows
+    lagice diagnose OUTPUT --wind-factor                  drifters' daily drift against the wind
     lagice scenes                                         list bundled scenes
     lagice ensemble SPEC [--out DIR] [--workers N] [--scheduler ADDRESS]
                                                           ensemble / parameter sweep on dask
@@ -244,6 +245,8 @@ def _diagnose(args) -> int:
     from .diagnostics import diagnose_arrays, window_arrays, window_statistics
     from .io.snapshots import read_index, snapshot_dir
 
+    if args.wind_factor:
+        return _diagnose_drift(args)
     snaps = snapshot_dir(args.output)
     if args.window_steps < 1:
         raise LagiceError(f"--window-steps = {args.window_steps}: expected an integer >= 1")
@@ -284,6 +287,32 @@ def _diagnose(args) -> int:
     for name, vals in (("shear", rates.shear_s), ("|divergence|", abs(rates.divergence_s))):
         for msg in tail_fit_quality(vals).warnings(f"PDF tail of {name}"):
             log.warning(msg)
+    return 0
+
+
+def _diagnose_drift(args) -> int:
+    """``--wind-factor``: the drifters' daily velocities fitted to the wind along their tracks
+    (Thorndike and Colony 1982; docs/diagnostics.md §13) -> ``drift_response.json``."""
+    from .diagnostics.drift import run_drift_response
+
+    run = Path(args.output)
+    res = run_drift_response(run)
+    out = Path(args.out or run / "diagnostics")
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / "drift_response.json"
+    path.write_text(json.dumps(res, indent=1))
+    f = res["fit"]
+    sp = res["factor_5_95_over_drifters"]
+    side = "left" if f["angle_deg"] > 0 else "right"
+    print(f"  {f['n']} drifter-days ({res['drifters']} drifters, {res['lost']} lost) against the "
+          f"{res['wind']} wind -> {path.resolve()}")
+    print(f"  wind factor |A| = {f['factor']:.4f}" + (f" (5-95 % over the drifters {sp[0]:.4f}-{sp[1]:.4f})" if sp
+                                                     else "")
+          + f", the ice {abs(f['angle_deg']):.0f} deg to the {side} of the wind, R2 = {f['r2']:.2f}, mean ice speed "
+          f"{100 * f['mean_ice_speed_m_s']:.1f} cm/s")
+    if res["wind"] == "geostrophic":
+        print("  observed (Thorndike and Colony 1982, Arctic winter): |A| about 0.008, about 5 deg to the right, "
+              "R2 about 0.7")
     return 0
 
 
@@ -389,6 +418,9 @@ def main(argv=None) -> int:
     d.add_argument("--rgps-error-m", type=float, default=None,
                    help="with --window-days: also the statistics as RGPS would see them: 10 km cells of tracked "
                         "points with this tracking error in m (RGPS: 100, Lindsay and Stern 2003)")
+    d.add_argument("--wind-factor", action="store_true",
+                   help="instead: the drifters' daily drift against the run's wind (U = A G + C, Thorndike and "
+                        "Colony 1982; drift_response.json)")
     d.add_argument("--out")
     d.set_defaults(func=_diagnose)
     sc = sub.add_parser("scenes", help="list bundled scenes", parents=[common])

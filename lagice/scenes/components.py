@@ -549,6 +549,21 @@ def check_forcing_files(cfg: dict, points_xy, duration_s: float) -> None:
         src.close()
 
 
+def scene_wind(cfg: dict, mesh, duration_s: float, grid=None):
+    """The wind field ``f(t, x, y) -> (u, v)`` [m s-1] of a scene on its initial ``mesh`` for a
+    run of ``duration_s`` (None without wind): the field :func:`build` gives the model, also
+    used to rebuild a finished run's wind (:func:`lagice.diagnostics.drift.run_drift_response`)."""
+    fc = cfg["forcing"]
+    if fc["wind"] is None:
+        return None
+    if grid is None:
+        grid = _grid(mesh, fc["grid_spacing_m"])
+    x0, y0 = mesh.nodes.min(axis=0)
+    x1, y1 = mesh.nodes.max(axis=0)
+    return build_wind(fc["wind"], grid, (x0, x1, y0, y1), draw_span_s(fc["wind"], "wind", duration_s),
+                      cfg["run"]["seed"], cfg["domain"]["crs"], cfg["run"]["start_date"])
+
+
 def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
     """The model's forces and optional components from the scene (None when not asked for)."""
     parts = {"forces": [], "thermo": None, "healing": None, "mover": None, "remesher": None}
@@ -560,11 +575,8 @@ def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
         rheology.params = rheology.params.replace(healing_time_s=None)
     need_grid = any(fc[k] is not None for k in ("wind", "ocean", "air_temperature"))
     grid = _grid(mesh, fc["grid_spacing_m"]) if need_grid else None
-    x0, y0 = mesh.nodes.min(axis=0)
-    x1, y1 = mesh.nodes.max(axis=0)
     t_end = duration_s
-    wind = (build_wind(fc["wind"], grid, (x0, x1, y0, y1), draw_span_s(fc["wind"], "wind", duration_s), seed,
-                       crs, start) if fc["wind"] is not None else None)
+    wind = scene_wind(cfg, mesh, duration_s, grid)
     ocean = build_ocean(fc["ocean"], grid, crs, start) if fc["ocean"] is not None else None
     air = (build_air_temperature(fc["air_temperature"], grid,
                                  draw_span_s(fc["air_temperature"], "air_temperature", duration_s), seed, crs, start)
