@@ -563,6 +563,41 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
                                            f"{_p}-hthick-1125 made again with the CPU kernels of 2026-11-26 "
                                            f"(seventh session, as kept)")
 
+# --- 2026-11-26 (ninth session): the strength calibrated to the observed drift ----------------
+# benchmarks/drift_response.py fits the drifters' daily velocities to the geostrophic wind as
+# Thorndike and Colony (1982) did with Arctic buoys (winter: wind factor |A| about 0.008, band
+# 0.006-0.010 ours). The shipped set's pack answers at 0.0016-0.0055 (median 0.0034) over its
+# sixteen month-basins: it is too stiff for its wind by an observable that is not a deformation
+# statistic. Of the strengths already run in the validation month (closed basin), the first
+# inside that band is C_lab halved (X10h-str-50: 0.0073); it was not refined. Screen, its rule
+# written before the runs (the validation month, closed, is X10h-str-50 itself; the other
+# fifteen month-basins are new; all from the shipped spin-up state): the halved strength
+# replaces neXtSIM's sourced value only if, over the eight months of each basin,
+#   (a) the median wind factor lies in 0.006-0.010 (the calibration holds out of sample);
+#   (b) the medians put at least as many bands inside as the shipped set's (3 closed, 3 strait);
+#   (c) the median rate rises at least x2 and the median beta falls by no more than 0.01.
+# Passing would call for a spin-up made with the halved strength and the validation regenerated
+# from it before the value is shipped.
+HALF_STRENGTH = ["rheology.strength_lab_pa=1.4e6"]
+add_weather_ensemble("str50", from_spinup("H1125") + HALF_STRENGTH,
+                     "with C_lab halved (1.4 MPa in lagice's form), calibrated to the winter wind factor",
+                     "thick-and-thin, strength calibrated to the wind factor", ENSEMBLE_SEEDS + MORE_SEEDS,
+                     suffix=", eight months")
+# the closed validation month of this set-up is X10h-str-50 (same overrides, same order)
+ENSEMBLES["thick-and-thin, strength calibrated to the wind factor, closed, eight months"][0] = "X10h-str-50"
+del EXPERIMENTS["F10-hthick-str50"]
+for _s in ENSEMBLE_SEEDS + MORE_SEEDS:
+    _b, _o, _r, _d, _w = EXPERIMENTS[f"F10-hthick-str50-w{_s}"]
+    EXPERIMENTS[f"F10-hthick-str50-w{_s}"] = (_b, _o, _r, _d, f"X10h-str-50, the weather of wind seed {_s}")
+# A diagnostic (not a lead): neXtSIM turns the ocean drag by 25 degrees whenever Coriolis is on
+# (`dynamics.oceanic_turning_angle`, options.cpp); the flagship has Coriolis at 80 N and no
+# turning. The shipped pack moves 8-32 degrees to the left of the geostrophic wind where
+# Thorndike and Colony found about 5 degrees to the right.
+EXPERIMENTS["F10-hthick-1125-turn25"] = ("closed", from_spinup("H1125") + ["forcing.drag.turning_angle_deg=25"],
+                                         10e3, 28, "F10-hthick-1125 with neXtSIM's 25° ocean turning angle "
+                                                   "(diagnostic)")
+
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]

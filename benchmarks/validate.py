@@ -119,6 +119,9 @@ SENSITIVITY_RESOLUTION_M = 10e3
 #: F10-hthick-1125 / F10s-hthick-1125, EVP E10h / E10hs, the ±50 % runs X10h-*. The runs of
 #: the pack shipped before (F10-1125, E10, X10-*...) keep their records in
 #: docs/figures/physics_experiments.json
+#: the winter wind factor of Thorndike and Colony (1982), about 0.008; the band is ours
+#: (benchmarks/drift_response.py OBSERVED)
+WIND_FACTOR_BAND = (0.006, 0.010)
 PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-1125", "strait_maxwell_eb": "F10s-hthick-1125",
                 "closed_evp": "E{evp}h", "strait_evp": "E{evp}hs", "sensitivity_base": "F10-hthick-1125",
                 "sensitivity_strength-50": "X10h-str-50", "sensitivity_strength+50": "X10h-str+50",
@@ -192,7 +195,23 @@ def analyse_run(run: Path, days: float, buffer_m: float, window_days: float = 3.
             "rgps_view": {"tracking_error_m": ws["rgps_tracking_error_m"], "cell_m": RGPS_CELL_M,
                           "median": ws["median_rgps"], "median_cells": ws["median_rgps_cells"]},
             "resolution_m": run_resolution_m(run), "run_command": cfg.get("command"), "run_dir": str(run),
-            "drift_km": drift_km(run, days)}
+            "drift_km": drift_km(run, days), "drift_response": drift_response(run)}
+
+
+def drift_response(run: Path) -> dict | None:
+    """The drifters' wind factor (benchmarks/drift_response.py, Thorndike and Colony 1982); None
+    for a run without drifters or without the climatology wind."""
+    from lagice.diagnostics.drift import run_drift_response
+    from lagice.errors import ConfigError
+
+    try:
+        r = run_drift_response(run)
+    except ConfigError as e:
+        print(f"validate: {run.name}: no drift response ({e})", flush=True)
+        return None
+    return {"wind_factor": r["fit"]["factor"], "turning_deg": r["fit"]["angle_deg"], "r2": r["fit"]["r2"],
+            "wind_factor_5_95_over_drifters": r["factor_5_95_over_drifters"], "drifter_days": r["fit"]["n"],
+            "mean_ice_speed_m_s": r["fit"]["mean_ice_speed_m_s"]}
 
 
 def run_resolution_m(run: Path):
@@ -640,6 +659,15 @@ def _basin_section(scene: str, b: dict, res: dict, figs: list[Path]) -> list[str
                      f"{x['drift_km']['max']:.0f} km at most; ice exported {(x['outflow_m3'] or 0) / 1e9:.3g} km³; "
                      f"remesh events {x['remesh_events']}; run wall time {x['wall_s'] or float('nan'):.0f} s "
                      f"(NUMBA_NUM_THREADS=1, two runs at a time on the shared 2-core host).")
+        d = x.get("drift_response")
+        if d is not None:
+            sp = d["wind_factor_5_95_over_drifters"]
+            side = "left" if d["turning_deg"] > 0 else "right"
+            lines.append(f"  Drift against the wind ({d['drifter_days']} drifter-days; docs/diagnostics.md §13): wind "
+                         f"factor {d['wind_factor']:.4f} (5–95 % over the drifters {sp[0]:.4f}–{sp[1]:.4f}; "
+                         f"Thorndike and Colony 1982, winter: about 0.008), the ice "
+                         f"{abs(d['turning_deg']):.0f}° to the {side} of the geostrophic wind (observed: about 5° "
+                         f"to the right), R² {d['r2']:.2f} (about 0.7).")
     lines += ["", "The same statistics on all elements (coastal shear zones included), medians over the windows:", "",
               "| metric | " + " | ".join(labels) + " |", "|---|" + "---|" * len(keys)]
     for k in TARGETS:
@@ -675,6 +703,13 @@ def headline(res: dict) -> list[str]:
             v = res["basin"][s][k]["median"][m]
             cells.append(_fmt(m, v) + (_inside_mark(m, v) or " ✗"))
         lines.append(f"| {LABELS[m]} | {_fmt(m, lo)}–{_fmt(m, hi)} | " + " | ".join(cells) + " |")
+    lo, hi = WIND_FACTOR_BAND
+    cells = []
+    for s, k in cols:
+        d = res["basin"][s][k].get("drift_response")
+        cells.append("–" if d is None else f"{d['wind_factor']:.4f}" + (" ✓" if lo <= d["wind_factor"] <= hi else " ✗"))
+    lines.append(f"| wind factor \\|A\\| (daily drift / geostrophic wind; Thorndike and Colony 1982, winter) | "
+                 f"about 0.008 ({lo}–{hi}) | " + " | ".join(cells) + " |")
     lines.append("| remesh events | | " + " | ".join(str(res["basin"][s][k]["remesh_events"]) for s, k in cols) + " |")
     lines.append("| mean / largest drift (km) | tens of km | " + " | ".join(
         f"{res['basin'][s][k]['drift_km']['mean']:.0f} / {res['basin'][s][k]['drift_km']['max']:.0f}"
@@ -772,7 +807,7 @@ def analyse_ensemble(physics: Path, days: float, buffer_m: float, basin: dict) -
             a = own if own is not None and Path(own["run_dir"]).resolve() == r.resolve() else analyse_run(r, days,
                                                                                                          buffer_m)
             members[n] = {"median": a["median"], "remesh_events": a["remesh_events"], "drift_km": a["drift_km"],
-                          "rgps_median": a["rgps_view"]["median"]}
+                          "rgps_median": a["rgps_view"]["median"], "drift_response": a.get("drift_response")}
         out[scene] = {"members": members, "metrics": _member_stats(members, "median"),
                       "rgps_metrics": _member_stats(members, "rgps_median")}
     return out
@@ -814,6 +849,14 @@ def ensemble_lines(ens: dict) -> list[str]:
             mark = "" if med is None else (" ✓" if lo <= med <= hi else " ✗")
             lines.append(f"| {LABELS[k]} | {_fmt(k, lo)}–{_fmt(k, hi)} | " + " | ".join(cells)
                          + f" | {_fmt3(k, med)}{mark} | {st['n_inside']} of {st['n_members']} |")
+        wf = [(e["members"][n].get("drift_response") or {}).get("wind_factor") for n in names]
+        if all(v is not None for v in wf):
+            lo, hi = WIND_FACTOR_BAND
+            med = float(np.median(wf))
+            lines.append("| wind factor \\|A\\| (Thorndike and Colony 1982, winter) | about 0.008 "
+                         f"({lo}–{hi}) | " + " | ".join(f"{v:.4f}" for v in wf)
+                         + f" | {med:.4f}{' ✓' if lo <= med <= hi else ' ✗'} | "
+                         f"{sum(lo <= v <= hi for v in wf)} of {len(wf)} |")
         lines.append("| remesh events | | " + " | ".join(str(e["members"][n]["remesh_events"]) for n in names)
                      + " | | |")
         lines.append("")
