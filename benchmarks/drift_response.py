@@ -4,8 +4,8 @@ For each run of ``benchmarks/physics_experiments.py`` (``benchmarks/out/physics/
 drifters' daily velocities are fitted to the daily geostrophic wind along their tracks,
 U = A G + C, as Thorndike and Colony (1982) did with Arctic buoys
 (:mod:`lagice.diagnostics.drift`). The wind is the run's own forcing, rebuilt from the
-configuration the run wrote into ``drifters.nc`` through the scene builder (the same
-``Model`` the run had), and the geostrophic wind is recovered exactly from the
+configuration the run wrote into ``drifters.nc`` (the scene's initial mesh and ``scene_wind``,
+the function that gave the run its wind), and the geostrophic wind is recovered exactly from the
 climatology's 10-m wind (G = R(−θ) U10 / s with the run's ``surface_factor`` s and
 ``cross_isobar_angle_deg`` θ).
 
@@ -34,10 +34,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 OUT = ROOT / "benchmarks" / "out" / "physics"
 STORE = OUT / "drift_response.json"
 PUBLISHED = ROOT / "docs" / "figures" / "drift_response.json"
-#: Thorndike and Colony (1982), Arctic buoys and geostrophic winds, winter (November–April):
-#: |A| ≈ 0.008, ice about 5° to the right of the geostrophic wind, R² ≈ 0.7 (values recalled from
-#: the literature, not re-read for this work); the band ±25 % around 0.008 is ours.
-OBSERVED = {"factor": (0.006, 0.010), "angle_deg": -5.0, "r2": 0.7}
+from lagice.diagnostics.drift import THORNDIKE_COLONY_WINTER as OBSERVED  # noqa: E402
 
 
 def analyse_run_dir(run: Path) -> dict:

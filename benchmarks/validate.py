@@ -60,6 +60,7 @@ import numpy as np
 from scipy.stats import skew
 
 from lagice.diagnostics import spatial_scaling, velocity_gradients, window_statistics
+from lagice.diagnostics.drift import THORNDIKE_COLONY_WINTER
 from lagice.diagnostics.faults import (
     angle_to_axis_deg,
     fault_orientations,
@@ -120,8 +121,7 @@ SENSITIVITY_RESOLUTION_M = 10e3
 #: the pack shipped before (F10-1125, E10, X10-*...) keep their records in
 #: docs/figures/physics_experiments.json
 #: the winter wind factor of Thorndike and Colony (1982), about 0.008; the band is ours
-#: (benchmarks/drift_response.py OBSERVED)
-WIND_FACTOR_BAND = (0.006, 0.010)
+WIND_FACTOR_BAND = THORNDIKE_COLONY_WINTER["factor"]
 PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-1125", "strait_maxwell_eb": "F10s-hthick-1125",
                 "closed_evp": "E{evp}h", "strait_evp": "E{evp}hs", "sensitivity_base": "F10-hthick-1125",
                 "sensitivity_strength-50": "X10h-str-50", "sensitivity_strength+50": "X10h-str+50",
@@ -199,8 +199,9 @@ def analyse_run(run: Path, days: float, buffer_m: float, window_days: float = 3.
 
 
 def drift_response(run: Path) -> dict | None:
-    """The drifters' wind factor (benchmarks/drift_response.py, Thorndike and Colony 1982); None
-    for a run without drifters or without the climatology wind."""
+    """The drifters' wind factor against the geostrophic wind (docs/diagnostics.md §13, Thorndike
+    and Colony 1982); None for a run without drifters or without the climatology wind (whose
+    geostrophic wind is not known, so the observed factor does not apply)."""
     from lagice.diagnostics.drift import run_drift_response
     from lagice.errors import ConfigError
 
@@ -208,6 +209,9 @@ def drift_response(run: Path) -> dict | None:
         r = run_drift_response(run)
     except ConfigError as e:
         print(f"validate: {run.name}: no drift response ({e})", flush=True)
+        return None
+    if r["wind"] != "geostrophic":
+        print(f"validate: {run.name}: no drift response (the {r['wind']} wind, not the climatology's)", flush=True)
         return None
     return {"wind_factor": r["fit"]["factor"], "turning_deg": r["fit"]["angle_deg"], "r2": r["fit"]["r2"],
             "wind_factor_5_95_over_drifters": r["factor_5_95_over_drifters"], "drifter_days": r["fit"]["n"],

@@ -32,6 +32,10 @@ import numpy as np
 from lagice.errors import ConfigError
 
 DAY_S = 86400.0
+#: Thorndike and Colony (1982), Arctic buoys against the geostrophic wind, winter (November–April):
+#: |A| about 0.008, the ice about 5° to the right of the wind, R² about 0.7 (values recalled from the
+#: literature, not re-read for this work). The band of |A|, ±25 % around 0.008, is ours.
+THORNDIKE_COLONY_WINTER = {"factor": (0.006, 0.010), "angle_deg": -5.0, "r2": 0.7}
 
 
 @dataclass(frozen=True)
