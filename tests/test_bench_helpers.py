@@ -1,6 +1,7 @@
 """Benchmark helpers that change what a benchmark builds (benchmarks/scene_runs.py)."""
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 
@@ -57,3 +58,22 @@ def test_screen_verdict_counts_bands_and_applies_the_stated_tolerances():
     assert v["beta_ok"] and not v["rate_ok"] and not v["passes"]
     assert screen_verdict(slower, ref, rate_tolerance_factor=1.5)["passes"]
     assert not screen_verdict(ref, ref, beta_tolerance=1.0, rate_tolerance_factor=10.0)["passes"]  # no band gained
+
+
+def test_validation_headline_reports_the_wind_factor_against_its_band():
+    """benchmarks/validate.py's headline row of the wind factor: ✓ inside Thorndike and Colony's
+    band, ✗ outside, – for a run without a drift response (no drifters, or not the climatology)."""
+    import validate
+
+    lo, hi = validate.WIND_FACTOR_BAND
+    median = {k: 0.5 * (a + b) for k, (a, b, _s, _n) in validate.TARGETS.items()}
+
+    def run(factor):
+        return {"median": median, "remesh_events": 3, "drift_km": {"mean": 10.0, "max": 20.0},
+                "resolution_m": 10e3, "drift_response": None if factor is None else {"wind_factor": factor}}
+
+    res = {"basin": {"closed": {"maxwell_eb": run(0.5 * (lo + hi)), "evp": run(0.3 * lo)},
+                     "strait": {"maxwell_eb": run(None), "evp": run(1.5 * hi)}}}
+    row = next(line for line in validate.headline(res) if line.startswith("| wind factor"))
+    cells = [c.strip() for c in re.split(r"(?<!\\)\|", row.strip("|"))][2:]  # "\\|A\\|" is escaped
+    assert cells == [f"{0.5 * (lo + hi):.4f} ✓", f"{0.3 * lo:.4f} ✗", "–", f"{1.5 * hi:.4f} ✗"]
