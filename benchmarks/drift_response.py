@@ -37,17 +37,13 @@ PUBLISHED = ROOT / "docs" / "figures" / "drift_response.json"
 from lagice.diagnostics.drift import THORNDIKE_COLONY_WINTER as OBSERVED  # noqa: E402
 
 
-def analyse_run_dir(run: Path) -> dict:
-    """:func:`lagice.diagnostics.drift.run_drift_response` of run folder ``run``."""
+def analyse(name: str) -> dict:
+    """:func:`lagice.diagnostics.drift.run_drift_response` of physics run ``name``, with its
+    median rate and remesh count."""
     from lagice.diagnostics.drift import run_drift_response
 
-    return run_drift_response(run)
-
-
-def analyse(name: str) -> dict:
-    """:func:`analyse_run_dir` of physics run ``name``, with its median rate and remesh count."""
     exp = json.loads((OUT / "experiments.json").read_text()).get(name, {})
-    return {"name": name, **analyse_run_dir(OUT / name),
+    return {"name": name, **run_drift_response(OUT / name),
             "median_rate_per_day": exp.get("median", {}).get("mean_total_deformation_rate_per_day"),
             "remesh_events": exp.get("remesh_events"), "what": exp.get("what")}
 
