@@ -176,6 +176,8 @@ def first_non_finite(state, skip=()):
         a = getattr(state, f.name, None)
         if a is None or a.dtype.kind != "f":
             continue
+        if np.isfinite(np.sum(a)):
+            continue  # a NaN or an inf makes the sum NaN or inf: all finite (one pass, no mask)
         bad = ~np.isfinite(a)
         if bad.any():
             idx = np.argwhere(bad)[0]

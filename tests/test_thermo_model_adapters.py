@@ -64,3 +64,96 @@ def test_healing_component():
     assert np.all(HealingComponent(ConstantHealing(1e5)).rate(st, 0.0) == 1e-5)
     with pytest.raises(ConfigError):
         HealingComponent(ThermodynamicHealing())
+
+
+def test_thermodynamic_effective_rate_is_the_numpy_form_bit_for_bit():
+    # the compiled pass replaces apply() on a copy divided by dt: the same values to the bit,
+    # warm and cold air, undamaged ice, ice that heals to 0 within the step, a NaN air temperature
+    from thermo.healing import Healing
+
+    rng = np.random.default_rng(3)
+    n = 5000
+    ta = rng.uniform(-45.0, 5.0, n)
+    ta[:20] = -1.8  # exactly at freezing: rate 0
+    ta[20] = np.nan
+    d = rng.uniform(0.0, 1.0, n) ** 3
+    d[30:60] = 0.0
+    d[60:90] = 1e-9  # heals to the floor within the step
+    ta[60:90] = -30.0
+    law = ThermodynamicHealing(th0_s=3.0 * DAY, delta_t0_k=17.0)
+    before = d.copy()
+    for dt in (600.0, 3600.0, 2.5 * DAY):
+        got = law.effective_rate(ta, d, dt)
+        want = Healing.effective_rate(law, ta, d, dt)
+        np.testing.assert_array_equal(got, want)
+        assert np.isnan(got[20]) and np.all(got[:20] == 0.0) and np.all(got[30:60] == 0.0)
+        np.testing.assert_allclose(got[60:90] * dt, d[60:90], rtol=1e-15)  # floored: the damage there
+    np.testing.assert_array_equal(d, before)  # the damage is not touched
+    with pytest.raises(ConfigError, match="dt_s"):
+        law.effective_rate(ta, d, 0.0)
+
+
+class _CountingAir:
+    """A scalar field that counts its evaluations (a real Field, wrapped)."""
+
+    def __init__(self):
+        from forcing.base import SCALAR, CallableField
+
+        self.calls = 0
+
+        def f(t, x, y):
+            self.calls += 1
+            return -20.0 + 1e-6 * x - 2e-6 * y + 1e-5 * t
+
+        self.field = CallableField(f, SCALAR, "degC")
+
+
+def test_thermodynamics_and_healing_share_one_air_temperature_evaluation():
+    # in a step the thermodynamics takes the air temperature at t + dt on the moved mesh, and
+    # the next step's healing rate at its start: the same time and centroids, so one
+    # evaluation serves both; moving nodes, another time or another mesh evaluates again
+    from thermo.model_adapters import air_at_centroids
+
+    air = _CountingAir()
+    st = state()
+    thermo = ThermoComponent(air.field)
+    heal = HealingComponent(ThermodynamicHealing(), air.field, dt_s=600.0)
+    memo = air_at_centroids(air.field)
+    assert thermo._air is memo and heal._air is memo
+    c = st.mesh.centroids()
+    expect = -20.0 + 1e-6 * c[:, 0] - 2e-6 * c[:, 1] + 1e-5 * 600.0
+    thermo.step(st, 600.0, 600.0)
+    assert air.calls == 1
+    r = heal.rate(st, 600.0)
+    assert air.calls == 1 and memo.n_reused == 1
+    np.testing.assert_array_equal(r, ThermodynamicHealing().effective_rate(expect, st.damage, 600.0))
+    heal.rate(st, 1200.0)  # another time
+    assert air.calls == 2
+    st.mesh.nodes[5] += 1.0  # nodes moved in place
+    heal.rate(st, 1200.0)
+    assert air.calls == 3
+    heal.rate(st, 1200.0)
+    assert air.calls == 3
+    from lagice.mesh import Mesh
+
+    m = st.mesh
+    st.mesh = Mesh(m.nodes.copy(), m.triangles.copy(), m.boundary_edges, m.boundary_tags, m.tag_names)
+    heal.rate(st, 1200.0)  # a new mesh (a remesh, a checkpoint load): evaluated again
+    assert air.calls == 4 and memo.n_evaluations == 4
+
+
+def test_first_non_finite_finds_the_first_bad_value_and_passes_huge_finite_ones():
+    # the check sums each field first (a NaN or inf makes the sum non-finite); finite values
+    # whose sum overflows must still pass, and a bad value is named with its index
+    from lagice.fields import first_non_finite
+
+    st = state()
+    assert first_non_finite(st) is None
+    st.thickness[:] = 1e308  # finite, but the sum overflows to inf
+    assert first_non_finite(st) is None
+    st.thickness[:] = 1.0
+    st.damage[7] = np.inf
+    st.damage[9] = np.nan
+    spec, idx, val = first_non_finite(st)
+    assert spec.name == "damage" and idx == 7 and val == np.inf
+    assert first_non_finite(st, skip=("damage",)) is None

@@ -28,6 +28,7 @@ applied (>= 0), so nothing is removed silently.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from lagice.errors import ConfigError, check_range
 
@@ -58,6 +59,13 @@ class Healing:
         old = damage.copy()
         np.maximum(damage - self.rate(air_temperature_c, damage) * dt_s, 0.0, out=damage)
         return old - damage
+
+    def effective_rate(self, air_temperature_c, damage, dt_s):
+        """(m,) the rate [s-1] that takes ``damage`` where :meth:`apply` would take it
+        over ``dt_s``: ``(d − d_after)/Δt``, with ``damage`` left unchanged (what the
+        stepper applies as ``d ← d − rate·Δt``)."""
+        trial = np.array(damage, dtype=np.float64)
+        return self.apply(trial, air_temperature_c, dt_s) / dt_s
 
 
 class ConstantHealing(Healing):
@@ -99,6 +107,18 @@ class ThermodynamicHealing(Healing):
         ta = _as_array(air_temperature_c, damage)
         return np.maximum(self.freezing_point_c - ta, 0.0) / (self.delta_t0_k * self.th0_s)
 
+    def effective_rate(self, air_temperature_c, damage, dt_s):
+        """As :meth:`Healing.effective_rate`, in one compiled pass over the elements
+        (the numpy form made six temporary arrays; this runs every step). The same
+        operations in the same order, so the same values bit for bit (tested)."""
+        check_range("dt_s", dt_s, 0.0, None, low_open=True, unit="s")
+        d = np.ascontiguousarray(damage, dtype=np.float64)
+        ta = np.ascontiguousarray(_as_array(air_temperature_c, d))
+        out = np.empty(d.shape[0])
+        _thermodynamic_effective_rate(ta, d, float(self.freezing_point_c),
+                                      float(self.delta_t0_k * self.th0_s), float(dt_s), out)
+        return out
+
 
 class FreezingDegreeDayHealing(Healing):
     """Girard 2010 √(freezing-degree-days) healing (eqs. 5.8–5.11), lagice convention.
@@ -137,6 +157,22 @@ class FreezingDegreeDayHealing(Healing):
         new = 1.0 - np.sqrt(ds * ds + 2.0 * dt_s * dT / self.beta_s_k)
         np.maximum(np.where(dT > 0.0, new, damage), 0.0, out=damage)
         return old - damage
+
+
+@njit(cache=True)
+def _thermodynamic_effective_rate(ta, d, tf, scale, dt, out):
+    """``(d − max(d − max(Tf − Ta, 0)/scale·Δt, 0))/Δt`` per element, as numpy evaluates
+    ``ThermodynamicHealing.apply`` on a copy (``np.maximum`` keeps a NaN)."""
+    for e in range(d.shape[0]):
+        x = tf - ta[e]
+        if not (x < 0.0):  # np.maximum(x, 0.0): x itself when x >= 0 or NaN
+            r = x / scale
+        else:
+            r = 0.0 / scale
+        y = d[e] - r * dt
+        if y < 0.0:
+            y = 0.0
+        out[e] = (d[e] - y) / dt
 
 
 HEALING_LAWS = {"constant": ConstantHealing, "thermodynamic": ThermodynamicHealing,

@@ -7,10 +7,18 @@
 * :class:`HealingComponent` (``healing``): the healing rate [s-1] per element
   that the time stepper's damage update applies (``d ← d − rate·dt``).
 
-They hold no physics of their own. Each keeps its own forcing field object,
-because the interpolation weights are cached per set of positions.
+They hold no physics of their own. Both take the air temperature at the element
+centroids through :func:`air_at_centroids`: one :class:`CentroidAirTemperature` per
+field object, shared by the components that use that field. In a step the
+thermodynamics takes it at the end of the step (t + Δt, nodes moved), and the next
+step's healing rate at its start: the same time and, unless a remesh came between,
+the same centroids. The second caller then gets the first one's array (the same
+values, since the evaluation depends only on the time and the positions) instead of
+a second interpolation.
 """
 from __future__ import annotations
+
+import weakref
 
 import numpy as np
 
@@ -25,6 +33,64 @@ from .zero_layer import ZeroLayerThermo
 def _centroids_xy(mesh):
     c = mesh.centroids()
     return np.ascontiguousarray(c[:, 0]), np.ascontiguousarray(c[:, 1])
+
+
+class CentroidAirTemperature:
+    """The air temperature [°C] of ``field`` at the element centroids of a mesh, kept
+    for the next caller at the same time and the same mesh.
+
+    "The same mesh" is the same :class:`~lagice.mesh.Mesh` object with the same
+    triangle array and node positions equal to those of the last evaluation
+    (compared element by element; the nodes move in place every step, and a remesh
+    or a checkpoint load makes a new mesh). The time is compared exactly. Anything
+    else evaluates the field again. The array returned is shared with later
+    callers at the same time and mesh: callers must not write to it.
+
+    ``n_evaluations`` and ``n_reused`` count the two outcomes (diagnostics, tests).
+    """
+
+    def __init__(self, field):
+        self.field = field
+        self._t = None
+        self._mesh = None
+        self._triangles = None
+        self._nodes = None
+        self._values = None
+        self.n_evaluations = 0
+        self.n_reused = 0
+
+    def values(self, mesh, t_s: float) -> np.ndarray:
+        """(m,) air temperature [°C] at the centroids of ``mesh`` at ``t_s`` [s]."""
+        nodes = mesh.nodes
+        if (self._values is not None and self._t == t_s and self._mesh is mesh
+                and self._triangles is mesh.triangles and self._nodes.shape == nodes.shape
+                and np.array_equal(self._nodes, nodes)):
+            self.n_reused += 1
+            return self._values
+        xc, yc = _centroids_xy(mesh)
+        ta = self.field.evaluate(t_s, xc, yc)
+        if self._nodes is not None and self._nodes.shape == nodes.shape:
+            np.copyto(self._nodes, nodes)
+        else:
+            self._nodes = nodes.copy()
+        self._t, self._mesh, self._triangles, self._values = t_s, mesh, mesh.triangles, ta
+        self.n_evaluations += 1
+        return ta
+
+
+_AT_CENTROIDS = weakref.WeakKeyDictionary()
+
+
+def air_at_centroids(field) -> CentroidAirTemperature:
+    """The one :class:`CentroidAirTemperature` of ``field`` (made at the first call;
+    a field that cannot be a weak key gets a new one each time, which shares nothing)."""
+    try:
+        memo = _AT_CENTROIDS.get(field)
+        if memo is None:
+            memo = _AT_CENTROIDS[field] = CentroidAirTemperature(field)
+    except TypeError:
+        memo = CentroidAirTemperature(field)
+    return memo
 
 
 class ThermoComponent:
@@ -50,15 +116,15 @@ class ThermoComponent:
             raise ConfigError("ThermoComponent needs an air temperature field")
         self.zero_layer = zero_layer if zero_layer is not None else ZeroLayerThermo()
         self.totals_m3 = dict.fromkeys(self.TOTALS, 0.0)
+        self._air = air_at_centroids(self.air_temperature)
 
     def step(self, state, t_s, dt_s, ledger=None):
         """One thermodynamic step on ``state`` (in place) with the air temperature at
         ``t_s`` [s]; books the net volume change in ``ledger`` (if given) and
         returns the step's volume changes [m³]."""
         mesh = state.mesh
-        xc, yc = _centroids_xy(mesh)
         area = np.abs(mesh.areas())
-        ta = self.air_temperature.evaluate(t_s, xc, yc)
+        ta = self._air.values(mesh, t_s)
         tend = self.zero_layer.step(state.thickness, state.concentration, ta, dt_s, hs=state.snow)
         dv = float(np.sum(tend.total * area))
         if ledger is not None:
@@ -110,6 +176,7 @@ class HealingComponent(RateComponent):
         if self.air_temperature is None and not isinstance(healing, ConstantHealing):
             raise ConfigError(f"{type(healing).__name__} needs an air temperature field")
         self.dt_s = dt_s
+        self._air = None if self.air_temperature is None else air_at_centroids(self.air_temperature)
 
     def rate(self, state, t_s):
         """Healing rate [s-1] per element of ``state`` at time ``t_s`` [s]."""
@@ -117,10 +184,8 @@ class HealingComponent(RateComponent):
         if self.air_temperature is None:
             ta = np.zeros_like(d)
         else:
-            xc, yc = _centroids_xy(state.mesh)
-            ta = self.air_temperature.evaluate(t_s, xc, yc)
+            ta = self._air.values(state.mesh, t_s)
         if self.dt_s is None:
             return np.asarray(self.healing.rate(ta, d), dtype=np.float64)
-        trial = d.copy()
-        return self.healing.apply(trial, ta, self.dt_s) / self.dt_s
+        return self.healing.effective_rate(ta, d, self.dt_s)
 

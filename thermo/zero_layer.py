@@ -138,7 +138,8 @@ def _zero_layer_kernel(h, A, hs, Ta, dt, ki, ks, rho_l, tf, kow, h0, hmin, amin,
         else:
             # --- existing ice: exact integration of dhi/dt = dT/(ρL(hi/ki + hsi/ks))
             hi = hv / a_k
-            b = (s / a_k) / ks
+            # (s/a_k)/ks is exactly ±0 without snow: skip its two divisions (same bits)
+            b = s if s == 0.0 else (s / a_k) / ks
             e = a2 * hi * hi + b * hi + dT * dt / rho_l
             if e <= 0.0:
                 hi_new = 0.0
