@@ -616,6 +616,13 @@ EXPERIMENTS["F10-hthick-1125-turn25"] = ("closed", from_spinup("H1125") + ["forc
 TURN25 = ["forcing.drag.turning_angle_deg=25"]
 SPINUPS["H1125-turn25"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + TURN25, OUT / "spinup-H1125-turn25.npz",
                            10e3)
+# Stage 1, added before any run when the VM turned out to run at half its earlier speed (28-day
+# runs of about 20 min): the same rule on the first four months (the scene's seed and
+# ENSEMBLE_SEEDS) against the shipped set's four months ("thick-and-thin, closed|strait": 3 and 2
+# bands inside). Stage 2 is the eight months above; the rule holds for both stages.
+add_weather_ensemble("turn25sp", TURN25 + from_spinup("H1125-turn25"),
+                     "with neXtSIM's 25° ocean turning angle, from its own spin-up",
+                     "thick-and-thin, ocean turning 25°, own spin-up", ENSEMBLE_SEEDS)
 add_weather_ensemble("turn25sp", TURN25 + from_spinup("H1125-turn25"),
                      "with neXtSIM's 25° ocean turning angle, from its own spin-up",
                      "thick-and-thin, ocean turning 25°, own spin-up", ENSEMBLE_SEEDS + MORE_SEEDS,
