@@ -49,7 +49,10 @@ def analyse(name: str) -> dict:
 
 
 def store(res: dict) -> None:
-    data = json.loads(STORE.read_text()) if STORE.exists() else {}
+    # a fresh checkout has no store yet: start from the published records (without their daily
+    # speed pairs), so that one new run does not drop every earlier one from docs/figures
+    src = STORE if STORE.exists() else PUBLISHED
+    data = json.loads(src.read_text()) if src.exists() else {}
     data[res["name"]] = res
     key = "observed_thorndike_colony_1982_winter"
     full = {key: OBSERVED, **{k: v for k, v in sorted(data.items()) if k != key}}

@@ -77,3 +77,26 @@ def test_validation_headline_reports_the_wind_factor_against_its_band():
     row = next(line for line in validate.headline(res) if line.startswith("| wind factor"))
     cells = [c.strip() for c in re.split(r"(?<!\\)\|", row.strip("|"))][2:]  # "\\|A\\|" is escaped
     assert cells == [f"{0.5 * (lo + hi):.4f} ✓", f"{0.3 * lo:.4f} ✗", "–", f"{1.5 * hi:.4f} ✗"]
+
+
+def test_drift_response_store_keeps_the_published_records_in_a_fresh_checkout(tmp_path, monkeypatch):
+    """A fresh checkout has no benchmarks/out/physics/drift_response.json: the first new run
+    must be added to the published records, not replace them (it did until the tenth
+    session), and the published copy stays without the daily speed pairs."""
+    import json
+
+    import drift_response as dr
+
+    published = tmp_path / "published.json"
+    key = "observed_thorndike_colony_1982_winter"
+    published.write_text(json.dumps({key: {"factor": [0.006, 0.01]}, "OLD": {"name": "OLD", "fit": {"factor": 0.003}}}))
+    monkeypatch.setattr(dr, "STORE", tmp_path / "out" / "store.json")
+    monkeypatch.setattr(dr, "PUBLISHED", published)
+    (tmp_path / "out").mkdir()
+    dr.store({"name": "NEW", "fit": {"factor": 0.007}, "daily_speeds_g_u_m_s": [[1.0, 0.01]]})
+    full = json.loads(dr.STORE.read_text())
+    slim = json.loads(published.read_text())
+    assert set(full) == set(slim) == {key, "NEW", "OLD"}
+    assert full["OLD"]["fit"]["factor"] == 0.003 and full["NEW"]["daily_speeds_g_u_m_s"] == [[1.0, 0.01]]
+    assert "daily_speeds_g_u_m_s" not in slim["NEW"]
+    assert full[key] == json.loads(json.dumps(dr.OBSERVED))  # the observed band is always the module's
