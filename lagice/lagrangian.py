@@ -198,7 +198,9 @@ def move_mesh(state, velocity: np.ndarray, dt_s: float, budget: dict | None = No
         sel = mesh.boundary_tags == mesh.tag_id(OPEN)
         if sel.any():
             edges = mesh.boundary_edges[sel]
-            owner = _edge_owner(mesh, edges)
+            owner = mesh._topology_cache.get("open_edge_owner")
+            if owner is None:  # sorts 3 m keys: about 4 ms at 28k elements, so once per mesh
+                owner = mesh._topology_cache["open_edge_owner"] = _edge_owner(mesh, edges)
             d = mesh.nodes[edges[:, 1]] - mesh.nodes[edges[:, 0]]
             # outward normal (times length) of an edge with the domain on its left
             nx, ny = d[:, 1], -d[:, 0]

@@ -110,6 +110,9 @@ class Mesh:
     _adj: tuple | None = field(default=None, repr=False)
     _fixed: np.ndarray | None = field(default=None, repr=False)
     _edge_on_boundary: np.ndarray | None = field(default=None, repr=False)
+    #: caches of other modules keyed on this mesh's topology (name -> value); cleared by nothing,
+    #: since a mesh's triangles and boundary never change (a remesh makes a new Mesh)
+    _topology_cache: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self):
         self.nodes = np.ascontiguousarray(self.nodes, dtype=np.float64)
