@@ -113,6 +113,27 @@ def test_open_boundary_outflow_booked(channel_mesh, rng):
     assert st.concentration.max() <= 1.0 and st.concentration.min() >= 0.0
 
 
+def test_open_edge_owners_found_once_per_mesh(channel_mesh, rng):
+    # the owners of the open edges are kept on the mesh (its topology never changes while its
+    # nodes move): the kept ones are the search's, and a copy (a new mesh) searches again
+    from lagice.lagrangian import _edge_owner
+
+    mesh = channel_mesh.copy()
+    st = _state(mesh, rng)
+    sel = mesh.boundary_tags == mesh.tag_id("open")
+    st.velocity[:] = (0.02, 0.0)
+    st.velocity[fixed_node_mask(mesh)] = 0.0
+    move_mesh(st, st.velocity, 1800.0)
+    kept = mesh._topology_cache["open_edge_owner"]
+    np.testing.assert_array_equal(kept, _edge_owner(mesh, mesh.boundary_edges[sel]))
+    tri = mesh.triangles[kept]  # each owner holds its edge
+    for (a, b), t in zip(mesh.boundary_edges[sel], tri):
+        assert a in t and b in t
+    move_mesh(st, st.velocity, 1800.0)
+    assert mesh._topology_cache["open_edge_owner"] is kept
+    assert "open_edge_owner" not in mesh.copy()._topology_cache
+
+
 def test_bad_arguments(box_mesh, rng):
     st = _state(box_mesh.copy(), rng)
     with pytest.raises(ConfigError, match="dt_s"):
