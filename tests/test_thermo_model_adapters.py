@@ -140,6 +140,14 @@ def test_thermodynamics_and_healing_share_one_air_temperature_evaluation():
     st.mesh = Mesh(m.nodes.copy(), m.triangles.copy(), m.boundary_edges, m.boundary_tags, m.tag_names)
     heal.rate(st, 1200.0)  # a new mesh (a remesh, a checkpoint load): evaluated again
     assert air.calls == 4 and memo.n_evaluations == 4
+    # the memo lives on the field: nothing keeps a field (and the mesh in its memo) alive
+    import gc
+    import weakref
+
+    gone = weakref.ref(air.field)
+    del thermo, heal, memo, air
+    gc.collect()
+    assert gone() is None
 
 
 def test_first_non_finite_finds_the_first_bad_value_and_passes_huge_finite_ones():

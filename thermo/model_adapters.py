@@ -18,8 +18,6 @@ a second interpolation.
 """
 from __future__ import annotations
 
-import weakref
-
 import numpy as np
 
 from forcing.base import SCALAR, as_field
@@ -78,18 +76,17 @@ class CentroidAirTemperature:
         return ta
 
 
-_AT_CENTROIDS = weakref.WeakKeyDictionary()
-
-
 def air_at_centroids(field) -> CentroidAirTemperature:
-    """The one :class:`CentroidAirTemperature` of ``field`` (made at the first call;
-    a field that cannot be a weak key gets a new one each time, which shares nothing)."""
-    try:
-        memo = _AT_CENTROIDS.get(field)
-        if memo is None:
-            memo = _AT_CENTROIDS[field] = CentroidAirTemperature(field)
-    except TypeError:
+    """The one :class:`CentroidAirTemperature` of ``field``, kept on the field object (made
+    at the first call; the field and its memo are freed together). A field that takes no
+    new attribute (a frozen dataclass) gets a new one each time, which shares nothing."""
+    memo = getattr(field, "_centroid_air_temperature", None)
+    if not isinstance(memo, CentroidAirTemperature):
         memo = CentroidAirTemperature(field)
+        try:
+            field._centroid_air_temperature = memo
+        except (AttributeError, TypeError):
+            pass
     return memo
 
 
