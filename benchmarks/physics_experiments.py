@@ -620,19 +620,17 @@ SPINUPS["H1125-turn25"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + TURN25,
 # runs of about 20 min): the same rule on the first four months (the scene's seed and
 # ENSEMBLE_SEEDS) against the shipped set's four months ("thick-and-thin, closed|strait": 3 and 2
 # bands inside). Stage 2 is the eight months above; the rule holds for both stages.
-add_weather_ensemble("turn25sp", TURN25 + from_spinup("H1125-turn25"),
-                     "with neXtSIM's 25° ocean turning angle, from its own spin-up",
-                     "thick-and-thin, ocean turning 25°, own spin-up", ENSEMBLE_SEEDS)
+_TURN25SP = ("turn25sp", TURN25 + from_spinup("H1125-turn25"),
+             "with neXtSIM's 25° ocean turning angle, from its own spin-up",
+             "thick-and-thin, ocean turning 25°, own spin-up")
+add_weather_ensemble(*_TURN25SP, ENSEMBLE_SEEDS)
 # Stage 1 result: (a) holds in both basins (the drift 6.5° and 8.1° further right: medians +4.6°
 # and +4.4° against +11.1° and +12.5°); the strait holds (b) and (c) (2 bands inside against 2,
 # beta 0.016 closer, the rate x1.04 further); the closed basin fails (b), 2 against 3 (the shear
 # tail 2.49 -> 2.55), and (c), beta 0.0068 further. The rule fails: 0 degrees stays. Stage 2
 # (w2030-w2033) was not run. (`screen` needs strictly more bands inside to print PASSES; this
 # rule asks for at least as many, so its strait line reads FAILS and is judged here by hand.)
-add_weather_ensemble("turn25sp", TURN25 + from_spinup("H1125-turn25"),
-                     "with neXtSIM's 25° ocean turning angle, from its own spin-up",
-                     "thick-and-thin, ocean turning 25°, own spin-up", ENSEMBLE_SEEDS + MORE_SEEDS,
-                     suffix=", eight months")
+add_weather_ensemble(*_TURN25SP, ENSEMBLE_SEEDS + MORE_SEEDS, suffix=", eight months")
 
 
 def command(scene, overrides, res, days, out) -> list:
