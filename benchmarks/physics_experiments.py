@@ -633,6 +633,42 @@ add_weather_ensemble(*_TURN25SP, ENSEMBLE_SEEDS)
 add_weather_ensemble(*_TURN25SP, ENSEMBLE_SEEDS + MORE_SEEDS, suffix=", eight months")
 
 
+# --- 2026-11-27 (eleventh session): how long leads stay open (a diagnostic, not a lead) ------
+# lagice closes open water with new ice at h0 = 0.1 m (thermo.params.new_ice_thickness_m; no
+# source), so a lead at 20 K refreezes to full concentration in about a day, and the
+# exp(-20 (1 - A)) of the rheology (stiffness, viscous time, healing) forgets it. neXtSIM's
+# classic new-ice scheme (Hibler 1979 type, `thermo.newice_type` 1) closes leads at
+# `thermo.hnull` = 0.25 m (options.cpp), about 2.5 times slower; its default (newice_type 4)
+# keeps new ice in a young-ice category (h_young_min 0.05 m, h_young_max 0.5 m) whose area
+# does not count in the concentration the rheology sees until it is about 0.275 m thick.
+# Both keep a lead weak for about 3 days at 20 K. First look at whether that memory matters:
+# the validation month with neXtSIM's hnull, from the shipped spin-up, both basins.
+HNULL = ["thermo.params.new_ice_thickness_m=0.25"]
+EXPERIMENTS["F10-hthick-1125-hnull"] = ("closed", from_spinup("H1125") + HNULL, 10e3, 28,
+                                        "F10-hthick-1125 with neXtSIM's lead-closing thickness hnull = 0.25 m "
+                                        "(diagnostic)")
+EXPERIMENTS["F10s-hthick-1125-hnull"] = ("strait", from_spinup("H1125") + HNULL, 10e3, 28,
+                                         "F10s-hthick-1125 with neXtSIM's lead-closing thickness hnull = 0.25 m "
+                                         "(diagnostic)")
+# The screen, written before the two diagnostic months above had finished (2026-11-27, 23:58
+# UTC on the VM clock): neXtSIM's hnull = 0.25 m replaces lagice's unsourced 0.1 m if, over four
+# months in each basin (the scene's wind seed and ENSEMBLE_SEEDS) from a spin-up made with it,
+#   (a) the median rate rises at least x1.3 against the shipped set's four months in one basin
+#       and falls in neither (the reason to look at it: the pack is too still);
+#   (b) the medians put at least as many bands inside as the shipped set's four months (3 closed,
+#       2 strait);
+#   (c) beta moves no further from its band than 0.005.
+# A sourced value replacing an unsourced one must not make the statistics worse; (a) asks that
+# it be worth a change of the shipped set. The screen is run only if one of the two diagnostic
+# months deforms at least x1.3 faster than F10-hthick-1125 / F10s-hthick-1125 (else hnull is
+# recorded as not mattering). Passing calls for eight months and the validation made again
+# from the new spin-up before the value is shipped.
+SPINUPS["H1125-hnull"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + HNULL, OUT / "spinup-H1125-hnull.npz",
+                          10e3)
+add_weather_ensemble("hnullsp", HNULL + from_spinup("H1125-hnull"),
+                     "with neXtSIM's lead-closing thickness hnull = 0.25 m, from its own spin-up",
+                     "thick-and-thin, hnull 0.25 m, own spin-up", ENSEMBLE_SEEDS)
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
