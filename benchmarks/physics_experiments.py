@@ -650,7 +650,7 @@ EXPERIMENTS["F10-hthick-1125-hnull"] = ("closed", from_spinup("H1125") + HNULL, 
 EXPERIMENTS["F10s-hthick-1125-hnull"] = ("strait", from_spinup("H1125") + HNULL, 10e3, 28,
                                          "F10s-hthick-1125 with neXtSIM's lead-closing thickness hnull = 0.25 m "
                                          "(diagnostic)")
-# The screen, written before the two diagnostic months above had finished (2026-11-27, 23:58
+# The screen, written before the two diagnostic months above had finished (2026-11-26, 23:58
 # UTC on the VM clock): neXtSIM's hnull = 0.25 m replaces lagice's unsourced 0.1 m if, over four
 # months in each basin (the scene's wind seed and ENSEMBLE_SEEDS) from a spin-up made with it,
 #   (a) the median rate rises at least x1.3 against the shipped set's four months in one basin
