@@ -21,7 +21,9 @@ streams through once per sub-step, read-modify-write arrays twice; gathered arra
 hits cache; arrays touched only at damaging or prescribed entities are left out),
 so achieved GB/s = bytes × element-sub-steps/s. A STREAM triad (a = b + s c, numba,
 serial and parallel, arrays of 2 × 10⁷ float64 ≫ cache, 24 B per entry counted as
-STREAM does) is measured in the same run for the bandwidth the machine delivers now.
+STREAM does) is measured in the same run for the bandwidth the machine delivers now,
+before and after the kernels; the table gives the fraction of the first, the summary after it
+the fraction of the better of the two (on shared hosts the triad moves by up to 2x between runs).
 Each configuration is timed ``--repeat`` times (fresh simulation each) and the best
 is kept (the machine is shared: the best run is the least disturbed). The JSON also
 has the throughput per CPU second of the process (``element_substeps_per_cpu_s``):
@@ -237,7 +239,7 @@ def main(argv=None):
             r = best
             r["requested"] = {None: "auto", True: "parallel", False: "serial"}[par]
             r["triad_GB_s"] = triad["parallel" if r["parallel"] else "serial"]
-            r["fraction_of_triad"] = r["achieved_GB_s"] / r["triad_GB_s"]
+            r["fraction_of_triad"] = r["achieved_GB_s"] / r["triad_GB_s"]  # of the triad at the start
             rows.append(r)
             mode = f"{r['requested'][:3]}:{'par' + str(r['threads']) if r['parallel'] else 'ser'}"
             print(f"{r['n_elements']:>9} {mode:>12} {r['substeps_per_step']:>8.0f} "
@@ -253,8 +255,23 @@ def main(argv=None):
         layer = "none used"
     for r in rows:
         r["threading_layer"] = layer
+    # The triad again after the kernels: on shared hosts it moved by up to 2x between runs
+    # (docs/benchmarks.md, tenth session), so each row is also given as a fraction of the
+    # best triad of the run, the bandwidth the machine showed it can deliver (the stricter
+    # denominator of the two).
+    triad_end = {"serial": stream_triad(False), "parallel": stream_triad(True)}
+    best_triad = {k: max(triad[k], triad_end[k]) for k in triad}
+    print(f"STREAM triad after the kernels: serial {triad_end['serial']:.2f} GB/s, parallel "
+          f"{triad_end['parallel']:.2f} GB/s; fraction of the run's best triad:")
+    for r in rows:
+        r["best_triad_GB_s"] = best_triad["parallel" if r["parallel"] else "serial"]
+        r["fraction_of_best_triad"] = r["achieved_GB_s"] / r["best_triad_GB_s"]
+        mode = f"{r['requested'][:3]}:{'par' + str(r['threads']) if r['parallel'] else 'ser'}"
+        print(f"{r['n_elements']:>9} {mode:>12} {r['achieved_GB_s']:>6.2f} GB/s of {r['best_triad_GB_s']:.2f}: "
+              f"{100 * r['fraction_of_best_triad']:.0f} %")
     a.json.parent.mkdir(parents=True, exist_ok=True)
-    a.json.write_text(json.dumps({"triad_GB_s": triad, "element_kernel_per_cpu_s": ek, "rows": rows}, indent=1))
+    a.json.write_text(json.dumps({"triad_GB_s": triad, "triad_GB_s_after": triad_end, "best_triad_GB_s": best_triad,
+                                  "element_kernel_per_cpu_s": ek, "rows": rows}, indent=1))
     print(f"threading layer: {layer}; wrote {a.json}")
 
 
