@@ -11,6 +11,7 @@ largest displacement of the nodes that exist at the start and at the end).
 
     python benchmarks/physics_experiments.py list
     python benchmarks/physics_experiments.py run F10 F10s ...     # one after the other
+    python benchmarks/physics_experiments.py run A B C D --jobs 2 # two queues side by side (A, C | B, D)
     python benchmarks/physics_experiments.py analyse F10 ...      # re-analyse finished runs
     python benchmarks/physics_experiments.py table                # markdown table of all results
     python benchmarks/physics_experiments.py run W20-d1 W20-d2 ...  # realisation ensembles (ENSEMBLES)
@@ -780,6 +781,29 @@ def run_experiment(name: str, force: bool = False, run: bool = True) -> dict:
     return r
 
 
+def queues(names: list, jobs: int) -> list:
+    """``names`` dealt round-robin into ``jobs`` queues (order kept within each): with the
+    closed and strait runs of a set-up listed in pairs, each queue holds one basin."""
+    if jobs < 1:
+        raise SystemExit(f"physics: --jobs {jobs}: expected at least 1")
+    return [q for q in (names[i::jobs] for i in range(jobs)) if q]
+
+
+def run_queues(names: list, jobs: int, force: bool = False) -> None:
+    """Run ``names`` in ``jobs`` child processes of this script, each through its queue one
+    run after the other (one numba thread per run unless NUMBA_NUM_THREADS says otherwise);
+    fails if any queue failed, after all have ended."""
+    for n in names:
+        if n not in EXPERIMENTS:
+            raise SystemExit(f"physics: unknown experiment {n!r}; known: {list(EXPERIMENTS)}")
+    env = {**os.environ, "NUMBA_NUM_THREADS": os.environ.get("NUMBA_NUM_THREADS", "1")}
+    procs = [subprocess.Popen([sys.executable, str(Path(__file__).resolve()), "run", *q]
+                              + (["--force"] if force else []), env=env, cwd=ROOT) for q in queues(names, jobs)]
+    failed = [i for i, p in enumerate(procs) if p.wait() != 0]
+    if failed:
+        raise SystemExit(f"physics: queue(s) {failed} failed (see the runs' logs in {OUT})")
+
+
 def row(r: dict) -> str:
     m = r["median"]
     cells = []
@@ -956,6 +980,8 @@ def main(argv=None):
     ap.add_argument("what", choices=("list", "run", "table", "spread", "spinup", "analyse", "figure", "screen"))
     ap.add_argument("names", nargs="*")
     ap.add_argument("--force", action="store_true", help="run again even if the run finished")
+    ap.add_argument("--jobs", type=int, default=1,
+                    help="run: this many queues side by side (names dealt round-robin), one thread each")
     ap.add_argument("--beta-tolerance", type=float, default=0.0,
                     help="screen: how much further from its band β may move (state it before the runs)")
     ap.add_argument("--rate-tolerance", type=float, default=1.0,
@@ -966,6 +992,8 @@ def main(argv=None):
     if args.what == "list":
         for k, (sc, ov, res, days, what) in EXPERIMENTS.items():
             print(f"{k}: {SCENES[sc]} {res / 1e3:g} km {days} d: {what}\n    {' '.join(ov)}")
+    elif args.what == "run" and args.jobs != 1:
+        run_queues(args.names, args.jobs, force=args.force)
     elif args.what in ("run", "analyse"):
         for n in args.names:
             if n not in EXPERIMENTS:

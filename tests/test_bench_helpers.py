@@ -100,3 +100,23 @@ def test_drift_response_store_keeps_the_published_records_in_a_fresh_checkout(tm
     assert full["OLD"]["fit"]["factor"] == 0.003 and full["NEW"]["daily_speeds_g_u_m_s"] == [[1.0, 0.01]]
     assert "daily_speeds_g_u_m_s" not in slim["NEW"]
     assert full[key] == json.loads(json.dumps(dr.OBSERVED))  # the observed band is always the module's
+
+
+def test_physics_run_queues_deal_the_runs_round_robin_and_check_names_first(monkeypatch):
+    """``physics_experiments.py run ... --jobs N``: the closed/strait pairs of a set-up, listed
+    in pairs, land one basin per queue in their order; an unknown name stops the command
+    before any run starts."""
+    import physics_experiments as pe
+
+    names = ["F10-hthick-hnullsp", "F10s-hthick-hnullsp", "F10-hthick-hnullsp-w2027", "F10s-hthick-hnullsp-w2027",
+             "F10-hthick-hnullsp-w2028"]
+    assert pe.queues(names, 2) == [names[0::2], names[1::2]]
+    assert pe.queues(names[:1], 3) == [names[:1]]  # no empty queue
+    assert pe.queues(names, 1) == [names]
+    with pytest.raises(SystemExit, match="--jobs 0"):
+        pe.queues(names, 0)
+    started = []
+    monkeypatch.setattr(pe.subprocess, "Popen", lambda *a, **k: started.append(a))
+    with pytest.raises(SystemExit, match="unknown experiment 'F10-nope'"):
+        pe.run_queues(names + ["F10-nope"], 2)
+    assert started == []
