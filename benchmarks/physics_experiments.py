@@ -669,6 +669,13 @@ SPINUPS["H1125-hnull"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + HNULL, O
 add_weather_ensemble("hnullsp", HNULL + from_spinup("H1125-hnull"),
                      "with neXtSIM's lead-closing thickness hnull = 0.25 m, from its own spin-up",
                      "thick-and-thin, hnull 0.25 m, own spin-up", ENSEMBLE_SEEDS)
+# Result (2026-11-27): the diagnostic months deformed x1.39 (closed) and x1.09 (strait) faster, so
+# the screen ran. (a) holds: the four-month median rate rose x1.43 (closed, 0.0014 -> 0.0020 per
+# day) and x1.27 (strait). The closed basin fails (b), 2 bands inside against 3 (the |divergence|
+# tail 2.36 -> 2.08 and the half-shear area 4.9 % -> 3.8 % leave their bands on the localised
+# side), and (c), beta 0.0068 further (0.048 -> 0.041). The strait holds (b) (2 against 2) and
+# (c). The rule fails: 0.1 m stays. `screen` with --rate-tolerance 1 prints FAILS for the strait
+# too, because it asks for strictly more bands inside; this rule asks for at least as many.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
