@@ -676,6 +676,15 @@ add_weather_ensemble("hnullsp", HNULL + from_spinup("H1125-hnull"),
 # side), and (c), beta 0.0068 further (0.048 -> 0.041). The strait holds (b) (2 against 2) and
 # (c). The rule fails: 0.1 m stays. `screen` with --rate-tolerance 1 prints FAILS for the strait
 # too, because it asks for strictly more bands inside; this rule asks for at least as many.
+# A diagnostic after the screen (2026-11-27, no rule: it decides nothing, it asks what the next
+# screen should be): the two leads that push the localisation in opposite directions together.
+# The strength calibrated to the wind factor (HALF_STRENGTH) drifts like the observed pack but
+# spreads the deformation (tails 2.8-3.1); hnull localises it (tails 2.0-2.1). The validation
+# month in each basin, from the shipped spin-up state, against X10h-str-50 / F10s-hthick-str50.
+EXPERIMENTS["X10h-str-50-hnull"] = ("closed", from_spinup("H1125") + HALF_STRENGTH + HNULL, 10e3, 28,
+                                    "X10h-str-50 with hnull = 0.25 m (diagnostic)")
+EXPERIMENTS["F10s-hthick-str50-hnull"] = ("strait", from_spinup("H1125") + HALF_STRENGTH + HNULL, 10e3, 28,
+                                          "F10s-hthick-str50 with hnull = 0.25 m (diagnostic)")
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
