@@ -691,7 +691,7 @@ EXPERIMENTS["F10s-hthick-str50-hnull"] = ("strait", from_spinup("H1125") + HALF_
 # 0.0091 per day just outside), strait 4 (both tails, 6.0 %, R2 0.735; rate 0.0086). Against
 # X10h-str-50 / F10s-hthick-str50: 2 and 1 bands inside. One month: a lead, not a result.
 #
-# Its screen, written here before any of its runs (2026-11-27, 01:48 UTC): the set "C_lab halved
+# Its screen, written here before any of its runs (2026-11-27, 01:46 UTC): the set "C_lab halved
 # (1.4 MPa in lagice's form, calibrated to the winter wind factor) with neXtSIM's hnull = 0.25 m"
 # replaces the shipped set if, from a spin-up made with both (`spinup H1125-str50-hnull`), over the
 # months of each basin:
