@@ -823,6 +823,13 @@ def run_experiment(name: str, force: bool = False, run: bool = True) -> dict:
     return r
 
 
+def check_names(names: list) -> None:
+    """Stop with the first name that is not an experiment (before any run starts)."""
+    for n in names:
+        if n not in EXPERIMENTS:
+            raise SystemExit(f"physics: unknown experiment {n!r}; known: {list(EXPERIMENTS)}")
+
+
 def queues(names: list, jobs: int) -> list:
     """``names`` dealt round-robin into ``jobs`` queues (order kept within each): with the
     closed and strait runs of a set-up listed in pairs, each queue holds one basin."""
@@ -835,9 +842,7 @@ def run_queues(names: list, jobs: int, force: bool = False) -> None:
     """Run ``names`` in ``jobs`` child processes of this script, each through its queue one
     run after the other (one numba thread per run unless NUMBA_NUM_THREADS says otherwise);
     fails if any queue failed, after all have ended."""
-    for n in names:
-        if n not in EXPERIMENTS:
-            raise SystemExit(f"physics: unknown experiment {n!r}; known: {list(EXPERIMENTS)}")
+    check_names(names)
     env = {**os.environ, "NUMBA_NUM_THREADS": os.environ.get("NUMBA_NUM_THREADS", "1")}
     procs = [subprocess.Popen([sys.executable, str(Path(__file__).resolve()), "run", *q]
                               + (["--force"] if force else []), env=env, cwd=ROOT) for q in queues(names, jobs)]
@@ -1039,9 +1044,8 @@ def main(argv=None):
     elif args.what == "run" and args.jobs != 1:
         run_queues(args.names, args.jobs, force=args.force)
     elif args.what in ("run", "analyse"):
+        check_names(args.names)
         for n in args.names:
-            if n not in EXPERIMENTS:
-                raise SystemExit(f"physics: unknown experiment {n!r}; known: {list(EXPERIMENTS)}")
             run_experiment(n, force=args.force, run=args.what == "run")
     elif args.what == "spinup":
         for n in args.names or ["shipped"]:
