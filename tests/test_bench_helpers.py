@@ -120,3 +120,25 @@ def test_physics_run_queues_deal_the_runs_round_robin_and_check_names_first(monk
     with pytest.raises(SystemExit, match="unknown experiment 'F10-nope'"):
         pe.run_queues(names + ["F10-nope"], 2)
     assert started == []
+
+
+def test_every_physics_experiment_resolves_to_a_valid_scene():
+    """Each run and spin-up of benchmarks/physics_experiments.py is a bundled scene with
+    ``--set`` overrides; a key given twice with two values, an unknown key or a value out of
+    range would stop that run only when its turn came (hours into a queue). All of them
+    resolve here, and a screened set's overrides reach the resolved scene."""
+    import physics_experiments as pe
+
+    from lagice.scenes.config import load_scene
+
+    shipped = {sc: load_scene(name) for sc, name in pe.SCENES.items()}
+    for name, (scene, overrides, _res, _days, _what) in pe.EXPERIMENTS.items():
+        cfg = load_scene(pe.SCENES[scene], overrides)
+        assert cfg["scene"]["name"] == shipped[scene]["scene"]["name"], name
+    for name, (overrides, _target, _res) in pe.SPINUPS.items():
+        if overrides is not None:
+            load_scene("winter_basin_spinup", overrides)
+    # the screened set's own overrides reach the scene
+    cfg = load_scene(pe.SCENES["closed"], pe.EXPERIMENTS["F10-hthick-str50hnullsp"][1])
+    assert cfg["rheology"]["strength_lab_pa"] == 1.4e6 and cfg["thermo"]["params"]["new_ice_thickness_m"] == 0.25
+    assert cfg != shipped["closed"]
