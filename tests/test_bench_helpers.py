@@ -135,7 +135,7 @@ def test_every_physics_experiment_resolves_to_a_valid_scene():
     for name, (scene, overrides, _res, _days, _what) in pe.EXPERIMENTS.items():
         cfg = load_scene(pe.SCENES[scene], overrides)
         assert cfg["scene"]["name"] == shipped[scene]["scene"]["name"], name
-    for name, (overrides, _target, _res) in pe.SPINUPS.items():
+    for overrides, _target, _res in pe.SPINUPS.values():
         if overrides is not None:
             load_scene("winter_basin_spinup", overrides)
     # the screened set's own overrides reach the scene
