@@ -716,6 +716,20 @@ add_weather_ensemble(*_STR50HNULL, ENSEMBLE_SEEDS + MORE_SEEDS, suffix=", eight 
 # R2 0.706 leave their bands; wind factor 0.0079, rate x3.8). Not shipped; the EVP and +-50 %
 # runs queued for the case that it passed were stopped and their definitions removed.
 
+# A diagnostic after stage 2 (2026-11-27, twelfth session; no rule: it decides nothing, it asks
+# what the next screen should be). The set screened last drifts like the observed pack and
+# spreads its shear; the strength correlated over 50 km came nearest to passing its screen
+# (4 bands inside against 3 in each basin) and localises. Both together, the validation month
+# in each basin from the halved strength's own spin-up state.
+EXPERIMENTS["F10-hthick-str50hnullsp-cor50"] = ("closed", HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull")
+                                                + CORRELATED_STRENGTH, 10e3, 28,
+                                                "F10-hthick-str50hnullsp with the strength correlated over 50 km "
+                                                "(diagnostic)")
+EXPERIMENTS["F10s-hthick-str50hnullsp-cor50"] = ("strait", HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull")
+                                                 + CORRELATED_STRENGTH, 10e3, 28,
+                                                 "F10s-hthick-str50hnullsp with the strength correlated over 50 km "
+                                                 "(diagnostic)")
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
