@@ -730,6 +730,7 @@ EXPERIMENTS["F10s-hthick-str50hnullsp-cor50"] = ("strait", HALF_STRENGTH + HNULL
                                                  "F10s-hthick-str50hnullsp with the strength correlated over 50 km "
                                                  "(diagnostic)")
 
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]

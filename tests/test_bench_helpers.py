@@ -124,9 +124,10 @@ def test_physics_run_queues_deal_the_runs_round_robin_and_check_names_first(monk
 
 def test_every_physics_experiment_resolves_to_a_valid_scene():
     """Each run and spin-up of benchmarks/physics_experiments.py is a bundled scene with
-    ``--set`` overrides; a key given twice with two values, an unknown key or a value out of
-    range would stop that run only when its turn came (hours into a queue). All of them
-    resolve here, and a screened set's overrides reach the resolved scene."""
+    ``--set`` overrides; a key given twice with two values or a key the scene does not know
+    would stop that run only when its turn came (hours into a queue). All of them resolve
+    here (the checks that need a run's input files, such as its spin-up state, are left to
+    the run), and a screened set's overrides reach the resolved scene."""
     import physics_experiments as pe
 
     from lagice.scenes.config import load_scene
