@@ -721,14 +721,10 @@ add_weather_ensemble(*_STR50HNULL, ENSEMBLE_SEEDS + MORE_SEEDS, suffix=", eight 
 # spreads its shear; the strength correlated over 50 km came nearest to passing its screen
 # (4 bands inside against 3 in each basin) and localises. Both together, the validation month
 # in each basin from the halved strength's own spin-up state.
-EXPERIMENTS["F10-hthick-str50hnullsp-cor50"] = ("closed", HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull")
-                                                + CORRELATED_STRENGTH, 10e3, 28,
-                                                "F10-hthick-str50hnullsp with the strength correlated over 50 km "
-                                                "(diagnostic)")
-EXPERIMENTS["F10s-hthick-str50hnullsp-cor50"] = ("strait", HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull")
-                                                 + CORRELATED_STRENGTH, 10e3, 28,
-                                                 "F10s-hthick-str50hnullsp with the strength correlated over 50 km "
-                                                 "(diagnostic)")
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    EXPERIMENTS[f"{_p}-hthick-str50hnullsp-cor50"] = (
+        _basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull") + CORRELATED_STRENGTH, 10e3, 28,
+        f"{_p}-hthick-str50hnullsp with the strength correlated over 50 km (diagnostic)")
 
 
 def command(scene, overrides, res, days, out) -> list:
