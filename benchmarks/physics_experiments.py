@@ -839,10 +839,22 @@ def run_experiment(name: str, force: bool = False, run: bool = True) -> dict:
 
 
 def check_names(names: list) -> None:
-    """Stop with the first name that is not an experiment (before any run starts)."""
+    """Stop with the first name that is not an experiment, or whose scene and ``--set``
+    overrides do not resolve (a key the scene does not know, a key given twice with two
+    values, a value out of range), before any run starts: in a queue such a run would fail
+    only when its turn came, hours in. The checks that need a run's input files (its spin-up
+    state) are left to the run."""
+    from lagice.errors import LagiceError
+    from lagice.scenes.config import load_scene
+
     for n in names:
         if n not in EXPERIMENTS:
             raise SystemExit(f"physics: unknown experiment {n!r}; known: {list(EXPERIMENTS)}")
+        scene, overrides = EXPERIMENTS[n][:2]
+        try:
+            load_scene(SCENES[scene], overrides)
+        except LagiceError as exc:
+            raise SystemExit(f"physics: experiment {n!r} (scene {SCENES[scene]}) does not resolve: {exc}") from None
 
 
 def queues(names: list, jobs: int) -> list:

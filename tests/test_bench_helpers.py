@@ -104,8 +104,8 @@ def test_drift_response_store_keeps_the_published_records_in_a_fresh_checkout(tm
 
 def test_physics_run_queues_deal_the_runs_round_robin_and_check_names_first(monkeypatch):
     """``physics_experiments.py run ... --jobs N``: the closed/strait pairs of a set-up, listed
-    in pairs, land one basin per queue in their order; an unknown name stops the command
-    before any run starts."""
+    in pairs, land one basin per queue in their order; an unknown name, or a run whose scene
+    overrides do not resolve, stops the command before any run starts."""
     import physics_experiments as pe
 
     names = ["F10-hthick-hnullsp", "F10s-hthick-hnullsp", "F10-hthick-hnullsp-w2027", "F10s-hthick-hnullsp-w2027",
@@ -119,6 +119,15 @@ def test_physics_run_queues_deal_the_runs_round_robin_and_check_names_first(monk
     monkeypatch.setattr(pe.subprocess, "Popen", lambda *a, **k: started.append(a))
     with pytest.raises(SystemExit, match="unknown experiment 'F10-nope'"):
         pe.run_queues(names + ["F10-nope"], 2)
+    assert started == []
+    # a defined run whose overrides do not resolve stops the queue before it starts too
+    scene, overrides, *rest = pe.EXPERIMENTS["F10-hthick-hnullsp"]
+    bad = {"F10-bad-key": (scene, [*overrides, "rheology.no_such_key=1"], *rest),
+           "F10-twice": (scene, [*overrides, "run.seed=1", "run.seed=2"], *rest)}
+    monkeypatch.setattr(pe, "EXPERIMENTS", {**pe.EXPERIMENTS, **bad})
+    for name in bad:
+        with pytest.raises(SystemExit, match=rf"experiment '{name}' \(scene winter_basin_pack\) does not resolve"):
+            pe.run_queues(names + [name], 2)
     assert started == []
 
 
