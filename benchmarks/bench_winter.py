@@ -117,6 +117,10 @@ def main(argv=None):
         print(f"  element-sub-steps/s: {r['element_substeps_per_s_loop'] / 1e6:.1f} M in the sub-step loop, "
               f"{r['element_substeps_per_s_wall'] / 1e6:.1f} M over the wall time; "
               f"28 days extrapolated: {r['wall_28d_extrapolated_s']:.0f} s", flush=True)
+        if "host_path" in r:  # the GPU stepper's calls to the device per step (docs/gpu.md: each costs host time)
+            c = r["host_path"]["per_step"]
+            print(f"  GPU calls per step: {c['uploads']:.1f} uploads, {c['downloads']:.1f} downloads, "
+                  f"{c['launches']:.1f} launches", flush=True)
     a.json.parent.mkdir(parents=True, exist_ok=True)
     a.json.write_text(json.dumps(rows, indent=1))
     print(f"wrote {a.json}")
