@@ -727,6 +727,23 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
         f"{_p}-hthick-str50hnullsp with the strength correlated over 50 km (diagnostic)")
 
 
+# --- 2026-11-27 (thirteenth session): a spin-up four times longer (a diagnostic) -----------
+# beta needs neighbouring features that slip in opposite senses (docs/physics.md §4, "How beta
+# was estimated"). The 14-day spin-up leaves the pack the leads of one short stretch of weather.
+# A pack with two months of history carries refrozen leads (thin, weak ice) of the several
+# wind regimes that made them, so the validation month may find weaknesses of several
+# orientations. The spin-up runs 56 days from 2025-11-20, so that it ends on the flagship's
+# start date as the 14-day one does. Its ice grows for 56 days instead of 14, so the pack
+# is also thicker, and both states' mean thicknesses are reported.
+# Stated before the runs: a lead if the median beta rises by 0.03 or more in both basins (three
+# times what correlated thickness gave) with no band of the six lost; it decides nothing.
+SPINUP_DAYS = {"H1125-long": 56}
+SPINUPS["H1125-long"] = ([f"initial.thickness_m={HETERO_THICKNESS}", 'run.start_date="2025-11-20 00:00:00"'],
+                         OUT / "spinup-H1125-long.npz", 10e3)
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    EXPERIMENTS[f"{_p}-hthick-long"] = (_basin, from_spinup("H1125-long"), 10e3, 28,
+                                        f"{_p}-hthick-1125 from a 56-day spin-up (diagnostic)")
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
@@ -1029,7 +1046,8 @@ def figure_strength(name: str = "F10-hthick-cor50", ref: str = "F10-hthick-1125"
 
 def spinup(name="shipped", days=14):
     """Spin-up state ``name`` (SPINUPS): ``examples/winter_basin_spinup.toml`` (pristine
-    ice, seed 2025) with its overrides for ``days``, then its last snapshot → its file
+    ice, seed 2025) with its overrides for ``days`` (the command takes them from
+    :data:`SPINUP_DAYS`, 14 otherwise), then its last snapshot → its file
     (for "shipped": data_stubs/winter_basin_spinup.npz of this checkout)."""
     from lagice.spinup import save_spinup
 
@@ -1076,7 +1094,7 @@ def main(argv=None):
             run_experiment(n, force=args.force, run=args.what == "run")
     elif args.what == "spinup":
         for n in args.names or ["shipped"]:
-            spinup(n)
+            spinup(n, SPINUP_DAYS.get(n, 14))
     elif args.what == "spread":
         print(spread())
     elif args.what == "screen":  # CANDIDATE_GROUP REFERENCE_GROUP
