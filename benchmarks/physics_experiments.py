@@ -743,6 +743,24 @@ SPINUPS["H1125-long"] = ([f"initial.thickness_m={HETERO_THICKNESS}", 'run.start_
 for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-long"] = (_basin, from_spinup("H1125-long"), 10e3, 28,
                                         f"{_p}-hthick-1125 from a 56-day spin-up (diagnostic)")
+# Result (2026-11-27, thirteenth session): not a lead. beta +0.001 (closed) and +0.031 (strait);
+# the closed basin's localisation moved inside (4 bands against 2) while its rate fell x0.29
+# (a thicker, healed pack); all within what a new draw of the strength disorder does.
+#
+# The same history for the set that drifts like the observed pack (a diagnostic, the same
+# day). The halved strength with hnull (str50hnullsp) has the observed wind factor and spreads
+# its shear (its strait failed its screen on the shear tail and R2); the long spin-up moved
+# the shipped set's localisation inside. Its own 56-day spin-up, then the validation month.
+# Stated before the runs: a lead if both basins put 4 or more bands of six inside with the
+# wind factor still in its band (0.006-0.010) and the median rate at 0.005 day-1 or more
+# (its 14-day validation month: 3 bands in each basin, rate 0.0085-0.0091); it decides nothing.
+SPINUP_DAYS["H1125-str50-hnull-long"] = 56
+SPINUPS["H1125-str50-hnull-long"] = (SPINUPS["H1125-str50-hnull"][0] + ['run.start_date="2025-11-20 00:00:00"'],
+                                     OUT / "spinup-H1125-str50-hnull-long.npz", 10e3)
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    EXPERIMENTS[f"{_p}-hthick-str50hnull-long"] = (
+        _basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull-long"), 10e3, 28,
+        f"{_p}-hthick-str50hnullsp from its own 56-day spin-up (diagnostic)")
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
