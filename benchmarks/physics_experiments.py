@@ -730,7 +730,7 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # --- 2026-11-27 (thirteenth session): a spin-up four times longer (a diagnostic) -----------
 # beta needs neighbouring features that slip in opposite senses (docs/physics.md §4, "How beta
 # was estimated"). The 14-day spin-up leaves the pack the leads of one short stretch of weather.
-# A pack with two months of history carries refrozen leads (thin, weak ice) of the several
+# A pack with two months of history may carry refrozen leads (thin, weak ice) of the several
 # wind regimes that made them, so the validation month may find weaknesses of several
 # orientations. The spin-up runs 56 days from 2025-11-20, so that it ends on the flagship's
 # start date as the 14-day one does. Its ice grows for 56 days instead of 14, so the pack
@@ -761,6 +761,7 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-str50hnull-long"] = (
         _basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull-long"), 10e3, 28,
         f"{_p}-hthick-str50hnullsp from its own 56-day spin-up (diagnostic)")
+
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
@@ -876,7 +877,7 @@ def run_experiment(name: str, force: bool = False, run: bool = True) -> dict:
 def check_names(names: list) -> None:
     """Stop with the first name that is not an experiment, or whose scene and ``--set``
     overrides do not resolve (a key the scene does not know, a key given twice with two
-    values, a value out of range), before any run starts: in a queue such a run would fail
+    values, a value of the wrong type), before any run starts: in a queue such a run would fail
     only when its turn came, hours in. The checks that need a run's input files (its spin-up
     state) are left to the run."""
     from lagice.errors import LagiceError
