@@ -738,7 +738,9 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # Stated before the runs: a lead if the median beta rises by 0.03 or more in both basins (three
 # times what correlated thickness gave) with no band of the six lost; it decides nothing.
 SPINUP_DAYS = {"H1125-long": 56}
-SPINUPS["H1125-long"] = ([f"initial.thickness_m={HETERO_THICKNESS}", 'run.start_date="2025-11-20 00:00:00"'],
+#: the start of a 56-day spin-up that ends on the flagship's start date (2026-01-15)
+LONG_SPINUP_START = ['run.start_date="2025-11-20 00:00:00"']
+SPINUPS["H1125-long"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + LONG_SPINUP_START,
                          OUT / "spinup-H1125-long.npz", 10e3)
 for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-long"] = (_basin, from_spinup("H1125-long"), 10e3, 28,
@@ -755,11 +757,12 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # wind factor still in its band (0.006-0.010) and the median rate at 0.005 day-1 or more
 # (its 14-day validation month: 3 bands in each basin, rate 0.0085-0.0091); it decides nothing.
 SPINUP_DAYS["H1125-str50-hnull-long"] = 56
-SPINUPS["H1125-str50-hnull-long"] = (SPINUPS["H1125-str50-hnull"][0] + ['run.start_date="2025-11-20 00:00:00"'],
+SPINUPS["H1125-str50-hnull-long"] = (SPINUPS["H1125-str50-hnull"][0] + LONG_SPINUP_START,
                                      OUT / "spinup-H1125-str50-hnull-long.npz", 10e3)
+_STR50HNULL_LONG_SET = HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull-long")
 for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-str50hnull-long"] = (
-        _basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull-long"), 10e3, 28,
+        _basin, _STR50HNULL_LONG_SET, 10e3, 28,
         f"{_p}-hthick-str50hnullsp from its own 56-day spin-up (diagnostic)")
 
 # Result (2026-11-27, thirteenth session): A LEAD by its criterion. Closed: 4 bands inside (both
@@ -775,7 +778,7 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # beta no further from its band than the shipped set's plus 0.005. Two stages of four months (the
 # scene's seed and ENSEMBLE_SEEDS; then MORE_SEEDS); stage 2 only if stage 1 passes. Shipping it
 # would also make the shipped spin-up 56 days (data_stubs, validate.py, the pinning of older runs).
-_STR50HNULL_LONG = ("str50hnull-long", HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull-long"),
+_STR50HNULL_LONG = ("str50hnull-long", _STR50HNULL_LONG_SET,
                     "with C_lab halved and hnull = 0.25 m, from its own 56-day spin-up",
                     "thick-and-thin, strength halved with hnull, 56-day spin-up")
 add_weather_ensemble(*_STR50HNULL_LONG, ENSEMBLE_SEEDS)
