@@ -778,6 +778,9 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # beta no further from its band than the shipped set's plus 0.005. Two stages of four months (the
 # scene's seed and ENSEMBLE_SEEDS; then MORE_SEEDS); stage 2 only if stage 1 passes. Shipping it
 # would also make the shipped spin-up 56 days (data_stubs, validate.py, the pinning of older runs).
+# Applied by (2026-11-27, fourteenth session; the rule's terms as flags, the same rule):
+#   screen "<candidate group>" "thick-and-thin, <basin>" --beta-tolerance 0.005 --band-gain 0 \
+#       --rate-gain 2 --wind-factor-band 0.006 0.010   (stage 2: both groups ", eight months")
 _STR50HNULL_LONG = ("str50hnull-long", _STR50HNULL_LONG_SET,
                     "with C_lab halved and hnull = 0.25 m, from its own 56-day spin-up",
                     "thick-and-thin, strength halved with hnull, 56-day spin-up")
@@ -1000,46 +1003,77 @@ def band_distance(key: str, value: float) -> float:
 
 
 def screen_verdict(candidate: dict, reference: dict, beta_tolerance: float = 0.0,
-                   rate_tolerance_factor: float = 1.0) -> dict:
+                   rate_tolerance_factor: float = 1.0, band_gain: int = 1, rate_gain: float | None = None,
+                   wind_factor_band: tuple | None = None) -> dict:
     """A screen rule as the sessions wrote them, made mechanical. ``candidate`` and
-    ``reference`` map each metric of TARGETS to a median over months. The screen passes if
-    the candidate puts more bands inside than the reference and neither β nor the rate
-    moves further from its band than the tolerances: β by more than ``beta_tolerance``, the
-    rate by more than the factor ``rate_tolerance_factor``. The rules of 2026-11-26 had no
-    tolerance (0 and 1); a rule should state them before its runs."""
+    ``reference`` map each metric of TARGETS to a median over months (and, for
+    ``wind_factor_band``, ``"wind_factor"`` to the median fitted |A|). The screen passes if
+    the candidate puts at least ``band_gain`` more bands inside than the reference (1: more;
+    0: at least as many) and neither β nor the rate moves further from its band than the
+    tolerances: β by more than ``beta_tolerance``, the rate by more than the factor
+    ``rate_tolerance_factor``. With ``rate_gain`` the candidate's rate must also be that many
+    times the reference's; with ``wind_factor_band`` (lo, hi) the candidate's wind factor must
+    lie in it. The rules of 2026-11-26 had no tolerance (0 and 1) and a gain of one band; the
+    twelfth session's rule (2026-11-27) is ``band_gain=0, rate_gain=2, beta_tolerance=0.005,
+    wind_factor_band=(0.006, 0.010)``. A rule should state all of them before its runs."""
     inside = {k: sum(band_distance(k, m[k]) == 0.0 for k in TARGETS) for k, m in
               (("candidate", candidate), ("reference", reference))}
     beta_move = (band_distance("beta_space", candidate["beta_space"])
                  - band_distance("beta_space", reference["beta_space"]))
     k = "mean_total_deformation_rate_per_day"
     rate_move = band_distance(k, candidate[k]) - band_distance(k, reference[k])
+    ok_bands = inside["candidate"] - inside["reference"] >= band_gain
     ok_beta = beta_move <= beta_tolerance
     ok_rate = rate_move <= math.log10(rate_tolerance_factor)
+    rate_ratio = candidate[k] / reference[k]
+    ok_gain = rate_gain is None or rate_ratio >= rate_gain
+    ok_wind = wind_factor_band is None or wind_factor_band[0] <= candidate["wind_factor"] <= wind_factor_band[1]
     return {"bands_inside": inside, "beta_further_by": beta_move, "rate_further_by_factor": 10.0 ** rate_move,
-            "beta_ok": ok_beta, "rate_ok": ok_rate,
-            "passes": inside["candidate"] > inside["reference"] and ok_beta and ok_rate}
+            "rate_ratio": rate_ratio, "bands_ok": ok_bands, "beta_ok": ok_beta, "rate_ok": ok_rate,
+            "rate_gain_ok": ok_gain, "wind_factor_ok": ok_wind,
+            "passes": ok_bands and ok_beta and ok_rate and ok_gain and ok_wind}
 
 
-def group_medians(group: str) -> dict:
+def group_medians(group: str, wind_factor: bool = False) -> dict:
     """The median over the members of :data:`ENSEMBLES` ``group`` of each metric (what
-    :func:`spread` prints)."""
+    :func:`spread` prints); with ``wind_factor`` also ``"wind_factor"``, the median of the
+    members' fitted |A| in ``drift_response.json`` (run ``drift_response.py`` on them first)."""
     allr = json.loads((OUT / "experiments.json").read_text())
     if group not in ENSEMBLES:
         raise SystemExit(f"physics: unknown group {group!r}; known: {list(ENSEMBLES)}")
     missing = [n for n in ENSEMBLES[group] if n not in allr]
     if missing:
         raise SystemExit(f"physics: group {group!r} lacks runs {missing}; run them first")
-    return {k: float(np.median([allr[n]["median"][k] for n in ENSEMBLES[group]])) for k in TARGETS}
+    out = {k: float(np.median([allr[n]["median"][k] for n in ENSEMBLES[group]])) for k in TARGETS}
+    if wind_factor:
+        store = OUT / "drift_response.json"
+        fits = json.loads(store.read_text()) if store.exists() else {}
+        missing = [n for n in ENSEMBLES[group] if n not in fits]
+        if missing:
+            raise SystemExit(f"physics: group {group!r} has no drift fit for {missing} in {store}; "
+                             f"run benchmarks/drift_response.py {' '.join(missing)} first")
+        out["wind_factor"] = float(np.median([fits[n]["fit"]["factor"] for n in ENSEMBLES[group]]))
+    return out
 
 
-def screen(candidate: str, reference: str, beta_tolerance: float, rate_tolerance_factor: float) -> dict:
+def screen(candidate: str, reference: str, beta_tolerance: float, rate_tolerance_factor: float,
+           band_gain: int = 1, rate_gain: float | None = None, wind_factor_band: tuple | None = None) -> dict:
     """Print and return :func:`screen_verdict` of two groups of :data:`ENSEMBLES`."""
-    v = screen_verdict(group_medians(candidate), group_medians(reference), beta_tolerance, rate_tolerance_factor)
+    cand = group_medians(candidate, wind_factor=wind_factor_band is not None)
+    v = screen_verdict(cand, group_medians(reference), beta_tolerance, rate_tolerance_factor, band_gain,
+                       rate_gain, wind_factor_band)
     b = v["bands_inside"]
+    extra = ""
+    if rate_gain is not None:
+        extra += f"; the rate ×{v['rate_ratio']:.2f} (needs ×{rate_gain:g} or more)"
+    if wind_factor_band is not None:
+        extra += (f"; wind factor {cand['wind_factor']:.4f} (needs {wind_factor_band[0]:g}–"
+                  f"{wind_factor_band[1]:g})")
     print(f"physics: screen {candidate!r} against {reference!r}: bands inside {b['candidate']} against "
-          f"{b['reference']}; β further from its band by {v['beta_further_by']:+.4f} (tolerance "
-          f"{beta_tolerance:g}; negative: closer), the rate by ×{v['rate_further_by_factor']:.3f} (tolerance "
-          f"×{rate_tolerance_factor:g}; below 1: closer): " + ("PASSES" if v["passes"] else "FAILS"))
+          f"{b['reference']} (needs a gain of {band_gain} or more); β further from its band by "
+          f"{v['beta_further_by']:+.4f} (tolerance {beta_tolerance:g}; negative: closer), the rate by "
+          f"×{v['rate_further_by_factor']:.3f} (tolerance ×{rate_tolerance_factor:g}; below 1: closer)"
+          f"{extra}: " + ("PASSES" if v["passes"] else "FAILS"))
     return v
 
 
@@ -1118,6 +1152,12 @@ def main(argv=None):
                     help="screen: how much further from its band β may move (state it before the runs)")
     ap.add_argument("--rate-tolerance", type=float, default=1.0,
                     help="screen: by what factor further from its band the rate may move (>= 1)")
+    ap.add_argument("--band-gain", type=int, default=1,
+                    help="screen: how many more bands the candidate must put inside (0: at least as many)")
+    ap.add_argument("--rate-gain", type=float, default=None,
+                    help="screen: the candidate's median rate must be this many times the reference's")
+    ap.add_argument("--wind-factor-band", type=float, nargs=2, default=None, metavar=("LO", "HI"),
+                    help="screen: the candidate's median wind factor (drift_response.json) must lie in LO-HI")
     args = ap.parse_args(argv)
     if args.jobs != 1 and args.what != "run":
         raise SystemExit(f"physics: --jobs applies to 'run' only (asked with {args.what!r})")
@@ -1140,7 +1180,8 @@ def main(argv=None):
     elif args.what == "screen":  # CANDIDATE_GROUP REFERENCE_GROUP
         if len(args.names) != 2:
             raise SystemExit("physics: screen needs two groups of ENSEMBLES: CANDIDATE REFERENCE")
-        screen(*args.names, args.beta_tolerance, args.rate_tolerance)
+        screen(*args.names, args.beta_tolerance, args.rate_tolerance, args.band_gain, args.rate_gain,
+               None if args.wind_factor_band is None else tuple(args.wind_factor_band))
     elif args.what == "figure":  # the cohesion and a storm window's shear: run NAME against run REF
         figure_strength(*args.names)
     else:

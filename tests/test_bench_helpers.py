@@ -60,6 +60,35 @@ def test_screen_verdict_counts_bands_and_applies_the_stated_tolerances():
     assert not screen_verdict(ref, ref, beta_tolerance=1.0, rate_tolerance_factor=10.0)["passes"]  # no band gained
 
 
+def test_screen_verdict_applies_the_twelfth_sessions_rule():
+    """The two-stage rule of 2026-11-27 (at least as many bands, the rate ×2 or more, β no
+    more than 0.005 further, the wind factor in 0.006-0.010) on the eight-month medians the
+    twelfth session recorded: the halved strength with hnull passes in the closed basin (3
+    bands against 3) and fails in the strait (2 against 3), as docs/physics.md reports; a
+    wind factor outside its band or a rate short of ×2 fails on its own."""
+    from physics_experiments import screen_verdict
+
+    rule = {"beta_tolerance": 0.005, "band_gain": 0, "rate_gain": 2.0, "wind_factor_band": (0.006, 0.010)}
+    keys = ("beta_space", "pdf_tail_exponent_shear", "pdf_tail_exponent_divergence",
+            "localisation_half_shear_area_fraction", "shear_divergence_r2", "mean_total_deformation_rate_per_day")
+    closed = dict(zip(keys, (0.0513, 2.383, 2.396, 0.0577, 0.7208, 0.008373)), wind_factor=0.00749)
+    closed_ref = dict(zip(keys, (0.0467, 2.319, 2.113, 0.0485, 0.7583, 0.001800)))
+    strait = dict(zip(keys, (0.0596, 2.636, 2.454, 0.0620, 0.7056, 0.008180)), wind_factor=0.00788)
+    strait_ref = dict(zip(keys, (0.0552, 2.240, 2.160, 0.0509, 0.7305, 0.002151)))
+    v = screen_verdict(closed, closed_ref, **rule)
+    assert v["bands_inside"] == {"candidate": 3, "reference": 3} and v["passes"]
+    assert v["rate_ratio"] == pytest.approx(4.65, abs=0.01) and v["beta_further_by"] < 0
+    v = screen_verdict(strait, strait_ref, **rule)
+    assert v["bands_inside"] == {"candidate": 2, "reference": 3} and not v["bands_ok"] and not v["passes"]
+    assert v["rate_gain_ok"] and v["wind_factor_ok"] and v["beta_ok"]
+    assert not screen_verdict({**closed, "wind_factor": 0.0055}, closed_ref, **rule)["passes"]
+    slow = {**closed, "mean_total_deformation_rate_per_day": 1.9 * closed_ref["mean_total_deformation_rate_per_day"]}
+    v = screen_verdict(slow, closed_ref, **rule)
+    assert not v["rate_gain_ok"] and not v["passes"]
+    # the rule of 2026-11-26 (one band more) fails the closed basin's 3 against 3
+    assert not screen_verdict(closed, closed_ref, beta_tolerance=0.005)["passes"]
+
+
 def test_validation_headline_reports_the_wind_factor_against_its_band():
     """benchmarks/validate.py's headline row of the wind factor: ✓ inside Thorndike and Colony's
     band, ✗ outside, – for a run without a drift response (no drifters, or not the climatology)."""
