@@ -786,6 +786,11 @@ _STR50HNULL_LONG = ("str50hnull-long", _STR50HNULL_LONG_SET,
                     "thick-and-thin, strength halved with hnull, 56-day spin-up")
 add_weather_ensemble(*_STR50HNULL_LONG, ENSEMBLE_SEEDS)
 add_weather_ensemble(*_STR50HNULL_LONG, ENSEMBLE_SEEDS + MORE_SEEDS, suffix=", eight months")
+# Result (2026-11-27, fourteenth session): stage 1 FAILS in the closed basin: 2 bands inside against
+# 3 (the shear tail 2.62 leaves its band) and the median wind factor 0.0058, below 0.006 (rate x4.7,
+# beta 0.0035 closer). The strait passes (2 against 2, rate x3.9, wind factor 0.0062). Stage 2 not
+# run; nothing shipped. The 56-day pack is 0.23 m thicker and drifts 6-16 % less than the 14-day
+# one in every month-basin, and spreads its shear in five of the six months after the first.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
