@@ -792,6 +792,24 @@ add_weather_ensemble(*_STR50HNULL_LONG, ENSEMBLE_SEEDS + MORE_SEEDS, suffix=", e
 # run; nothing shipped. The 56-day pack is 0.23 m thicker and drifts 6-16 % less than the 14-day
 # one in every month-basin, and spreads its shear in five of the six months after the first.
 
+# --- 2026-11-27 (fourteenth session): the halved strength with hnull and neXtSIM's compressive
+# term (a diagnostic) -------------------------------------------------------------------------
+# The two sets nearest to passing push the localisation in opposite directions. The halved
+# strength with hnull (str50hnullsp) drifts like the observed pack but spreads its shear (its
+# strait failed stage 2 on the shear tail 2.64 and R2 0.706). neXtSIM's compressive term (PMAX,
+# sourced) over-localised the shipped set (tails 1.9-2.0, half-shear area 3.6-3.7 % over eight
+# months) and raised its rate x1.5-1.9 and its wind factor a little (0.0034 -> 0.0038 closed).
+# Both together, the validation month in each basin from the str50hnullsp spin-up state (made
+# without the term; its own spin-up would follow for a screen).
+# Stated before the runs (2026-11-27, 08:50 UTC): a lead if both basins put 4 or more bands of
+# six inside with the wind factor in its band (0.006-0.010) and the median rate at 0.005 day-1 or
+# more (str50hnullsp's validation month: 3 bands in each basin); it decides nothing.
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    EXPERIMENTS[f"{_p}-hthick-str50hnullsp-P"] = (
+        _basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull") + PMAX, 10e3, 28,
+        f"{_p}-hthick-str50hnullsp with neXtSIM's compressive term (diagnostic)")
+
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
