@@ -808,6 +808,23 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-str50hnullsp-P"] = (
         _basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull") + PMAX, 10e3, 28,
         f"{_p}-hthick-str50hnullsp with neXtSIM's compressive term (diagnostic)")
+# Result (2026-11-27, fourteenth session): NOT a lead. The term spreads this set's shear instead of
+# localising it: closed 2 bands inside (tails 2.91 / 3.97; half-shear area 6.8 %, rate 0.0101),
+# strait 2 (tails 2.74 / 2.63, 5.4 %, R2 0.708, rate 0.0098); str50hnullsp's month had 3 and 3.
+#
+# Why the opposite of the shipped set? With C_lab halved the envelope sits lower while P_max
+# (10 kPa h^1.5) does not, so damaged ice under compression keeps more stress above the
+# envelope before it may creep. neXtSIM pairs P* = 10 kPa with its own C_lab (2 MPa in its
+# form, 2.8 MPa in lagice's). A diagnostic of that ratio (it decides nothing; P* = 5 kPa is a
+# calibration by that ratio, not a source): the same month with P* halved with C_lab.
+# Stated before the runs (2026-11-27, 09:06 UTC): the ratio is the cause if both basins' shear
+# tails come back by 0.3 or more towards the str50hnullsp month's (2.15, 2.41); a lead if both
+# basins put 4 or more bands inside with the wind factor in 0.006-0.010 and the rate >= 0.005.
+PMAX_HALF = ["rheology.max_pressure_pa=5e3", "rheology.max_pressure_thickness_exponent=1.5"]
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    EXPERIMENTS[f"{_p}-hthick-str50hnullsp-P50"] = (
+        _basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull") + PMAX_HALF, 10e3, 28,
+        f"{_p}-hthick-str50hnullsp with the compressive term's P* halved with C_lab (diagnostic)")
 
 
 def command(scene, overrides, res, days, out) -> list:
