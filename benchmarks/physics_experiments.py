@@ -812,9 +812,10 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # localising it: closed 2 bands inside (tails 2.91 / 3.97; half-shear area 6.8 %, rate 0.0101),
 # strait 2 (tails 2.74 / 2.63, 5.4 %, R2 0.708, rate 0.0098); str50hnullsp's month had 3 and 3.
 #
-# Why the opposite of the shipped set? With C_lab halved the envelope sits lower while P_max
-# (10 kPa h^1.5) does not, so damaged ice under compression keeps more stress above the
-# envelope before it may creep. neXtSIM pairs P* = 10 kPa with its own C_lab (2 MPa in its
+# (wind factor 0.0067 and 0.0071, inside its band.) Why the opposite of the shipped set? A
+# hypothesis: with C_lab halved the envelope caps the stress lower while P_max (10 kPa h^1.5)
+# stays, so more of the compressed damaged ice sits below P_max, cannot creep, and sheds its
+# stress only by more damage. neXtSIM pairs P* = 10 kPa with its own C_lab (2 MPa in its
 # form, 2.8 MPa in lagice's). A diagnostic of that ratio (it decides nothing; P* = 5 kPa is a
 # calibration by that ratio, not a source): the same month with P* halved with C_lab.
 # Stated before the runs (2026-11-27, 09:06 UTC): the ratio is the cause if both basins' shear
