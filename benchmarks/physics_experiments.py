@@ -826,6 +826,9 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-str50hnullsp-P50"] = (
         _basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull") + PMAX_HALF, 10e3, 28,
         f"{_p}-hthick-str50hnullsp with the compressive term's P* halved with C_lab (diagnostic)")
+# Result (2026-11-27, fourteenth session): the ratio is NOT the cause, and not a lead. Closed: the
+# shear tail stays at 2.91 (the |divergence| tail 3.97 -> 2.81), 2 bands inside; strait: tails 2.97 /
+# 2.80, 1 band. Wind factor 0.0073 and 0.0080, rate 0.0101 and 0.0095, beta 0.074 and 0.093.
 
 
 def command(scene, overrides, res, days, out) -> list:
