@@ -831,6 +831,25 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # 2.80, 1 band. Wind factor 0.0073 and 0.0080, rate 0.0101 and 0.0095, beta 0.074 and 0.093.
 
 
+# --- 2026-11-27 (fourteenth session): ocean eddies under the halved-strength pack (a diagnostic)
+# The eddy diagnostic of 2026-11-26 (EDDIES: 10 cm/s, R = 30 km, both senses) raised the shipped
+# pack's beta by 0.014 only, and its rate fell (0.0024 -> 0.0013 per day): that pack did not
+# follow the eddies, and their drag held it. An eddy's drag across its diameter (about
+# 1025 kg m-3 * 5.5e-3 * (0.1 m/s)^2 * 60 km = 3.4 kN per metre) is about a quarter of what
+# breaks 1.6 m of the shipped pack along 60 km (cohesion about 9 kPa at 10 km: 14 kN per metre),
+# and about half for the halved strength (about 4.4 kPa: 7 kN per metre). So the pack that
+# drifts like the observed one may follow eddies where the shipped one could not. The eddies
+# under the str50hnullsp set, validation month, both basins, from its spin-up state.
+# Stated before the runs (2026-11-27, 09:30 UTC), as for the eddies of 2026-11-26: a lead for
+# beta if beta (>= 10 boxes) rises by 0.04 or more over the month without eddies (closed 0.052,
+# strait 0.068) in both basins with no band lost; not adopted either way (the amplitude is
+# not sourced, and one month is one month).
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    EXPERIMENTS[f"{_p}-hthick-str50hnullsp-eddies"] = (
+        _basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull") + EDDIES, 10e3, 28,
+        f"{_p}-hthick-str50hnullsp with ocean eddies of both senses, 10 cm/s, R = 30 km (diagnostic)")
+
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
