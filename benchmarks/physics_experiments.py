@@ -848,6 +848,9 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-str50hnullsp-eddies"] = (
         _basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull") + EDDIES, 10e3, 28,
         f"{_p}-hthick-str50hnullsp with ocean eddies of both senses, 10 cm/s, R = 30 km (diagnostic)")
+# Result (2026-11-27, fourteenth session): not a lead. beta 0.052 -> 0.069 (closed), 0.068 -> 0.053
+# (strait); each basin loses a band (the shear tail: 2.68, 2.65); the rate holds (0.0089, 0.0085),
+# unlike the shipped pack's; R2 falls 0.02-0.05. What the eddies add is diffuse.
 
 
 def command(scene, overrides, res, days, out) -> list:
