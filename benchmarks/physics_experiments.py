@@ -790,7 +790,7 @@ add_weather_ensemble(*_STR50HNULL_LONG, ENSEMBLE_SEEDS + MORE_SEEDS, suffix=", e
 # 3 (the shear tail 2.62 leaves its band) and the median wind factor 0.0058, below 0.006 (rate x4.7,
 # beta 0.0035 closer). The strait passes (2 against 2, rate x3.9, wind factor 0.0062). Stage 2 not
 # run; nothing shipped. The 56-day pack is 0.23 m thicker and drifts 6-16 % less than the 14-day
-# one in every month-basin, and spreads its shear in five of the six months after the first.
+# one in every month-basin, and spreads its shear in five of the six other month-basins.
 
 # --- 2026-11-27 (fourteenth session): the halved strength with hnull and neXtSIM's compressive
 # term (a diagnostic) -------------------------------------------------------------------------
@@ -811,9 +811,9 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # Result (2026-11-27, fourteenth session): NOT a lead. The term spreads this set's shear instead of
 # localising it: closed 2 bands inside (tails 2.91 / 3.97; half-shear area 6.8 %, rate 0.0101),
 # strait 2 (tails 2.74 / 2.63, 5.4 %, R2 0.708, rate 0.0098); str50hnullsp's month had 3 and 3.
+# The wind factor stays in its band (0.0067 and 0.0071).
 #
-# (wind factor 0.0067 and 0.0071, inside its band.) Why the opposite of the shipped set? A
-# hypothesis: with C_lab halved the envelope caps the stress lower while P_max (10 kPa h^1.5)
+# Why the opposite of the shipped set? A hypothesis: with C_lab halved the envelope caps the stress lower while P_max (10 kPa h^1.5)
 # stays, so more of the compressed damaged ice sits below P_max, cannot creep, and sheds its
 # stress only by more damage. neXtSIM pairs P* = 10 kPa with its own C_lab (2 MPa in its
 # form, 2.8 MPa in lagice's). A diagnostic of that ratio (it decides nothing; P* = 5 kPa is a
