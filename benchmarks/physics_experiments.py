@@ -814,10 +814,11 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # The wind factor stays in its band (0.0067 and 0.0071).
 #
 # Why the opposite of the shipped set? A hypothesis: with C_lab halved the envelope caps the
-# stress lower while P_max (10 kPa h^1.5) stays, so more of the compressed damaged ice sits
-# below P_max, cannot creep, and sheds its stress only by more damage. neXtSIM pairs P* = 10 kPa with its own C_lab (2 MPa in its
-# form, 2.8 MPa in lagice's). A diagnostic of that ratio (it decides nothing; P* = 5 kPa is a
-# calibration by that ratio, not a source): the same month with P* halved with C_lab.
+# stress lower while P_max (10 kPa h^1.5) stays, so more of the compressed damaged ice sits below
+# P_max, cannot creep, and sheds its stress only by more damage. neXtSIM pairs P* = 10 kPa with
+# its own C_lab (2 MPa in its form, 2.8 MPa in lagice's). A diagnostic of that ratio (it decides
+# nothing; P* = 5 kPa is a calibration by that ratio, not a source): the same month with P*
+# halved with C_lab.
 # Stated before the runs (2026-11-27, 09:06 UTC): the ratio is the cause if both basins' shear
 # tails come back by 0.3 or more towards the str50hnullsp month's (2.15, 2.41); a lead if both
 # basins put 4 or more bands inside with the wind factor in 0.006-0.010 and the rate >= 0.005.
