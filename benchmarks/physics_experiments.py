@@ -716,15 +716,23 @@ add_weather_ensemble(*_STR50HNULL, ENSEMBLE_SEEDS + MORE_SEEDS, suffix=", eight 
 # R2 0.706 leave their bands; wind factor 0.0079, rate x3.8). Not shipped; the EVP and +-50 %
 # runs queued for the case that it passed were stopped and their definitions removed.
 
+
+def add_str50hnull_month(tag: str, extra: list, what: str) -> None:
+    """The validation month of the str50hnullsp set (C_lab halved, hnull = 0.25 m, from the
+    ``H1125-str50-hnull`` spin-up state) with ``extra`` overrides, in both basins:
+    ``F10-hthick-str50hnullsp-{tag}`` / ``F10s-...``, described as the set ``with {what}``."""
+    for basin, p in (("closed", "F10"), ("strait", "F10s")):
+        EXPERIMENTS[f"{p}-hthick-str50hnullsp-{tag}"] = (
+            basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull") + extra, 10e3, 28,
+            f"{p}-hthick-str50hnullsp with {what} (diagnostic)")
+
+
 # A diagnostic after stage 2 (2026-11-27, twelfth session; no rule: it decides nothing, it asks
 # what the next screen should be). The set screened last drifts like the observed pack and
 # spreads its shear; the strength correlated over 50 km came nearest to passing its screen
 # (4 bands inside against 3 in each basin) and localises. Both together, the validation month
 # in each basin from the halved strength's own spin-up state.
-for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
-    EXPERIMENTS[f"{_p}-hthick-str50hnullsp-cor50"] = (
-        _basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull") + CORRELATED_STRENGTH, 10e3, 28,
-        f"{_p}-hthick-str50hnullsp with the strength correlated over 50 km (diagnostic)")
+add_str50hnull_month("cor50", CORRELATED_STRENGTH, "the strength correlated over 50 km")
 
 
 # --- 2026-11-27 (thirteenth session): a spin-up four times longer (a diagnostic) -----------
@@ -804,10 +812,7 @@ add_weather_ensemble(*_STR50HNULL_LONG, ENSEMBLE_SEEDS + MORE_SEEDS, suffix=", e
 # Stated before the runs (2026-11-27, 08:50 UTC): a lead if both basins put 4 or more bands of
 # six inside with the wind factor in its band (0.006-0.010) and the median rate at 0.005 day-1 or
 # more (str50hnullsp's validation month: 3 bands in each basin); it decides nothing.
-for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
-    EXPERIMENTS[f"{_p}-hthick-str50hnullsp-P"] = (
-        _basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull") + PMAX, 10e3, 28,
-        f"{_p}-hthick-str50hnullsp with neXtSIM's compressive term (diagnostic)")
+add_str50hnull_month("P", PMAX, "neXtSIM's compressive term")
 # Result (2026-11-27, fourteenth session): NOT a lead. The term spreads this set's shear instead of
 # localising it: closed 2 bands inside (tails 2.91 / 3.97; half-shear area 6.8 %, rate 0.0101),
 # strait 2 (tails 2.74 / 2.63, 5.4 %, R2 0.708, rate 0.0098); str50hnullsp's month had 3 and 3.
@@ -823,10 +828,7 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # tails come back by 0.3 or more towards the str50hnullsp month's (2.15, 2.41); a lead if both
 # basins put 4 or more bands inside with the wind factor in 0.006-0.010 and the rate >= 0.005.
 PMAX_HALF = ["rheology.max_pressure_pa=5e3", "rheology.max_pressure_thickness_exponent=1.5"]
-for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
-    EXPERIMENTS[f"{_p}-hthick-str50hnullsp-P50"] = (
-        _basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull") + PMAX_HALF, 10e3, 28,
-        f"{_p}-hthick-str50hnullsp with the compressive term's P* halved with C_lab (diagnostic)")
+add_str50hnull_month("P50", PMAX_HALF, "the compressive term's P* halved with C_lab")
 # Result (2026-11-27, fourteenth session): the ratio is NOT the cause, and not a lead. Closed: the
 # shear tail stays at 2.91 (the |divergence| tail 3.97 -> 2.81), 2 bands inside; strait: tails 2.97 /
 # 2.80, 1 band. Wind factor 0.0073 and 0.0080, rate 0.0101 and 0.0095, beta 0.074 and 0.093.
@@ -845,10 +847,7 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # beta if beta (>= 10 boxes) rises by 0.04 or more over the month without eddies (closed 0.052,
 # strait 0.068) in both basins with no band lost; not adopted either way (the amplitude is
 # not sourced, and one month is one month).
-for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
-    EXPERIMENTS[f"{_p}-hthick-str50hnullsp-eddies"] = (
-        _basin, HALF_STRENGTH + HNULL + from_spinup("H1125-str50-hnull") + EDDIES, 10e3, 28,
-        f"{_p}-hthick-str50hnullsp with ocean eddies of both senses, 10 cm/s, R = 30 km (diagnostic)")
+add_str50hnull_month("eddies", EDDIES, "ocean eddies of both senses, 10 cm/s, R = 30 km")
 # Result (2026-11-27, fourteenth session): not a lead. beta 0.052 -> 0.069 (closed), 0.068 -> 0.053
 # (strait); each basin loses a band (the shear tail: 2.68, 2.65); the rate holds (0.0089, 0.0085),
 # unlike the shipped pack's; R2 falls 0.02-0.05. What the eddies add is diffuse.
