@@ -853,6 +853,36 @@ add_str50hnull_month("eddies", EDDIES, "ocean eddies of both senses, 10 cm/s, R 
 # unlike the shipped pack's; R2 falls 0.02-0.05. What the eddies add is diffuse.
 
 
+# --- 2026-11-27 (fifteenth session): damaged ice that keeps its pressure (a diagnostic) --------
+# beta split into its parts (benchmarks/beta_components.py, validation month, six runs on disk):
+# the shear part alone has beta 0.054-0.084, the divergence part -0.012-0.082, and the interior
+# converges coherently (median net-divergence ratio sum(div A)/sum(|div| A) -0.44 to -0.73: most
+# elements close at once). A part with one sign everywhere does not cancel between scales, so it
+# holds beta down. Girard et al. (2009) call such patches of convergence in a winter pack
+# incompatible with a fractured plate, whose convergence is localised on faults. In Maxwell-EB the
+# relaxation sigma/lambda relaxes the mean stress of damaged ice as freely as its deviator: read
+# as a flow rule it compacts (docs/physics.md, "Why the faults are steep"), so damaged ice
+# anywhere creeps closed under the wind's load. rheology.relax_mean_stress = false relaxes the
+# deviator only (damaged ice still flows in shear; it converges elastically, or at damage events).
+# Run in the validation month of two packs: the shipped set from its spin-up (a fresh run of the
+# shipped month alongside, F10-hthick-1125-ref, so that the same diagnostics exist for it), and
+# the str50hnullsp set from its spin-up. Both spin-ups were made with the whole stress relaxing.
+# Stated before the runs (2026-11-27, 10:30 UTC), for each pack: the mechanism holds if the median
+# net-divergence ratio's magnitude halves in both basins; a lead for beta if beta (>= 10 boxes)
+# rises by 0.04 or more in both basins with no band of the six lost (as for the eddies). Predicted:
+# beta rises, but at most to its shear part's (0.07-0.08), so not into 0.17-0.20. It decides
+# nothing (the option has no source; it is a diagnostic of where beta is lost).
+KEEP_MEAN = ["rheology.relax_mean_stress=false"]
+add_str50hnull_month("keepmean", KEEP_MEAN, "the mean stress of damaged ice kept (deviatoric relaxation)")
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    EXPERIMENTS[f"{_p}-hthick-1125-keepmean"] = (
+        _basin, from_spinup("H1125") + KEEP_MEAN, 10e3, 28,
+        f"{_p}-hthick-1125 with the mean stress of damaged ice kept (diagnostic)")
+    EXPERIMENTS[f"{_p}-hthick-1125-ref"] = (
+        _basin, from_spinup("H1125"), 10e3, 28,
+        f"{_p}-hthick-1125 run again on today's code (its run folder, for beta_components.py)")
+
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]

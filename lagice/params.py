@@ -51,6 +51,14 @@ class MaxwellEBParams:
             ``dynamics.compression_factor`` = 10 kPa, ``exponent_compression_factor`` = 1.5
             (``model/finiteelement.cpp``, ``updateSigmaDamage``); explicit stepper only (CPU and CUDA)
         max_pressure_thickness_exponent: k of P_max [-] (neXtSIM: 1.5)
+        relax_mean_stress: True (Dansereau et al. 2016, neXtSIM): the Maxwell relaxation σ/λ acts
+            on the whole stress, so damaged ice creeps in convergence as freely as in shear.
+            False (a diagnostic of lagice, 2026-11-27; docs/physics.md §4, "Damaged ice that keeps
+            its pressure"): it acts on the deviatoric stress σ − m I only, m = (σ1 + σ2)/2, and
+            the mean normal stress of damaged ice does not creep; with ``max_pressure_pa`` set the
+            mean takes the compressive term's factor above (it creeps where it is tensile or
+            compressive beyond P_max). The ice then converges elastically, at damage events or
+            above P_max. Explicit CPU stepper only
     """
 
     poisson: float = 0.3
@@ -69,6 +77,7 @@ class MaxwellEBParams:
     stress_correction_mean_fraction: float | None = None
     max_pressure_pa: float | None = None
     max_pressure_thickness_exponent: float = 1.5
+    relax_mean_stress: bool = True
 
     def __post_init__(self):
         check_range("poisson (ν)", self.poisson, 0.0, 0.5, high_open=True)
@@ -88,6 +97,8 @@ class MaxwellEBParams:
         if self.max_pressure_pa is not None:
             check_range("max_pressure_pa (P*)", self.max_pressure_pa, 0.0, 1e7, unit="Pa")
         check_range("max_pressure_thickness_exponent (k)", self.max_pressure_thickness_exponent, 0.0, 3.0)
+        if not isinstance(self.relax_mean_stress, bool):
+            raise ConfigError(f"rheology.relax_mean_stress = {self.relax_mean_stress!r}: expected true or false")
         if self.stress_correction not in STRESS_CORRECTIONS:
             raise ConfigError(f"rheology.stress_correction = {self.stress_correction!r}: expected one of "
                               f"{list(STRESS_CORRECTIONS)}")

@@ -142,6 +142,10 @@ def test_outputs_readable(heal_run):
      "stepper only \\(CPU and CUDA\\); solver.name = 'implicit'"),
     ({"rheology.max_pressure_pa": -1.0}, "max_pressure_pa \\(P\\*\\) = -1.0 Pa is out of range"),
     ({"rheology.max_pressure_thickness_exponent": 4.0}, "max_pressure_thickness_exponent \\(k\\) = 4.0"),
+    ({"rheology.relax_mean_stress": False},
+     "rheology.relax_mean_stress = false is implemented in the explicit stepper on the CPU only; "
+     "solver.name = 'implicit'"),
+    ({"rheology.relax_mean_stress": "no"}, "relax_mean_stress"),
 ])
 def test_bad_input_fails_before_meshing(ov, match, monkeypatch, tmp_path):
     import lagice.scenes.builder as mod

@@ -58,7 +58,7 @@ def test_element_kernel_damage_matches_rheology(kernel):
     kc, kt = envelope_factors(rheo)
     e_dt, gam = np.zeros(m), np.ones(m)
     kernel(tri, zeros3, zeros3, np.zeros((1, 2)), s2, d2, conc_factor, coh, kc, kt, td, heal, e_dt, gam, None,
-           7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, p.alpha, flag)
+           None, 7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, p.alpha, flag)
     assert (dc < 1).sum() > 100
     assert np.allclose(s2, s1, rtol=1e-13, atol=1e-13 * np.abs(s1).max())
     assert np.allclose(d2, d1, rtol=1e-13, atol=1e-15)
@@ -101,7 +101,7 @@ def test_element_kernel_stress_update_uses_rheology_moduli(kernel):
         kc, kt = envelope_factors(rheo)
         E, lam = rheo.moduli(damage, conc)
         kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, conc_factor, np.full(m, 1e15), kc, kt,
-               np.full(m, 20.0), np.zeros(m), dt_s * E, lam / (lam + dt_s), None, dt_s, *rheo.K[0, :2],
+               np.full(m, 20.0), np.zeros(m), dt_s * E, lam / (lam + dt_s), None, None, dt_s, *rheo.K[0, :2],
                rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, float(alpha),
                np.zeros(m, np.int8))
         eps = strain_rate(mesh.triangles, b, c, vel)
@@ -137,7 +137,7 @@ def test_alpha4_builds_equal_general_builds():
         sigma, d, flag = sigma0.copy(), damage0.copy(), np.zeros(m, np.int8)
         e_dt, gam = dt_s * E, lam / (lam + dt_s)
         capped = kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, np.full(m, 0.9),
-                        coh, kc, kt, np.full(m, 30.0), np.full(m, 1e-6), e_dt, gam, None, dt_s, *rheo.K[0, :2],
+                        coh, kc, kt, np.full(m, 30.0), np.full(m, 1e-6), e_dt, gam, None, None, dt_s, *rheo.K[0, :2],
                         rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
         out.append((sigma, d, flag, capped, e_dt, gam))
     assert 0 < out[0][2].sum() < m  # some elements damage, some do not
@@ -283,6 +283,51 @@ def test_max_pressure_is_refused_where_it_is_not_implemented():
     from lagice.solvers.implicit import ImplicitSolver
     with pytest.raises(ConfigError, match="max_pressure_pa = 10000.0: the implicit solver"):
         ImplicitSolver(MaxwellEB(max_pressure_pa=10e3), mesh=None)
+
+
+def test_deviatoric_relaxation_keeps_the_mean_stress():
+    """``rheology.relax_mean_stress = False``: with no motion (uniform stress, boundary nodes
+    coast) a stress m I + s relaxes to m I + s γ^n, γ = λ/(λ + Δt_s): the mean normal stress
+    does not creep, where the default relaxes the whole tensor by γ^n. With neXtSIM's
+    compressive term as well, the mean follows that term's recursion towards P_max (as in
+    the test above) while the deviator still decays by γ^n; below P_max the mean is kept."""
+    poly, _ = rectangle_domain(50e3, 50e3)
+    mesh = generate_mesh(poly, 10e3)
+    lam, dts, h, n_steps = 900.0, 5.0, 2.0, 120
+    gn = (lam / (lam + dts)) ** (6 * n_steps)
+    dev = np.array([2e3, -2e3, 1e3])
+
+    def run(mean, **kw):
+        s = ExplicitSolver(MaxwellEB(relaxation_time_s=lam, healing_time_s=None, **kw), mesh, substeps=6)
+        st = IceState.uniform(mesh, cohesion_pa=1e12, thickness_m=h)
+        st.stress[:] = dev + [mean, mean, 0.0]
+        for _ in range(n_steps):
+            step(s, st, 6 * dts)
+        assert np.abs(st.velocity).max() < 1e-12
+        return st.stress
+
+    m0 = -30e3
+    whole = run(m0)
+    assert np.allclose(whole, (dev + [m0, m0, 0.0]) * gn, rtol=1e-12, atol=0)
+    kept = run(m0, relax_mean_stress=False)
+    assert np.allclose(kept, dev * gn + [m0, m0, 0.0], rtol=1e-12, atol=1e-9)
+    assert gn < 0.1  # the deviator relaxed by more than 90 %: the test can tell the two apart
+    pmax = 10e3 * h ** 1.5
+    p_ref = 3.0 * pmax
+    for _ in range(6 * n_steps):
+        p_ref = p_ref * lam / (lam + dts * (1.0 - pmax / p_ref))
+    both = run(-3.0 * pmax, relax_mean_stress=False, max_pressure_pa=10e3)
+    assert np.allclose(both, dev * gn + [-p_ref, -p_ref, 0.0], rtol=1e-12, atol=1e-9)
+    below = run(-0.5 * pmax, relax_mean_stress=False, max_pressure_pa=10e3)
+    assert np.allclose(below, dev * gn + [-0.5 * pmax, -0.5 * pmax, 0.0], rtol=1e-12, atol=1e-9)
+
+
+def test_deviatoric_relaxation_is_refused_where_it_is_not_implemented():
+    from lagice.solvers.implicit import ImplicitSolver
+    with pytest.raises(ConfigError, match="relax_mean_stress = False: the implicit solver relaxes the whole"):
+        ImplicitSolver(MaxwellEB(relax_mean_stress=False), mesh=None)
+    with pytest.raises(ConfigError, match="relax_mean_stress = 1: expected true or false"):
+        MaxwellEB(relax_mean_stress=1)
 
 
 def test_partial_dirichlet_component():

@@ -313,6 +313,13 @@ class MaxwellEB:
             raise ConfigError(f"rheology.stress_correction = {self.params.stress_correction!r}: the explicit "
                               "stepper corrects towards the origin only (the option is in the implicit solver)")
 
+    def require_whole_relaxation(self, where: str):
+        """Raise :class:`ConfigError` if ``relax_mean_stress`` is false: only the explicit CPU
+        stepper relaxes the deviatoric stress alone, and ``where`` must not ignore it."""
+        if not self.params.relax_mean_stress:
+            raise ConfigError(f"rheology.relax_mean_stress = False: {where} relaxes the whole stress (the "
+                              "deviatoric-only relaxation is in the explicit CPU stepper)")
+
     def require_no_max_pressure(self, where: str):
         """Raise :class:`ConfigError` if neXtSIM's compressive term (``max_pressure_pa``) is
         set: only the explicit stepper (CPU and CUDA) implements it, and ``where`` must not ignore it."""

@@ -335,6 +335,7 @@ class CudaExplicitSolver:
         if not isinstance(rheology, MaxwellEB):
             raise ConfigError(f"the explicit stepper solves the Maxwell-EB rheology; got {type(rheology).__name__}")
         rheology.require_origin_correction()
+        rheology.require_whole_relaxation("the CUDA explicit stepper")
         if substeps is not None:
             if int(substeps) != substeps or int(substeps) < 1:
                 raise ConfigError(f"substeps = {substeps!r} must be an integer >= 1 (or None: automatic)")

@@ -199,7 +199,7 @@ _ALPHA_IS_4 = False
 
 
 def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion, kc, kt,
-                           td, heal_rate, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q, denom,
+                           td, heal_rate, e_dt, gamma, pmax, keep_mean, dt_s, kxx, kxy, kss, q, denom,
                            max_damage, E0, lambda0, alpha, damaged_flag):
     """Maxwell stress update and damage/healing of one sub-step, in place (module doc, step 2).
 
@@ -216,6 +216,10 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     nothing for it): where the mean stress σn of the previous sub-step is compressive, the
     relaxation factor is λ/(λ + Δt_s (1 − P̃)), P̃ = min(1, pmax/(−σn)), computed from γ
     as γ/(γ + (1 − γ)(1 − P̃)) (neXtSIM's ``updateSigmaDamage``).
+    keep_mean: None (rheology.relax_mean_stress true, the default; pruned as pmax is): the
+    relaxation factor scales the whole stress. True: it scales the deviatoric stress
+    σ − m I only (m = (σxx + σyy)/2 after the elastic increment), and the mean m is kept, or,
+    with pmax, scaled by the compressive term's factor (it creeps in tension and above P_max).
     Returns the number of elements whose damage hit the cap.
     """
     m = tri.shape[0]
@@ -224,14 +228,24 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
         exx, eyy, exy = element_strain_rate(tri, b, c, vel, e)
         ed = e_dt[e]
         g = gamma[e]
+        gp = g
         if pmax is not None:
             sn = -0.5 * (sigma[e, 0] + sigma[e, 1])
             if sn > 0.0:
                 pt = min(1.0, pmax[e] / sn)
-                g = g / (g + (1.0 - g) * (1.0 - pt))
-        sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * g
-        syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * g
-        sxy = (sigma[e, 2] + ed * (kss * exy)) * g
+                gp = g / (g + (1.0 - g) * (1.0 - pt))
+        if keep_mean is None:
+            sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * gp
+            syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * gp
+            sxy = (sigma[e, 2] + ed * (kss * exy)) * gp
+        else:
+            axx = sigma[e, 0] + ed * (kxx * exx + kxy * eyy)
+            ayy = sigma[e, 1] + ed * (kxy * exx + kxx * eyy)
+            am = 0.5 * (axx + ayy)
+            gm = 1.0 if pmax is None else gp
+            sxx = (axx - am) * g + am * gm
+            syy = (ayy - am) * g + am * gm
+            sxy = (sigma[e, 2] + ed * (kss * exy)) * g
         # damage and stress correction: rheology.damage_step (both healing forms, by the sign of
         # heal_rate), as in rheology.damage_update_kernel.
         # Cheap test first: strictly inside the envelope (s1 < σT and q s1 − s2 < σc) _dcrit
@@ -289,8 +303,8 @@ PARALLEL_MIN_ELEMENTS = PARALLEL_MIN_SIZE
 
 @njit(cache=True, error_model="numpy")
 def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
-                      c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q,
-                      denom, max_damage, E0, lambda0, alpha, flag):
+                      c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, dt_s, kxx, kxy,
+                      kss, q, denom, max_damage, E0, lambda0, alpha, flag):
     """All ``n_sub`` sub-steps of one outer step in compiled code (one call per outer
     step, no Python per sub-step): the node kernel then the element kernel, serial
     builds; the same calls as a Python loop over the kernels, bit-identical results."""
@@ -299,15 +313,15 @@ def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t,
         node_velocity_kernel_serial(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
                                     (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel_serial(
-            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy,
-            kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, dt_s,
+            kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
 
 @njit(cache=True, error_model="numpy")
 def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
-                      c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q,
-                      denom, max_damage, E0, lambda0, alpha, flag):
+                      c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, dt_s, kxx, kxy,
+                      kss, q, denom, max_damage, E0, lambda0, alpha, flag):
     """:func:`substeps_serial` with the parallel kernel builds (one fork/join per
     kernel and sub-step, launched from compiled code)."""
     n_capped = 0
@@ -315,8 +329,8 @@ def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_
         node_velocity_kernel(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
                              (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel(
-            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy,
-            kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, dt_s,
+            kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
 
@@ -541,8 +555,8 @@ class ExplicitSolver:
     def _profiled_substeps(self, par, n_sub, args):
         """The sub-step loop in Python with each kernel timed (``profile_kernels``)."""
         (vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b, c, damage, conc_factor,
-         coh, kc, kt, td, heal, e_dt, gamma, pmax, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha,
-         flag) = args
+         coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0,
+         alpha, flag) = args
         node_k = node_velocity_kernel if par else node_velocity_kernel_serial
         elem_k = element_kernels(alpha)[int(par)]
         n_capped = 0
@@ -552,7 +566,8 @@ class ExplicitSolver:
             node_k(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, (k + 1) / n_sub)
             tb = time.perf_counter()
             n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma,
-                               pmax, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+                               pmax, keep_mean, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha,
+                               flag)
             tc = time.perf_counter()
             tn += tb - ta
             tm += tc - tb
@@ -589,6 +604,7 @@ class ExplicitSolver:
         rh = self.rheology
         pmax = rh.max_pressure(state.thickness, state.concentration)  # None: off
         pmax = None if pmax is None else np.ascontiguousarray(pmax, np.float64)
+        keep_mean = None if p.relax_mean_stress else True
         heal = (self.heal_rate(state, t_s) if self.heal_rate is not None
                 else self.rheology.constant_heal_rate(mesh.n_elements))
         heal = np.ascontiguousarray(heal, np.float64)
@@ -607,8 +623,9 @@ class ExplicitSolver:
 
         ptr32, elems32, tri32 = self._indices(mesh)
         args = (vel, vel_sum, sigma, ptr32, elems32, su.w, nc, terms.cos_turn, terms.sin_turn, ns.fixed, pres0,
-                pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, k_c, k_t, self.td, heal, e_dt, gamma, pmax, dt_s,
-                kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), flag)
+                pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, k_c, k_t, self.td, heal, e_dt, gamma, pmax,
+                keep_mean, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s,
+                float(p.alpha), flag)
         if self.kernel_choice is None or (
                 self.parallel_setting is None
                 and time.perf_counter() - self._tuned_at > (

@@ -1,0 +1,105 @@
+"""β split into its shear and divergence parts, and how coherently the pack converges
+(docs/physics.md §4, "Damaged ice that keeps its pressure").
+
+β is the slope of ⟨ε̇tot⟩(L), the mean over boxes of width L of the total deformation rate of
+the box (:func:`lagice.diagnostics.spatial_scaling`). The box's velocity gradient is the
+area-weighted mean of its elements' gradients, so a box rate is smaller than the mean of its
+elements' rates only where their gradients *cancel*: opposite senses of shear, shear along
+different directions, opening next to closing. A part of the deformation that has the same sign
+everywhere (a pack that converges everywhere) does not cancel and has β = 0 whatever its
+localisation. This script splits each element's velocity gradient into its isotropic part
+(ε̇I / 2 · I, the divergence) and the rest (the shear), and fits β to each part alone, with the
+estimator of the validation (3-day windows from day 1, the 100 km coast buffer, widths with at
+least 10 boxes). It also prints, per window, the *net-divergence ratio*
+Σ ε̇I A / Σ |ε̇I| A over the interior's elements (A: area): −1 where every element converges,
+0 where opening and closing balance. Girard et al. (2009, "Evaluation of high-resolution sea
+ice models on the basis of statistical and scaling properties of Arctic sea ice drift and
+deformation", J. Geophys. Res. 114) call large patches of convergence in a winter pack near
+100 % concentration incompatible with a fractured plate, whose convergence closes fresh
+fractures and builds ridges along narrow faults.
+
+    python benchmarks/beta_components.py F10-hthick-str50hnullsp F10s-hthick-str50hnullsp
+
+Runs are read from ``benchmarks/out/physics`` (made by ``physics_experiments.py run``); results
+are merged into ``docs/figures/beta_components.json`` (one entry per run).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from lagice.diagnostics.scaling import spatial_scaling
+from lagice.diagnostics.strain import ElementStrainRates, lagrangian_velocity_gradients
+from lagice.diagnostics.windows import window_arrays, window_starts_days
+from lagice.errors import ConfigError
+
+ROOT = Path(__file__).resolve().parents[1]
+RUNS = ROOT / "benchmarks" / "out" / "physics"
+OUT = ROOT / "docs" / "figures" / "beta_components.json"
+DAY_S = 86400.0
+KEYS = ("beta", "beta_shear_part", "beta_divergence_part", "net_divergence_ratio",
+        "mean_abs_divergence_to_mean_shear", "element_rate_per_day")
+
+
+def split_gradient(gradient_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(the gradient less its isotropic part, the isotropic part ε̇I/2 · I) of (m, 2, 2) gradients [s-1]."""
+    half_div = 0.5 * (gradient_s[:, 0, 0] + gradient_s[:, 1, 1])
+    iso = np.zeros_like(gradient_s)
+    iso[:, 0, 0] = half_div
+    iso[:, 1, 1] = half_div
+    return gradient_s - iso, iso
+
+
+def window_components(rates: ElementStrainRates) -> dict:
+    """β of the whole gradient, of its shear part and of its divergence part, and the
+    net-divergence ratio, for the element rates of one window."""
+    shear_part, div_part = split_gradient(rates.gradient_s)
+    out = {}
+    for key, g in (("beta", rates.gradient_s), ("beta_shear_part", shear_part), ("beta_divergence_part", div_part)):
+        part = ElementStrainRates(g, rates.area_m2, rates.centroid_xy_m, rates.bounds_m)
+        out[key] = float(spatial_scaling(part).fit.exponent)
+    div, area = rates.divergence_s, rates.area_m2
+    out["net_divergence_ratio"] = float(np.sum(div * area) / np.sum(np.abs(div) * area))
+    out["mean_abs_divergence_to_mean_shear"] = float(np.abs(div).mean() / rates.shear_s.mean())
+    out["element_rate_per_day"] = float(rates.total_s.mean() * DAY_S)
+    return out
+
+
+def run_components(run_dir: Path, window_days: float = 3.0, start_day: float = 1.0,
+                   coast_buffer_m: float = 100e3) -> dict:
+    """Per-window components and their medians over the windows of one finished run."""
+    rows = []
+    for s0 in window_starts_days(run_dir, window_days, start_day):
+        xy0, xy1, tri, dt, info = window_arrays(run_dir, s0 * DAY_S, (s0 + window_days) * DAY_S, coast_buffer_m)
+        rates = lagrangian_velocity_gradients(xy0, xy1, tri[info["interior"]], dt)
+        rows.append({"start_day": float(s0), **window_components(rates)})
+    return {"windows": rows, "median": {k: float(np.median([r[k] for r in rows])) for k in KEYS}}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("runs", nargs="+", help="run names in benchmarks/out/physics")
+    args = ap.parse_args(argv)
+    missing = [r for r in args.runs if not (RUNS / r).is_dir()]
+    if missing:
+        raise ConfigError(f"no run folder for {missing} in {RUNS}: make them with physics_experiments.py run")
+    table = json.loads(OUT.read_text()) if OUT.exists() else {}
+    print(f"{'run':38s} {'beta':>6s} {'shear':>6s} {'div':>6s} {'net div':>8s} {'|div|/sh':>8s} {'rate/d':>8s}")
+    for name in args.runs:
+        res = run_components(RUNS / name)
+        table[name] = res
+        m = res["median"]
+        print(f"{name:38s} {m['beta']:6.3f} {m['beta_shear_part']:6.3f} {m['beta_divergence_part']:6.3f} "
+              f"{m['net_divergence_ratio']:8.2f} {m['mean_abs_divergence_to_mean_shear']:8.2f} "
+              f"{m['element_rate_per_day']:8.4f}")
+    OUT.write_text(json.dumps(table, indent=1, sort_keys=True) + "\n")
+    print(f"medians over the 3-day windows; written to {OUT.relative_to(ROOT)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
