@@ -181,3 +181,39 @@ def test_every_physics_experiment_resolves_to_a_valid_scene():
     cfg = load_scene(pe.SCENES["closed"], pe.EXPERIMENTS["F10-hthick-str50hnullsp"][1])
     assert cfg["rheology"]["strength_lab_pa"] == 1.4e6 and cfg["thermo"]["params"]["new_ice_thickness_m"] == 0.25
     assert cfg != shipped["closed"]
+
+
+def test_beta_components_separate_a_coherent_convergence_from_cancelling_shear():
+    """benchmarks/beta_components.py on two synthetic gradient fields on 8 km cells over 400 km:
+    (1) a uniform convergence (∂u/∂x = ∂v/∂y = −a) under shear bands of alternating sense
+    (∂v/∂x = b cos(2π x / 40 km)): the net-divergence ratio is −1, the divergence part does not
+    cancel between scales (β = 0: every box holds the same divergence) and the shear part does
+    (β > 0.2), and the whole lies between; (2) opening and closing bands (∂u/∂x = b cos(2π x /
+    40 km)): the ratio is near 0 and the divergence part cancels (β > 0.2)."""
+    from beta_components import window_components
+
+    from lagice.diagnostics.strain import ElementStrainRates
+
+    h = 8e3
+    cx, cy = np.meshgrid(np.arange(50) * h + h / 2, np.arange(50) * h + h / 2)
+    cen = np.column_stack([cx.ravel(), cy.ravel()])
+    area = np.full(len(cen), h * h)
+    wave = np.cos(2.0 * np.pi * cen[:, 0] / 40e3)
+    a, b = 1e-7, 1e-6
+
+    def components(grad):
+        return window_components(ElementStrainRates(grad, area, cen, np.array([0.0, 0.0, 400e3, 400e3])))
+
+    g = np.zeros((len(cen), 2, 2))
+    g[:, 0, 0] = g[:, 1, 1] = -a
+    g[:, 1, 0] = b * wave
+    conv = components(g)
+    assert conv["net_divergence_ratio"] == pytest.approx(-1.0, abs=1e-12)
+    assert abs(conv["beta_divergence_part"]) < 1e-9
+    assert conv["beta_shear_part"] > 0.2
+    assert conv["beta_divergence_part"] < conv["beta"] < conv["beta_shear_part"]
+    g = np.zeros((len(cen), 2, 2))
+    g[:, 0, 0] = b * wave
+    bands = components(g)
+    assert abs(bands["net_divergence_ratio"]) < 0.1
+    assert bands["beta_divergence_part"] > 0.2
