@@ -881,6 +881,24 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-1125-ref"] = (
         _basin, from_spinup("H1125"), 10e3, 28,
         f"{_p}-hthick-1125 run again on today's code (its run folder, for beta_components.py)")
+# Result for the str50hnullsp pack (2026-11-27, fifteenth session): NOT a lead, and the pack locks.
+# Closed: rate 0.0091 -> 0.00013 per day, drift 60 -> 2 km, net-divergence ratio -0.58 -> -0.19
+# (halved), beta 0.052 -> 0.059; strait: rate 0.0085 -> 0.0028, ratio -0.48 -> -0.50, beta 0.068 ->
+# 0.070; both lose bands (tails 3.5-4.3, R2 0.19-0.21). The pack's compressive mean stress climbs
+# from a median of 4-7 kPa to 55-90 kPa (90th percentile 150-180 kPa): the whole wind load is carried
+# elastically against the coast, the friction of the envelope (mu = 0.7) makes the pressed ice
+# strong in shear, the damaged fraction (d > 0.9) falls from about 0.5 to 0.02-0.14, and the pack
+# heals shut. What lets a Maxwell-EB pack move is that its damaged ice sheds its pressure.
+#
+# The ridging cap (a diagnostic): real pack ice sheds pressure by ridging above its compressive
+# strength. neXtSIM's P_max = 10 kPa h^1.5 exp(-20(1-A)) (PMAX, sourced) as that cap on the kept
+# mean: the deviator relaxes always, the mean only where its compression exceeds P_max (or in
+# tension). Same pack and month, both basins.
+# Stated before the runs (2026-11-27, 10:40 UTC): the cap unlocks the pack if both basins' median
+# rate is at 0.005 per day or more; the mechanism holds if the net-divergence ratio's magnitude is
+# at most half of str50hnullsp's (0.58, 0.48) in both basins; a lead for beta if beta rises by 0.04
+# or more over str50hnullsp's month (0.052, 0.068) in both basins with no band of the six lost.
+add_str50hnull_month("keepmeanP", KEEP_MEAN + PMAX, "the mean stress of damaged ice kept below neXtSIM's P_max")
 
 
 def command(scene, overrides, res, days, out) -> list:
