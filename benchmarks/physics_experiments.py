@@ -899,6 +899,15 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # at most half of str50hnullsp's (0.58, 0.48) in both basins; a lead for beta if beta rises by 0.04
 # or more over str50hnullsp's month (0.052, 0.068) in both basins with no band of the six lost.
 add_str50hnull_month("keepmeanP", KEEP_MEAN + PMAX, "the mean stress of damaged ice kept below neXtSIM's P_max")
+# Result (2026-11-27, fifteenth session): the cap unlocks the pack (rate 0.0062 and 0.0054 per day)
+# but the mechanism does not hold and it is NOT a lead: the net-divergence ratio is back at -0.59
+# and -0.55 (the ice compacts wherever its pressure passes P_max, which is again most of the
+# interior), beta 0.052 and 0.043 (no rise; the strait's falls), 2 bands inside in each basin
+# against 3 (R2 0.64 and 0.62 leave), the wind factor 0.0042 in both (below its band).
+# The shipped pack kept its mean too (F10-hthick-1125-keepmean, F10s-...): it locks (rate 0.00006 and
+# 0.0003 per day, drift 1-2 km); the net-divergence ratio goes -0.73 -> -0.02 and -0.71 -> -0.27
+# (halved), beta 0.038 -> 0.057 and 0.030 -> 0.077, bands lost. The fresh runs of the shipped month
+# (-ref) reproduce every recorded statistic of F10-hthick-1125 and F10s-hthick-1125 exactly.
 
 
 def command(scene, overrides, res, days, out) -> list:
