@@ -18,7 +18,18 @@ deformation", J. Geophys. Res. 114) call large patches of convergence in a winte
 100 % concentration incompatible with a fractured plate, whose convergence closes fresh
 fractures and builds ridges along narrow faults.
 
+Two checks of where the convergence comes from, per window:
+
+* the share of the mesh's area that the window follows (elements remeshed during the window
+  are left out of every window statistic) and the change of that area over the window; in a
+  closed basin the mesh keeps its area, so a followed area that shrinks means that the
+  remeshed patches opened;
+* ``--wind-curl``: the interior's mean divergence against the interior's mean curl of the
+  geostrophic wind (the run's wind rebuilt from its configuration, 6-hourly over the window,
+  centred differences 5 km apart). In free drift u = A R(θ) G, div u = −A sin θ curl G.
+
     python benchmarks/beta_components.py F10-hthick-str50hnullsp F10s-hthick-str50hnullsp
+    python benchmarks/beta_components.py F10-hthick-1125-ref --wind-curl
 
 Runs are read from ``benchmarks/out/physics`` (made by ``physics_experiments.py run``); results
 are merged into ``docs/figures/beta_components.json`` (one entry per run).
@@ -31,9 +42,10 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import xarray as xr
 
 from lagice.diagnostics.scaling import spatial_scaling
-from lagice.diagnostics.strain import ElementStrainRates, lagrangian_velocity_gradients
+from lagice.diagnostics.strain import ElementStrainRates, lagrangian_velocity_gradients, triangle_geometry
 from lagice.diagnostics.windows import window_arrays, window_starts_days
 from lagice.errors import ConfigError
 
@@ -69,20 +81,66 @@ def window_components(rates: ElementStrainRates) -> dict:
     return out
 
 
+def mean_geostrophic_curl(wind, surface_factor: float, t0_s: float, t1_s: float, xy_m, area_m2,
+                          every_s: float = 6 * 3600.0, h_m: float = 5e3) -> float:
+    """Area-weighted mean over points ``xy_m`` and over [t0, t1] (every ``every_s``) of the
+    curl of the geostrophic wind [s-1]: the 10-m wind's curl by centred differences ``h_m``
+    apart, divided by the climatology's surface factor (its turning does not change the curl)."""
+    x, y = xy_m[:, 0], xy_m[:, 1]
+    out = []
+    for t in np.arange(t0_s, t1_s + 1e-6, every_s):
+        u_n, _ = wind(t, x, y + h_m)
+        u_s, _ = wind(t, x, y - h_m)
+        _, v_e = wind(t, x + h_m, y)
+        _, v_w = wind(t, x - h_m, y)
+        curl = (np.asarray(v_e) - np.asarray(v_w) - np.asarray(u_n) + np.asarray(u_s)) / (2.0 * h_m)
+        out.append(np.sum(curl * area_m2) / np.sum(area_m2))
+    return float(np.mean(out)) / surface_factor
+
+
 def run_components(run_dir: Path, window_days: float = 3.0, start_day: float = 1.0,
-                   coast_buffer_m: float = 100e3) -> dict:
-    """Per-window components and their medians over the windows of one finished run."""
+                   coast_buffer_m: float = 100e3, wind_curl: bool = False) -> dict:
+    """Per-window components and their medians over the windows of one finished run, with the
+    followed area and (``wind_curl``) the interior's mean divergence against the geostrophic curl."""
+    wind = None
+    if wind_curl:
+        from lagice.diagnostics.drift import run_wind
+
+        with xr.open_dataset(run_dir / "drifters.nc") as ds:
+            cfg = json.loads(ds.attrs["lagice_config"])
+        wind, (kind, s, _th) = run_wind(cfg)
+        if kind != "geostrophic":
+            raise ConfigError(f"{run_dir}: --wind-curl needs the climatology's wind (the run's wind is {kind})")
     rows = []
     for s0 in window_starts_days(run_dir, window_days, start_day):
-        xy0, xy1, tri, dt, info = window_arrays(run_dir, s0 * DAY_S, (s0 + window_days) * DAY_S, coast_buffer_m)
+        t0, t1 = s0 * DAY_S, (s0 + window_days) * DAY_S
+        xy0, xy1, tri, dt, info = window_arrays(run_dir, t0, t1, coast_buffer_m)
         rates = lagrangian_velocity_gradients(xy0, xy1, tri[info["interior"]], dt)
-        rows.append({"start_day": float(s0), **window_components(rates)})
-    return {"windows": rows, "median": {k: float(np.median([r[k] for r in rows])) for k in KEYS}}
+        row = {"start_day": float(s0), **window_components(rates)}
+        mesh_area = np.abs(triangle_geometry(*info["start_mesh"][:2])[0]).sum()
+        a0 = np.abs(triangle_geometry(xy0, tri)[0]).sum()
+        a1 = np.abs(triangle_geometry(xy1, tri)[0]).sum()
+        row.update(followed_area_fraction=float(a0 / mesh_area), followed_area_change=float(a1 / a0 - 1.0),
+                   remeshed_elements=int(info["n_elements_lost"]))
+        if wind is not None:
+            area = rates.area_m2
+            row["interior_mean_divergence_per_day"] = float(np.sum(rates.divergence_s * area) / area.sum() * DAY_S)
+            row["interior_mean_geostrophic_curl_per_day"] = DAY_S * mean_geostrophic_curl(
+                wind, s, t0, t1, rates.centroid_xy_m, area)
+        rows.append(row)
+    res = {"windows": rows, "median": {k: float(np.median([r[k] for r in rows])) for k in KEYS}}
+    if wind is not None:
+        d = [r["interior_mean_divergence_per_day"] for r in rows]
+        c = [r["interior_mean_geostrophic_curl_per_day"] for r in rows]
+        res["correlation_divergence_geostrophic_curl"] = float(np.corrcoef(d, c)[0, 1])
+    return res
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("runs", nargs="+", help="run names in benchmarks/out/physics")
+    ap.add_argument("--wind-curl", action="store_true",
+                    help="also the interior's mean divergence against the geostrophic wind's curl (slower)")
     args = ap.parse_args(argv)
     missing = [r for r in args.runs if not (RUNS / r).is_dir()]
     if missing:
@@ -90,12 +148,23 @@ def main(argv=None) -> int:
     table = json.loads(OUT.read_text()) if OUT.exists() else {}
     print(f"{'run':38s} {'beta':>6s} {'shear':>6s} {'div':>6s} {'net div':>8s} {'|div|/sh':>8s} {'rate/d':>8s}")
     for name in args.runs:
-        res = run_components(RUNS / name)
+        res = run_components(RUNS / name, wind_curl=args.wind_curl)
         table[name] = res
         m = res["median"]
         print(f"{name:38s} {m['beta']:6.3f} {m['beta_shear_part']:6.3f} {m['beta_divergence_part']:6.3f} "
               f"{m['net_divergence_ratio']:8.2f} {m['mean_abs_divergence_to_mean_shear']:8.2f} "
               f"{m['element_rate_per_day']:8.4f}")
+        for w in res["windows"]:
+            line = (f"    day {w['start_day']:4.0f}: net-div ratio {w['net_divergence_ratio']:+.2f}, followed "
+                    f"{w['followed_area_fraction']:.3f} of the area, its change {w['followed_area_change']:+.4f}, "
+                    f"{w['remeshed_elements']} elements remeshed")
+            if args.wind_curl:
+                line += (f"; interior div {w['interior_mean_divergence_per_day']:+.5f}/d, "
+                         f"curl G {w['interior_mean_geostrophic_curl_per_day']:+.3f}/d")
+            print(line)
+        if args.wind_curl:
+            print(f"    correlation of the interior's divergence with curl G: "
+                  f"{res['correlation_divergence_geostrophic_curl']:+.2f}")
     OUT.write_text(json.dumps(table, indent=1, sort_keys=True) + "\n")
     print(f"medians over the 3-day windows; written to {OUT.relative_to(ROOT)}")
     return 0
