@@ -24,6 +24,11 @@ Two checks of where the convergence comes from, per window:
   are left out of every window statistic) and the change of that area over the window; in a
   closed basin the mesh keeps its area, so a followed area that shrinks means that the
   remeshed patches opened;
+* the share of the interior's area (≥ 100 km from the coast) in patches remeshed during the
+  window, and with ``--patches``, β (fitted without the element scale) and the net-divergence
+  ratio with each remeshed interior patch added back as one cell: its area-mean velocity
+  gradient is the integral of the velocity over its boundary, whose nodes outlive the remesh
+  (a patch with a boundary node that does not is left out, and its area is counted);
 * ``--wind-curl``: the interior's mean divergence against the interior's mean curl of the
   geostrophic wind (the run's wind rebuilt from its configuration, 6-hourly over the window,
   centred differences 5 km apart). In free drift u = A R(θ) G, div u = −A sin θ curl G.
@@ -44,6 +49,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from lagice.diagnostics.faults import interior_triangles
 from lagice.diagnostics.scaling import spatial_scaling
 from lagice.diagnostics.strain import ElementStrainRates, lagrangian_velocity_gradients, triangle_geometry
 from lagice.diagnostics.windows import window_arrays, window_starts_days
@@ -98,8 +104,108 @@ def mean_geostrophic_curl(wind, surface_factor: float, t0_s: float, t1_s: float,
     return float(np.mean(out)) / surface_factor
 
 
+def _snapshot_pair(run_dir: Path, t0_s: float, t1_s: float):
+    """(start nodes (n, 2), their end positions (NaN where the node is gone), start
+    triangles, Δt [s]) of the snapshots nearest t0 and t1, nodes followed by ``node_id``."""
+    from lagice.io.snapshots import read_index, snapshot_dir
+
+    d = snapshot_dir(run_dir)
+    idx = read_index(d)
+    times = np.array([e["time_s"] for e in idx])
+    e0, e1 = (idx[int(np.argmin(np.abs(times - t)))] for t in (t0_s, t1_s))
+    ds0 = xr.load_dataset(d / e0["file"], decode_times=False)
+    ds1 = xr.load_dataset(d / e1["file"], decode_times=False)
+    xy0 = np.column_stack([ds0["mesh_node_x"].values, ds0["mesh_node_y"].values])
+    xy1 = np.column_stack([ds1["mesh_node_x"].values, ds1["mesh_node_y"].values])
+    id0, id1 = ds0["node_id"].values, ds1["node_id"].values
+    order = np.argsort(id1)
+    pos = np.minimum(np.searchsorted(id1[order], id0), id1.size - 1)
+    found = id1[order][pos] == id0
+    end = np.full_like(xy0, np.nan)
+    end[found] = xy1[order[pos[found]]]
+    return xy0, end, ds0["mesh_face_nodes"].values.astype(np.int64), float(e1["time_s"] - e0["time_s"])
+
+
+def patch_cells(xy0, xy1, triangles, dt_s: float):
+    """One cell per connected patch of ``triangles`` (those remeshed during the window): its
+    area-mean velocity gradient [s-1] = (1/A) ∮ u ⊗ n dl over the patch boundary (mid-window
+    geometry, u = (xy1 − xy0)/Δt at the boundary nodes, exact for the P1 field of the lost
+    triangles), area A [m²] and centroid [m]. Returns (gradients (k, 2, 2), areas, centroids,
+    start area of the patches used, start area of those left out because a boundary node is gone)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    m = len(triangles)
+    if m == 0:
+        return np.zeros((0, 2, 2)), np.zeros(0), np.zeros((0, 2)), 0.0, 0.0
+    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    owner = np.tile(np.arange(m), 3)
+    _, inv, counts = np.unique(np.sort(edges, axis=1), axis=0, return_inverse=True, return_counts=True)
+    inv = inv.ravel()
+    shared = np.flatnonzero(counts[inv] == 2)
+    first = {}
+    pairs = []
+    for k in shared:  # each interior edge twice: pair its two owners
+        if inv[k] in first:
+            pairs.append((first[inv[k]], owner[k]))
+        else:
+            first[inv[k]] = owner[k]
+    a, b = (np.array(x, np.int64) for x in zip(*pairs)) if pairs else (np.zeros(0, np.int64),) * 2
+    _, label = connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(m, m)), directed=False)
+    p0, p1, p2 = (xy0[triangles[:, i]] for i in range(3))
+    signed = 0.5 * ((p1[:, 0] - p0[:, 0]) * (p2[:, 1] - p0[:, 1]) - (p1[:, 1] - p0[:, 1]) * (p2[:, 0] - p0[:, 0]))
+    mid, vel = 0.5 * (xy0 + xy1), (xy1 - xy0) / dt_s
+    grads, areas, cents = [], [], []
+    used = dropped = 0.0
+    boundary = counts[inv] == 1
+    for c in np.unique(label):
+        sel = boundary & (label[owner] == c)
+        ed = edges[sel].copy()
+        flip = signed[owner[sel]] < 0
+        ed[flip] = ed[flip][:, ::-1]  # counter-clockwise
+        start_area = np.abs(signed[label == c]).sum()
+        if not np.all(np.isfinite(xy1[ed])):
+            dropped += start_area
+            continue
+        pa, pb = mid[ed[:, 0]], mid[ed[:, 1]]
+        cross = pa[:, 0] * pb[:, 1] - pb[:, 0] * pa[:, 1]
+        area = 0.5 * cross.sum()
+        normal = np.column_stack([pb[:, 1] - pa[:, 1], pa[:, 0] - pb[:, 0]])
+        u_edge = 0.5 * (vel[ed[:, 0]] + vel[ed[:, 1]])
+        grads.append((u_edge[:, :, None] * normal[:, None, :]).sum(axis=0) / area)
+        areas.append(area)
+        cents.append(np.array([((pa[:, 0] + pb[:, 0]) * cross).sum(), ((pa[:, 1] + pb[:, 1]) * cross).sum()])
+                     / (6.0 * area))
+        used += start_area
+    if not grads:
+        return np.zeros((0, 2, 2)), np.zeros(0), np.zeros((0, 2)), used, dropped
+    return np.array(grads), np.array(areas), np.array(cents), used, dropped
+
+
+def with_patches(run_dir: Path, t0_s: float, t1_s: float, coast_buffer_m: float) -> dict:
+    """β (no element scale) and the net-divergence ratio of the interior's followed elements,
+    and of the same with the remeshed interior patches added back as cells (:func:`patch_cells`)."""
+    from lagice.diagnostics.faults import interior_triangles
+
+    xy0, xy1, tri, dt = _snapshot_pair(run_dir, t0_s, t1_s)
+    inside = interior_triangles(xy0, tri, coast_buffer_m)
+    kept = np.all(np.isfinite(xy1[tri]).reshape(len(tri), -1), axis=1)
+    rates = lagrangian_velocity_gradients(xy0, np.where(np.isfinite(xy1), xy1, xy0), tri[kept & inside], dt)
+    g, a, c, used, dropped = patch_cells(xy0, xy1, tri[~kept & inside], dt)
+    out = {}
+    for key, r in (("followed", rates), ("with_patches", ElementStrainRates(
+            np.concatenate([rates.gradient_s, g]), np.concatenate([rates.area_m2, a]),
+            np.concatenate([rates.centroid_xy_m, c]), rates.bounds_m))):
+        div = r.gradient_s[:, 0, 0] + r.gradient_s[:, 1, 1]
+        beta = spatial_scaling(r, include_element_scale=False, origin_xy_m=rates.bounds_m[:2]).fit.exponent
+        out[key] = {"beta_without_element_scale": float(beta),
+                    "net_divergence_ratio": float(np.sum(div * r.area_m2) / np.sum(np.abs(div) * r.area_m2))}
+    out.update(patches=int(len(a)), patch_start_area_km2=used / 1e6, patch_area_left_out_km2=dropped / 1e6)
+    return out
+
+
 def run_components(run_dir: Path, window_days: float = 3.0, start_day: float = 1.0,
-                   coast_buffer_m: float = 100e3, wind_curl: bool = False) -> dict:
+                   coast_buffer_m: float = 100e3, wind_curl: bool = False, patches: bool = False) -> dict:
     """Per-window components and their medians over the windows of one finished run, with the
     followed area and (``wind_curl``) the interior's mean divergence against the geostrophic curl."""
     wind = None
@@ -120,8 +226,17 @@ def run_components(run_dir: Path, window_days: float = 3.0, start_day: float = 1
         mesh_area = np.abs(triangle_geometry(*info["start_mesh"][:2])[0]).sum()
         a0 = np.abs(triangle_geometry(xy0, tri)[0]).sum()
         a1 = np.abs(triangle_geometry(xy1, tri)[0]).sum()
+        start_xy, start_tri = info["start_mesh"][:2]
+        start_area = np.abs(triangle_geometry(start_xy, start_tri)[0])
+        inside0 = interior_triangles(start_xy, start_tri, coast_buffer_m)
+        lost0 = np.ones(len(start_tri), bool)
+        lost0[info["kept_elements"]] = False
         row.update(followed_area_fraction=float(a0 / mesh_area), followed_area_change=float(a1 / a0 - 1.0),
-                   remeshed_elements=int(info["n_elements_lost"]))
+                   remeshed_elements=int(info["n_elements_lost"]),
+                   interior_area_remeshed_fraction=float(start_area[inside0 & lost0].sum()
+                                                         / start_area[inside0].sum()))
+        if patches and info["n_elements_lost"]:
+            row["remeshed_patches"] = with_patches(run_dir, t0, t1, coast_buffer_m)
         if wind is not None:
             area = rates.area_m2
             row["interior_mean_divergence_per_day"] = float(np.sum(rates.divergence_s * area) / area.sum() * DAY_S)
@@ -139,6 +254,8 @@ def run_components(run_dir: Path, window_days: float = 3.0, start_day: float = 1
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("runs", nargs="+", help="run names in benchmarks/out/physics")
+    ap.add_argument("--patches", action="store_true",
+                    help="also β and the net-divergence ratio with the remeshed interior patches added back")
     ap.add_argument("--wind-curl", action="store_true",
                     help="also the interior's mean divergence against the geostrophic wind's curl (slower)")
     args = ap.parse_args(argv)
@@ -148,7 +265,7 @@ def main(argv=None) -> int:
     table = json.loads(OUT.read_text()) if OUT.exists() else {}
     print(f"{'run':38s} {'beta':>6s} {'shear':>6s} {'div':>6s} {'net div':>8s} {'|div|/sh':>8s} {'rate/d':>8s}")
     for name in args.runs:
-        res = run_components(RUNS / name, wind_curl=args.wind_curl)
+        res = run_components(RUNS / name, wind_curl=args.wind_curl, patches=args.patches)
         table[name] = res
         m = res["median"]
         print(f"{name:38s} {m['beta']:6.3f} {m['beta_shear_part']:6.3f} {m['beta_divergence_part']:6.3f} "
@@ -157,7 +274,16 @@ def main(argv=None) -> int:
         for w in res["windows"]:
             line = (f"    day {w['start_day']:4.0f}: net-div ratio {w['net_divergence_ratio']:+.2f}, followed "
                     f"{w['followed_area_fraction']:.3f} of the area, its change {w['followed_area_change']:+.4f}, "
-                    f"{w['remeshed_elements']} elements remeshed")
+                    f"{w['remeshed_elements']} elements remeshed "
+                    f"({100 * w['interior_area_remeshed_fraction']:.1f} % of the interior's area)")
+            if "remeshed_patches" in w:
+                p = w["remeshed_patches"]
+                line += (f"; with {p['patches']} patches added back ({p['patch_start_area_km2']:.0f} km², "
+                         f"{p['patch_area_left_out_km2']:.0f} km² left out) beta w/o element scale "
+                         f"{p['followed']['beta_without_element_scale']:.3f} -> "
+                         f"{p['with_patches']['beta_without_element_scale']:.3f}, net-div ratio "
+                         f"{p['followed']['net_divergence_ratio']:+.2f} -> "
+                         f"{p['with_patches']['net_divergence_ratio']:+.2f}")
             if args.wind_curl:
                 line += (f"; interior div {w['interior_mean_divergence_per_day']:+.5f}/d, "
                          f"curl G {w['interior_mean_geostrophic_curl_per_day']:+.3f}/d")

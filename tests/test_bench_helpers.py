@@ -217,3 +217,43 @@ def test_beta_components_separate_a_coherent_convergence_from_cancelling_shear()
     bands = components(g)
     assert abs(bands["net_divergence_ratio"]) < 0.1
     assert bands["beta_divergence_part"] > 0.2
+
+
+def test_a_remeshed_patch_is_added_back_with_the_gradient_of_its_boundary():
+    """beta_components.patch_cells: a patch of triangles whose inner nodes are gone (NaN end
+    positions, as after a remesh) gets the area-mean gradient of a linear velocity field
+    exactly, from its boundary nodes alone, with its mid-window area and centroid; a patch
+    with a boundary node gone is left out and its start area counted."""
+    import shapely
+    from beta_components import patch_cells
+
+    from lagice.mesh import generate_mesh
+
+    mesh = generate_mesh(shapely.box(0.0, 0.0, 200e3, 200e3), 10e3)
+    xy0, tri = mesh.nodes, mesh.triangles
+    grad = np.array([[2e-7, -1e-7], [3e-7, -0.5e-7]])
+    dt = 86400.0
+    xy1 = xy0 + dt * (xy0 - 100e3) @ grad.T
+    cen = xy0[tri].mean(axis=1)
+    in_patch = np.hypot(cen[:, 0] - 100e3, cen[:, 1] - 100e3) < 35e3
+    inner = np.setdiff1d(np.unique(tri[in_patch]), np.unique(tri[~in_patch]))
+    assert inner.size > 3
+    end = xy1.copy()
+    end[inner] = np.nan
+    g, a, c, used, dropped = patch_cells(xy0, end, tri[in_patch], dt)
+    assert g.shape == (1, 2, 2) and dropped == 0.0
+    # the gradient on the mid-window geometry x_mid = x0 + Δt/2 · u (as lagrangian_velocity_gradients)
+    assert np.allclose(g[0], grad @ np.linalg.inv(np.eye(2) + 0.5 * dt * grad), rtol=1e-9, atol=0)
+
+    def areas(p):
+        return 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+                            - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0]))
+
+    mid = 0.5 * (xy0 + xy1)[tri[in_patch]]
+    assert a[0] == pytest.approx(areas(mid).sum(), rel=1e-12)
+    assert np.allclose(c[0], (areas(mid)[:, None] * mid.mean(axis=1)).sum(axis=0) / areas(mid).sum(), rtol=1e-9)
+    assert used == pytest.approx(areas(xy0[tri[in_patch]]).sum(), rel=1e-12)
+    boundary = np.setdiff1d(np.unique(tri[in_patch]), inner)
+    end[boundary[0]] = np.nan
+    g, a, c, used2, dropped2 = patch_cells(xy0, end, tri[in_patch], dt)
+    assert g.shape == (0, 2, 2) and used2 == 0.0 and dropped2 == pytest.approx(used)
