@@ -908,6 +908,17 @@ add_str50hnull_month("keepmeanP", KEEP_MEAN + PMAX, "the mean stress of damaged 
 # 0.0003 per day, drift 1-2 km); the net-divergence ratio goes -0.73 -> -0.02 and -0.71 -> -0.27
 # (halved), beta 0.038 -> 0.057 and 0.030 -> 0.077, bands lost. The fresh runs of the shipped month
 # (-ref) reproduce every recorded statistic of F10-hthick-1125 and F10s-hthick-1125 exactly.
+#
+# The same cap on the shipped pack (completing the two packs x two options; a diagnostic).
+# Stated before the runs (2026-11-27, 11:45 UTC): the mechanism holds if the net-divergence
+# ratio's magnitude is at most half the shipped month's (0.73, 0.71) in both basins; a lead for beta
+# if beta rises by 0.04 or more over the shipped month's (0.038, 0.030) in both basins with no band
+# of the six lost (2 and 3 inside); the pack counts as moving if its median rate is at least half
+# the shipped month's (0.0024, 0.0028 per day).
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    EXPERIMENTS[f"{_p}-hthick-1125-keepmeanP"] = (
+        _basin, from_spinup("H1125") + KEEP_MEAN + PMAX, 10e3, 28,
+        f"{_p}-hthick-1125 with the mean stress of damaged ice kept below neXtSIM's P_max (diagnostic)")
 
 
 def command(scene, overrides, res, days, out) -> list:
