@@ -919,6 +919,9 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-1125-keepmeanP"] = (
         _basin, from_spinup("H1125") + KEEP_MEAN + PMAX, 10e3, 28,
         f"{_p}-hthick-1125 with the mean stress of damaged ice kept below neXtSIM's P_max (diagnostic)")
+# Result (2026-11-27, fifteenth session): the mechanism does not hold (ratio -0.68, -0.67), not a lead
+# (beta 0.043, 0.029: +0.005, -0.001), and the pack moves less than half as much (rate 0.0011 and
+# 0.0014 per day, x0.46 and x0.49; drift 23 and 28 km); 1 and 2 bands inside against 2 and 3.
 
 
 def command(scene, overrides, res, days, out) -> list:
