@@ -1,5 +1,5 @@
 """β split into its shear and divergence parts, and how coherently the pack converges
-(docs/physics.md §4, "Damaged ice that keeps its pressure").
+(docs/physics.md §4, "Where β is lost, and damaged ice that keeps its pressure").
 
 β is the slope of ⟨ε̇tot⟩(L), the mean over boxes of width L of the total deformation rate of
 the box (:func:`lagice.diagnostics.spatial_scaling`). The box's velocity gradient is the
@@ -18,7 +18,7 @@ deformation", J. Geophys. Res. 114) call large patches of convergence in a winte
 100 % concentration incompatible with a fractured plate, whose convergence closes fresh
 fractures and builds ridges along narrow faults.
 
-Two checks of where the convergence comes from, per window:
+Three checks of where the convergence comes from, per window:
 
 * the share of the mesh's area that the window follows (elements remeshed during the window
   are left out of every window statistic) and the change of that area over the window; in a
@@ -104,28 +104,6 @@ def mean_geostrophic_curl(wind, surface_factor: float, t0_s: float, t1_s: float,
     return float(np.mean(out)) / surface_factor
 
 
-def _snapshot_pair(run_dir: Path, t0_s: float, t1_s: float):
-    """(start nodes (n, 2), their end positions (NaN where the node is gone), start
-    triangles, Δt [s]) of the snapshots nearest t0 and t1, nodes followed by ``node_id``."""
-    from lagice.io.snapshots import read_index, snapshot_dir
-
-    d = snapshot_dir(run_dir)
-    idx = read_index(d)
-    times = np.array([e["time_s"] for e in idx])
-    e0, e1 = (idx[int(np.argmin(np.abs(times - t)))] for t in (t0_s, t1_s))
-    ds0 = xr.load_dataset(d / e0["file"], decode_times=False)
-    ds1 = xr.load_dataset(d / e1["file"], decode_times=False)
-    xy0 = np.column_stack([ds0["mesh_node_x"].values, ds0["mesh_node_y"].values])
-    xy1 = np.column_stack([ds1["mesh_node_x"].values, ds1["mesh_node_y"].values])
-    id0, id1 = ds0["node_id"].values, ds1["node_id"].values
-    order = np.argsort(id1)
-    pos = np.minimum(np.searchsorted(id1[order], id0), id1.size - 1)
-    found = id1[order][pos] == id0
-    end = np.full_like(xy0, np.nan)
-    end[found] = xy1[order[pos[found]]]
-    return xy0, end, ds0["mesh_face_nodes"].values.astype(np.int64), float(e1["time_s"] - e0["time_s"])
-
-
 def patch_cells(xy0, xy1, triangles, dt_s: float):
     """One cell per connected patch of ``triangles`` (those remeshed during the window): its
     area-mean velocity gradient [s-1] = (1/A) ∮ u ⊗ n dl over the patch boundary (mid-window
@@ -143,14 +121,8 @@ def patch_cells(xy0, xy1, triangles, dt_s: float):
     _, inv, counts = np.unique(np.sort(edges, axis=1), axis=0, return_inverse=True, return_counts=True)
     inv = inv.ravel()
     shared = np.flatnonzero(counts[inv] == 2)
-    first = {}
-    pairs = []
-    for k in shared:  # each interior edge twice: pair its two owners
-        if inv[k] in first:
-            pairs.append((first[inv[k]], owner[k]))
-        else:
-            first[inv[k]] = owner[k]
-    a, b = (np.array(x, np.int64) for x in zip(*pairs)) if pairs else (np.zeros(0, np.int64),) * 2
+    shared = shared[np.argsort(inv[shared], kind="stable")]  # each shared edge twice, side by side
+    a, b = owner[shared[0::2]], owner[shared[1::2]]
     _, label = connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(m, m)), directed=False)
     p0, p1, p2 = (xy0[triangles[:, i]] for i in range(3))
     signed = 0.5 * ((p1[:, 0] - p0[:, 0]) * (p2[:, 1] - p0[:, 1]) - (p1[:, 1] - p0[:, 1]) * (p2[:, 0] - p0[:, 0]))
@@ -182,14 +154,15 @@ def patch_cells(xy0, xy1, triangles, dt_s: float):
     return np.array(grads), np.array(areas), np.array(cents), used, dropped
 
 
-def with_patches(run_dir: Path, t0_s: float, t1_s: float, coast_buffer_m: float) -> dict:
+def with_patches(info: dict, dt_s: float, inside) -> dict:
     """β (no element scale) and the net-divergence ratio of the interior's followed elements,
-    and of the same with the remeshed interior patches added back as cells (:func:`patch_cells`)."""
-    from lagice.diagnostics.faults import interior_triangles
-
-    xy0, xy1, tri, dt = _snapshot_pair(run_dir, t0_s, t1_s)
-    inside = interior_triangles(xy0, tri, coast_buffer_m)
-    kept = np.all(np.isfinite(xy1[tri]).reshape(len(tri), -1), axis=1)
+    and of the same with the remeshed interior patches added back as cells (:func:`patch_cells`).
+    ``info``: a window of :func:`window_arrays` (its start mesh and the end position of each
+    start node); ``inside``: the start mesh's interior mask."""
+    xy0, tri = info["start_mesh"][:2]
+    xy1, dt = info["start_nodes_at_end"], dt_s
+    kept = np.zeros(len(tri), bool)
+    kept[info["kept_elements"]] = True
     rates = lagrangian_velocity_gradients(xy0, np.where(np.isfinite(xy1), xy1, xy0), tri[kept & inside], dt)
     g, a, c, used, dropped = patch_cells(xy0, xy1, tri[~kept & inside], dt)
     out = {}
@@ -223,20 +196,19 @@ def run_components(run_dir: Path, window_days: float = 3.0, start_day: float = 1
         xy0, xy1, tri, dt, info = window_arrays(run_dir, t0, t1, coast_buffer_m)
         rates = lagrangian_velocity_gradients(xy0, xy1, tri[info["interior"]], dt)
         row = {"start_day": float(s0), **window_components(rates)}
-        mesh_area = np.abs(triangle_geometry(*info["start_mesh"][:2])[0]).sum()
-        a0 = np.abs(triangle_geometry(xy0, tri)[0]).sum()
-        a1 = np.abs(triangle_geometry(xy1, tri)[0]).sum()
         start_xy, start_tri = info["start_mesh"][:2]
         start_area = np.abs(triangle_geometry(start_xy, start_tri)[0])
+        a0 = np.abs(triangle_geometry(xy0, tri)[0]).sum()
+        a1 = np.abs(triangle_geometry(xy1, tri)[0]).sum()
         inside0 = interior_triangles(start_xy, start_tri, coast_buffer_m)
         lost0 = np.ones(len(start_tri), bool)
         lost0[info["kept_elements"]] = False
-        row.update(followed_area_fraction=float(a0 / mesh_area), followed_area_change=float(a1 / a0 - 1.0),
+        row.update(followed_area_fraction=float(a0 / start_area.sum()), followed_area_change=float(a1 / a0 - 1.0),
                    remeshed_elements=int(info["n_elements_lost"]),
                    interior_area_remeshed_fraction=float(start_area[inside0 & lost0].sum()
                                                          / start_area[inside0].sum()))
         if patches and info["n_elements_lost"]:
-            row["remeshed_patches"] = with_patches(run_dir, t0, t1, coast_buffer_m)
+            row["remeshed_patches"] = with_patches(info, dt, inside0)
         if wind is not None:
             area = rates.area_m2
             row["interior_mean_divergence_per_day"] = float(np.sum(rates.divergence_s * area) / area.sum() * DAY_S)

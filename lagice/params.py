@@ -53,8 +53,8 @@ class MaxwellEBParams:
         max_pressure_thickness_exponent: k of P_max [-] (neXtSIM: 1.5)
         relax_mean_stress: True (Dansereau et al. 2016, neXtSIM): the Maxwell relaxation σ/λ acts
             on the whole stress, so damaged ice creeps in convergence as freely as in shear.
-            False (a diagnostic of lagice, 2026-11-27; docs/physics.md §4, "Damaged ice that keeps
-            its pressure"): it acts on the deviatoric stress σ − m I only, m = (σ1 + σ2)/2, and
+            False (a diagnostic of lagice, 2026-11-27; docs/physics.md §4, "Where β is lost, and
+            damaged ice that keeps its pressure"): it acts on the deviatoric stress σ − m I only, m = (σ1 + σ2)/2, and
             the mean normal stress of damaged ice does not creep; with ``max_pressure_pa`` set the
             mean takes the compressive term's factor above (it creeps where it is tensile or
             compressive beyond P_max). The ice then converges elastically, at damage events or

@@ -64,6 +64,12 @@ def test_window_across_a_remesh_follows_nodes(tmp_path):
     # the coast mask is taken on the start mesh, not on the holes left by the patch
     xy_s, tri_s = win["start_mesh"]
     assert tri_s.shape[0] == win["triangles"].shape[0] + win["n_elements_lost"]
+    # every start node's end position: the affine motion where it survived, NaN where it was replaced
+    end = win["start_nodes_at_end"]
+    gone = np.isnan(end[:, 0])
+    assert 0 < gone.sum() < len(end)
+    np.testing.assert_allclose(end[~gone], (xy_s + dt * (xy_s @ G.T + np.array([0.01, -0.02])))[~gone],
+                               rtol=1e-15, atol=1e-6)
 
 
 def test_window_without_ids_across_remesh_is_refused(tmp_path):

@@ -129,7 +129,9 @@ def load_window(path, start_s: float, end_s: float) -> dict:
     Returns ``{"xy0", "xy1" (n, 2) m, "triangles" (m, 3), "dt_s", "start_s", "end_s",
     "fixed_mesh", "velocity0", "velocity1" (n, 2) m s-1, "n_elements_lost",
     "kept_elements" (indices into the first mesh's triangles), "start_mesh": (nodes,
-    triangles) of the first snapshot, "remesh_events", "datasets": (first, last)}``.
+    triangles) of the first snapshot, "start_nodes_at_end" (n0, 2) m (the end position of
+    each node of the first mesh, NaN where remeshing replaced it), "remesh_events",
+    "datasets": (first, last)}``.
     Masks that depend on the domain boundary (coast distance) should be computed
     on ``start_mesh`` and indexed with ``kept_elements``: the elements left out
     by remeshing open holes that are not coasts.
@@ -166,6 +168,7 @@ def load_window(path, start_s: float, end_s: float) -> dict:
     start_mesh = (xy0, tri)
     kept = np.arange(tri.shape[0])
     lost = 0
+    start_at_end = xy1  # the same nodes when the mesh did not change
     if e0["mesh_epoch"] != e1["mesh_epoch"]:
         if "node_id" not in ds0 or "node_id" not in ds1:
             raise LagiceError(f"{d}: the window {e0['time_s']:g}-{e1['time_s']:g} s spans a remesh "
@@ -177,6 +180,7 @@ def load_window(path, start_s: float, end_s: float) -> dict:
         pos = np.minimum(pos, id1.size - 1)
         found = id1[order][pos] == id0
         at_end = np.where(found, order[pos], -1)          # end index of each start node, -1 if gone
+        start_at_end = np.where(found[:, None], xy1[at_end], np.nan)
         keep_el = np.all(found[tri], axis=1)
         lost = int(tri.shape[0] - keep_el.sum())
         kept = np.flatnonzero(keep_el)
@@ -194,5 +198,5 @@ def load_window(path, start_s: float, end_s: float) -> dict:
             "dt_s": float(e1["time_s"] - e0["time_s"]), "start_s": float(e0["time_s"]),
             "end_s": float(e1["time_s"]), "fixed_mesh": bool(np.array_equal(xy0, xy1)),
             "velocity0": v0, "velocity1": v1, "n_elements_lost": lost, "kept_elements": kept,
-            "start_mesh": start_mesh,
+            "start_mesh": start_mesh, "start_nodes_at_end": start_at_end,
             "remesh_events": int(e1["mesh_epoch"] - e0["mesh_epoch"]), "datasets": (ds0, ds1)}
