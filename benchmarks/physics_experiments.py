@@ -110,6 +110,10 @@ COMPLIANCE50 = ["healing.params.form=compliance", "healing.params.compliance_fac
 #: the basin twice as wide (radius 1000 km instead of 500 km; the coastline and island
 #: scaled): written by :func:`prepare_inputs`, not shipped
 BASIN_X2 = OUT / "winter_basin_coast_x2.geojson"
+#: the shipped basin with seven more islands near its coast (an archipelago): written by
+#: :func:`prepare_inputs`, not shipped; (bearing from the centroid [deg], radius [m])
+BASIN_ARCH = OUT / "winter_basin_coast_archipelago.geojson"
+ARCHIPELAGO = ((115, 40e3), (140, 30e3), (160, 35e3), (20, 40e3), (-60, 35e3), (-125, 30e3), (75, 30e3))
 SPINUPS = {"shipped": ([], ROOT / "data_stubs" / "winter_basin_spinup.npz", 10e3),
            "K50": (COMPLIANCE50, OUT / "spinup-K50.npz", 10e3),
            "S20": ([], OUT / "spinup-S20.npz", 20e3),
@@ -157,6 +161,47 @@ def prepare_inputs():
         g["features"][0]["properties"]["made_by"] = "benchmarks/physics_experiments.py (x2)"
         OUT.mkdir(parents=True, exist_ok=True)
         BASIN_X2.write_text(json.dumps(g))
+    if not BASIN_ARCH.exists():
+        OUT.mkdir(parents=True, exist_ok=True)
+        BASIN_ARCH.write_text(json.dumps(archipelago_basin()))
+
+
+def archipelago_basin(channel_m: float = 25e3) -> dict:
+    """The shipped basin (``data_stubs/winter_basin_coast.geojson``: the same coastline, so
+    the strait's segment still lies on it, and the same island) with seven more islands
+    near its coast (:data:`ARCHIPELAGO`: bearing from the basin's centroid [deg], radius
+    [m]): perturbed circles as ``data_stubs/make_basin_coast.py`` draws the island, each
+    placed ``channel_m`` plus 1.3 radii inside the coast along its bearing. Deterministic.
+    Checked: every island valid, at least 20 km from the coast, 40 km from every other."""
+    from shapely.geometry import LineString, Point, Polygon
+
+    g = json.loads((ROOT / "data_stubs" / "winter_basin_coast.geojson").read_text())
+    rings = g["features"][0]["geometry"]["coordinates"]
+    outer = Polygon(rings[0])
+    islands = [Polygon(r) for r in rings[1:]]
+    c = np.asarray(outer.centroid.coords[0])
+    for i, (bearing, radius) in enumerate(ARCHIPELAGO):
+        d = np.array([math.cos(math.radians(bearing)), math.sin(math.radians(bearing))])
+        hit = LineString([c, c + 2e6 * d]).intersection(outer.exterior)
+        pts = [hit] if hit.geom_type == "Point" else list(hit.geoms)
+        r_coast = min(Point(c).distance(q) for q in pts)
+        centre = c + d * (r_coast - channel_m - 1.3 * radius)
+        rng = np.random.default_rng(100 + i)
+        th = np.linspace(0.0, 2.0 * np.pi, 24, endpoint=False)
+        r = 1.0 + sum(a * np.cos(k * th + rng.uniform(0.0, 2.0 * np.pi)) for k, a in ((2, 0.15), (3, 0.08)))
+        isl = Polygon(np.round(np.column_stack([centre[0] + radius * r * np.cos(th),
+                                                centre[1] + radius * r * np.sin(th)]), 1))
+        if not (isl.is_valid and isl.distance(outer.exterior) >= 20e3
+                and all(isl.distance(o) >= 40e3 for o in islands)):
+            raise SystemExit(f"physics: archipelago island {i} (bearing {bearing} deg) does not fit")
+        islands.append(isl)
+    poly = Polygon(outer.exterior.coords, [list(o.exterior.coords)[::-1] for o in islands])
+    if not poly.is_valid:
+        raise SystemExit("physics: the archipelago basin is not a valid polygon")
+    g["features"][0]["geometry"]["coordinates"] = [[list(map(float, q)) for q in poly.exterior.coords]] + [
+        [list(map(float, q)) for q in ring.coords] for ring in poly.interiors]
+    g["features"][0]["properties"]["made_by"] = "benchmarks/physics_experiments.py (archipelago)"
+    return g
 
 
 # basin size (closed, 20 km, each from its own 20 km spin-up state): the wind stress that
@@ -922,6 +967,33 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # Result (2026-11-27, fifteenth session): the mechanism does not hold (ratio -0.68, -0.67), not a lead
 # (beta 0.043, 0.029: +0.005, -0.001), and the pack moves less than half as much (rate 0.0011 and
 # 0.0014 per day, x0.46 and x0.49; drift 23 and 28 km); 1 and 2 bands inside against 2 and 3.
+
+
+# --- 2026-11-27 (sixteenth session): an archipelago (a diagnostic of geometry) -----------------
+# EVP and Maxwell-EB give the same beta in this basin (0.04 and 0.05 closed, 0.04 and 0.03 strait;
+# docs/validation.md), although their rheologies differ in everything that localises. So what
+# holds beta near 0.04 may lie outside the rheology: in the forcing (winds, eddies: tried) or in
+# the geometry. The basin has a smooth coast and one island; the Arctic Ocean is ringed by
+# archipelagos (the Canadian Arctic Archipelago, Svalbard, Franz Josef Land, Severnaya Zemlya, the
+# New Siberian Islands), and RGPS maps show leads running from island to island and from capes.
+# Each island concentrates stress, so more islands could start more faults, of more orientations,
+# whose motions would cancel between 10 and 150 km. BASIN_ARCH: the shipped coastline and island
+# plus seven islands of radius 30-40 km, 25 km channels from the coast (prepare_inputs). Its
+# interior (>= 100 km from any coast) is 72 % of the shipped basin's (287 000 against 400 000 km2).
+# The flagship set, from the thick-and-thin pack's own 14-day spin-up in this basin (spinup
+# H1125-arch), the validation month, both basins.
+# Stated before the runs (2026-11-27, 12:30 UTC): a lead for beta if beta (>= 10 boxes) rises by
+# 0.04 or more over the shipped month's (0.038 closed, 0.030 strait) in both basins with no band of
+# the six lost (2 and 3 inside); the mechanism (faults of more orientations) holds if beta of the
+# shear part (beta_components.py) rises by 0.02 or more in both basins. Predicted: beta rises by
+# less than 0.02, as for the eddies and the 30-80 km thickness (the islands lie outside the analysed
+# interior; their faults must cross 100 km of ice to count).
+ARCH = [f"domain.file={BASIN_ARCH.relative_to(ROOT)}"]
+SPINUPS["H1125-arch"] = (ARCH + [f"initial.thickness_m={HETERO_THICKNESS}"], OUT / "spinup-H1125-arch.npz", 10e3)
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    EXPERIMENTS[f"{_p}-hthick-arch"] = (
+        _basin, ARCH + from_spinup("H1125-arch"), 10e3, 28,
+        f"{_p}-hthick-1125 in the basin with an archipelago (seven more islands), its own spin-up (diagnostic)")
 
 
 def command(scene, overrides, res, days, out) -> list:
