@@ -994,6 +994,12 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-arch"] = (
         _basin, ARCH + from_spinup("H1125-arch"), 10e3, 28,
         f"{_p}-hthick-1125 in the basin with an archipelago (seven more islands), its own spin-up (diagnostic)")
+# The EVP control in the same basin and month, from the same spin-up state (as E10h, E10hs: beta
+# 0.046, 0.044). Stated before the runs (2026-11-27, 12:40 UTC): if EVP's beta also rises by 0.02
+# or more in both basins, what the islands change is in the geometry, not in Maxwell-EB's fracture.
+for _basin, _e in (("closed", "E10h"), ("strait", "E10hs")):
+    EXPERIMENTS[f"{_e}-arch"] = (_basin, ARCH + from_spinup("H1125-arch") + EVP, 10e3, 28,
+                                 f"{_e} in the basin with an archipelago (diagnostic control)")
 
 
 def command(scene, overrides, res, days, out) -> list:
