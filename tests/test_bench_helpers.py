@@ -257,3 +257,43 @@ def test_a_remeshed_patch_is_added_back_with_the_gradient_of_its_boundary():
     end[boundary[0]] = np.nan
     g, a, c, used2, dropped2 = patch_cells(xy0, end, tri[in_patch], dt)
     assert g.shape == (0, 2, 2) and used2 == 0.0 and dropped2 == pytest.approx(used)
+
+
+def test_archipelago_basin_keeps_the_shipped_coast_and_meshes_with_its_islands():
+    """The archipelago diagnostic (physics_experiments.py, sixteenth session) changes only the
+    islands: the outer ring is the shipped coastline vertex for vertex (the strait scene's
+    open segment runs through those vertices), the shipped island stays, the seven new islands
+    keep the stated clearances, and gmsh meshes the basin with every island as a hole."""
+    import json
+
+    import physics_experiments as pe
+    from shapely.geometry import Polygon, shape
+
+    from lagice.mesh.generate import generate_mesh
+
+    shipped = json.loads((pe.ROOT / "data_stubs" / "winter_basin_coast.geojson").read_text())
+    ship_rings = shipped["features"][0]["geometry"]["coordinates"]
+    g = pe.archipelago_basin()
+    rings = g["features"][0]["geometry"]["coordinates"]
+    assert len(rings) == 2 + len(pe.ARCHIPELAGO)
+    np.testing.assert_array_equal(np.asarray(rings[0]), np.asarray(ship_rings[0]))
+    assert Polygon(rings[1]).equals(Polygon(ship_rings[1]))
+    basin = shape(g["features"][0]["geometry"])
+    assert basin.is_valid
+    outer = Polygon(rings[0])
+    islands = [Polygon(r) for r in rings[1:]]
+    for i, isl in enumerate(islands[1:]):
+        assert isl.distance(outer.exterior) >= 20e3
+        assert min(isl.distance(o) for j, o in enumerate(islands) if j != i + 1) >= 40e3
+        # radius as stated: area of the perturbed circle within 10 % of pi R^2
+        r = pe.ARCHIPELAGO[i][1]
+        assert abs(isl.area / (np.pi * r * r) - 1.0) < 0.1
+    mesh = generate_mesh(basin, 40e3, algorithm=5)
+    e1 = mesh.nodes[mesh.triangles[:, 1]] - mesh.nodes[mesh.triangles[:, 0]]
+    e2 = mesh.nodes[mesh.triangles[:, 2]] - mesh.nodes[mesh.triangles[:, 0]]
+    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]).sum()
+    assert abs(area / basin.area - 1.0) < 0.01
+    centroids = mesh.nodes[mesh.triangles].mean(axis=1)
+    for isl in islands:  # no element inside an island
+        c = np.asarray(isl.centroid.coords[0])
+        assert np.hypot(*(centroids - c).T).min() > 0.3 * np.sqrt(isl.area / np.pi)
