@@ -177,10 +177,36 @@ def with_patches(info: dict, dt_s: float, inside) -> dict:
     return out
 
 
+def region_mask(xy_m: np.ndarray, triangles: np.ndarray, region) -> np.ndarray:
+    """Triangles whose centroid lies inside ``region`` (a shapely geometry in the mesh's metres)."""
+    import shapely
+
+    c = xy_m[triangles].mean(axis=1)
+    return shapely.contains_xy(region, c[:, 0], c[:, 1])
+
+
+def load_region(path: Path, buffer_m: float):
+    """The part of the polygon of GeoJSON file ``path`` at least ``buffer_m`` from its boundary
+    (its coast and its islands' coasts): the interior another basin would analyse."""
+    from shapely.geometry import shape
+
+    g = json.loads(Path(path).read_text())
+    geom = shape(g["features"][0]["geometry"] if "features" in g else g)
+    if geom.is_empty or not geom.is_valid:
+        raise ConfigError(f"{path}: --region needs one valid polygon")
+    region = geom.buffer(-buffer_m)
+    if region.is_empty:
+        raise ConfigError(f"{path}: nothing of the polygon lies {buffer_m / 1e3:g} km from its boundary")
+    return region
+
+
 def run_components(run_dir: Path, window_days: float = 3.0, start_day: float = 1.0,
-                   coast_buffer_m: float = 100e3, wind_curl: bool = False, patches: bool = False) -> dict:
+                   coast_buffer_m: float = 100e3, wind_curl: bool = False, patches: bool = False,
+                   region=None) -> dict:
     """Per-window components and their medians over the windows of one finished run, with the
-    followed area and (``wind_curl``) the interior's mean divergence against the geostrophic curl."""
+    followed area and (``wind_curl``) the interior's mean divergence against the geostrophic curl.
+    ``region`` (shapely, :func:`load_region`): only the interior's elements whose centroid lies in
+    it at the window's start (to compare two basins on the same area)."""
     wind = None
     if wind_curl:
         from lagice.diagnostics.drift import run_wind
@@ -194,8 +220,12 @@ def run_components(run_dir: Path, window_days: float = 3.0, start_day: float = 1
     for s0 in window_starts_days(run_dir, window_days, start_day):
         t0, t1 = s0 * DAY_S, (s0 + window_days) * DAY_S
         xy0, xy1, tri, dt, info = window_arrays(run_dir, t0, t1, coast_buffer_m)
-        rates = lagrangian_velocity_gradients(xy0, xy1, tri[info["interior"]], dt)
+        sel = tri[info["interior"]]
+        if region is not None:
+            sel = sel[region_mask(xy0, sel, region)]
+        rates = lagrangian_velocity_gradients(xy0, xy1, sel, dt)
         row = {"start_day": float(s0), **window_components(rates)}
+        row["analysed_area_km2"] = float(rates.area_m2.sum() / 1e6)
         start_xy, start_tri = info["start_mesh"][:2]
         start_area = np.abs(triangle_geometry(start_xy, start_tri)[0])
         a0 = np.abs(triangle_geometry(xy0, tri)[0]).sum()
@@ -230,14 +260,20 @@ def main(argv=None) -> int:
                     help="also β and the net-divergence ratio with the remeshed interior patches added back")
     ap.add_argument("--wind-curl", action="store_true",
                     help="also the interior's mean divergence against the geostrophic wind's curl (slower)")
+    ap.add_argument("--region", type=Path, default=None, metavar="GEOJSON",
+                    help="only elements >= 100 km from this polygon's boundary too (records as RUN@region:NAME)")
     args = ap.parse_args(argv)
+    region = None if args.region is None else load_region(args.region, 100e3)
     missing = [r for r in args.runs if not (RUNS / r).is_dir()]
     if missing:
         raise ConfigError(f"no run folder for {missing} in {RUNS}: make them with physics_experiments.py run")
     table = json.loads(OUT.read_text()) if OUT.exists() else {}
     print(f"{'run':38s} {'beta':>6s} {'shear':>6s} {'div':>6s} {'net div':>8s} {'|div|/sh':>8s} {'rate/d':>8s}")
     for name in args.runs:
-        res = run_components(RUNS / name, wind_curl=args.wind_curl, patches=args.patches)
+        res = run_components(RUNS / name, wind_curl=args.wind_curl, patches=args.patches, region=region)
+        if region is not None:
+            res["region"] = str(args.region.name)
+            name = f"{name}@region:{args.region.stem}"
         table[name] = res
         m = res["median"]
         print(f"{name:38s} {m['beta']:6.3f} {m['beta_shear_part']:6.3f} {m['beta_divergence_part']:6.3f} "

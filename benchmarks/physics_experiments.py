@@ -113,6 +113,8 @@ BASIN_X2 = OUT / "winter_basin_coast_x2.geojson"
 #: the shipped basin with seven more islands near its coast (an archipelago): written by
 #: :func:`prepare_inputs`, not shipped; (bearing from the centroid [deg], radius [m])
 BASIN_ARCH = OUT / "winter_basin_coast_archipelago.geojson"
+#: the published copy of every run's record (experiments.json with paths made repository-relative)
+PUBLISHED = ROOT / "docs" / "figures" / "physics_experiments.json"
 ARCHIPELAGO = ((115, 40e3), (140, 30e3), (160, 35e3), (20, 40e3), (-60, 35e3), (-125, 30e3), (75, 30e3))
 SPINUPS = {"shipped": ([], ROOT / "data_stubs" / "winter_basin_spinup.npz", 10e3),
            "K50": (COMPLIANCE50, OUT / "spinup-K50.npz", 10e3),
@@ -1000,6 +1002,14 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 for _basin, _e in (("closed", "E10h"), ("strait", "E10hs")):
     EXPERIMENTS[f"{_e}-arch"] = (_basin, ARCH + from_spinup("H1125-arch") + EVP, 10e3, 28,
                                  f"{_e} in the basin with an archipelago (diagnostic control)")
+# Result (2026-11-27, sixteenth session): NOT a lead, and the mechanism does not hold. beta 0.038 ->
+# 0.018 (closed), 0.030 -> 0.079 (strait); its shear part 0.045 -> 0.038, 0.057 -> 0.091. On the
+# same area (the shipped runs analysed on the archipelago's interior: beta_components.py --region)
+# the shipped month has beta 0.060 and 0.054, so the islands move it by -0.042 and +0.025. The
+# islands hold the pack: rate x0.44 and x0.36 (0.0011, 0.0010 per day), wind factor 0.0024 and
+# 0.0032, the interior closes more coherently (net-divergence ratio -0.86, -0.77). Bands inside: 3
+# (closed; the shear tail, the half-shear area, R2) and 2 (strait) against 2 and 3. EVP control:
+# beta 0.046 -> 0.052 and 0.044 -> 0.055 (below its 0.02), rate and drift about the same.
 
 
 def command(scene, overrides, res, days, out) -> list:
@@ -1173,6 +1183,61 @@ def table() -> str:
              "|---|---|" + "---|" * (len(TARGETS) + 3),
              "| | observed | 0.17–0.20 | 1.9–2.5 | 2.2–2.8 | 4–8 % | 0.73–0.93 | 0.01–0.05 | | | |"]
     lines += [row(allr[n]) for n in EXPERIMENTS if n in allr]
+    return "\n".join(lines)
+
+
+#: window-rate bins [day⁻¹] of :func:`beta_by_rate`; 0.01-0.05 is the observed band
+RATE_BINS = ((0.0, 1e-3), (1e-3, 3e-3), (3e-3, 1e-2), (1e-2, 5e-2), (5e-2, math.inf))
+
+
+def beta_by_rate(records: dict, resolution_m: float = 10e3, bins=RATE_BINS) -> dict:
+    """β of single 3-day windows against the window's mean total deformation rate, pooled over
+    every run of ``records`` (:data:`OUT`/experiments.json, or the published copy) at
+    ``resolution_m`` whose β was fitted with the validation's estimator (widths with at least
+    10 boxes; records without ``beta_min_boxes`` used every width and are left out).
+    Maxwell-EB and EVP (``solver.name=evp`` in the overrides) apart. For each rheology and rate
+    bin: the count of windows and runs, the median, quartiles and 90th percentile of β and the
+    fraction of windows with β ≥ 0.17 (the observed band's lower edge). Does the pack reach the
+    observed β in windows where it deforms at the observed rate?"""
+    pooled = {"maxwell_eb": ([], [], []), "evp": ([], [], [])}
+    for name, r in records.items():
+        if r.get("resolution_m") != resolution_m or r.get("beta_min_boxes") != 10:
+            continue
+        key = "evp" if "solver.name=evp" in r.get("overrides", []) else "maxwell_eb"
+        for w, rate in zip(r["per_window"], r["window_rates_per_day"]):
+            b = w.get("beta_space")
+            if b is not None and math.isfinite(b) and rate is not None and math.isfinite(rate):
+                pooled[key][0].append(b)
+                pooled[key][1].append(rate)
+                pooled[key][2].append(name)
+    out = {}
+    for key, (beta, rate, names) in pooled.items():
+        beta, rate, names = np.asarray(beta, float), np.asarray(rate, float), np.asarray(names)
+        rows = []
+        for lo, hi in bins:
+            m = (rate >= lo) & (rate < hi)
+            row = {"rate_per_day": [lo, hi], "windows": int(m.sum()), "runs": int(np.unique(names[m]).size)}
+            if m.any():
+                q25, q50, q75, q90 = np.percentile(beta[m], [25, 50, 75, 90])
+                row.update(beta_median=float(q50), beta_q25=float(q25), beta_q75=float(q75), beta_q90=float(q90),
+                           fraction_at_least_0_17=float(np.mean(beta[m] >= TARGETS["beta_space"][0])))
+            rows.append(row)
+        out[key] = {"runs": int(np.unique(names).size), "windows": int(beta.size), "bins": rows}
+    return out
+
+
+def beta_by_rate_table(result: dict) -> str:
+    lines = ["| rheology | window rate (day⁻¹) | windows (runs) | β median | β quartiles | β 90th pct "
+             "| windows with β ≥ 0.17 |", "|---|---|---|---|---|---|---|"]
+    for key, label in (("maxwell_eb", "Maxwell-EB"), ("evp", "EVP")):
+        for row in result[key]["bins"]:
+            if not row["windows"]:
+                continue
+            lo, hi = row["rate_per_day"]
+            span = f"≥ {lo:g}" if math.isinf(hi) else f"{lo:g}–{hi:g}"
+            lines.append(f"| {label} | {span} | {row['windows']} ({row['runs']}) | {row['beta_median']:.3f} | "
+                         f"{row['beta_q25']:.3f}–{row['beta_q75']:.3f} | {row['beta_q90']:.3f} | "
+                         f"{100 * row['fraction_at_least_0_17']:.1f} % |")
     return "\n".join(lines)
 
 
@@ -1358,7 +1423,8 @@ def spinup(name="shipped", days=14):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("what", choices=("list", "run", "table", "spread", "spinup", "analyse", "figure", "screen"))
+    ap.add_argument("what", choices=("list", "run", "table", "spread", "spinup", "analyse", "figure", "screen",
+                                    "beta-by-rate"))
     ap.add_argument("names", nargs="*")
     ap.add_argument("--force", action="store_true", help="run again even if the run finished")
     ap.add_argument("--jobs", type=int, default=1,
@@ -1392,6 +1458,11 @@ def main(argv=None):
             spinup(n, SPINUP_DAYS.get(n, 14))
     elif args.what == "spread":
         print(spread())
+    elif args.what == "beta-by-rate":  # from the published records, so a fresh checkout gives the same
+        res = beta_by_rate(json.loads(PUBLISHED.read_text()))
+        print(beta_by_rate_table(res))
+        (ROOT / "docs" / "figures" / "beta_by_rate.json").write_text(json.dumps(res, indent=1) + "\n")
+        print("physics: wrote docs/figures/beta_by_rate.json")
     elif args.what == "screen":  # CANDIDATE_GROUP REFERENCE_GROUP
         if len(args.names) != 2:
             raise SystemExit("physics: screen needs two groups of ENSEMBLES: CANDIDATE REFERENCE")

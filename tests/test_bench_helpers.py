@@ -297,3 +297,54 @@ def test_archipelago_basin_keeps_the_shipped_coast_and_meshes_with_its_islands()
     for isl in islands:  # no element inside an island
         c = np.asarray(isl.centroid.coords[0])
         assert np.hypot(*(centroids - c).T).min() > 0.3 * np.sqrt(isl.area / np.pi)
+
+
+def test_beta_by_rate_pools_windows_by_rate_and_rheology_and_skips_old_estimators():
+    """``physics_experiments.py beta-by-rate``: each window's β goes to the bin of its own rate;
+    EVP apart; records fitted with every width (no ``beta_min_boxes``) or at another resolution
+    are left out; the fraction at or above 0.17 counts windows."""
+    import physics_experiments as pe
+
+    def rec(betas, rates, overrides=(), res=10e3, boxes=10):
+        r = {"resolution_m": res, "overrides": list(overrides), "window_rates_per_day": list(rates),
+             "per_window": [{"beta_space": b} for b in betas]}
+        if boxes is not None:
+            r["beta_min_boxes"] = boxes
+        return r
+
+    records = {"a": rec([0.01, 0.20, 0.05], [5e-4, 0.02, 0.02]),
+               "b": rec([0.30, float("nan")], [0.02, 0.02]),
+               "e": rec([0.10, 0.02], [0.02, 2e-4], overrides=["solver.name=evp"]),
+               "old": rec([0.9, 0.9], [0.02, 0.02], boxes=None),
+               "coarse": rec([0.9], [0.02], res=20e3)}
+    res = pe.beta_by_rate(records)
+    meb = {tuple(r["rate_per_day"]): r for r in res["maxwell_eb"]["bins"]}
+    assert res["maxwell_eb"]["windows"] == 4 and res["maxwell_eb"]["runs"] == 2
+    quiet, observed = meb[(0.0, 1e-3)], meb[(1e-2, 5e-2)]
+    assert quiet["windows"] == 1 and quiet["beta_median"] == 0.01
+    assert observed["windows"] == 3 and observed["runs"] == 2
+    assert observed["beta_median"] == 0.20 and observed["fraction_at_least_0_17"] == 2 / 3
+    evp = {tuple(r["rate_per_day"]): r for r in res["evp"]["bins"]}
+    assert evp[(1e-2, 5e-2)]["beta_median"] == 0.10 and evp[(0.0, 1e-3)]["windows"] == 1
+    assert "| Maxwell-EB | 0.01–0.05 | 3 (2) | 0.200 |" in pe.beta_by_rate_table(res)
+
+
+def test_beta_components_region_keeps_elements_inside_another_basins_interior(tmp_path):
+    """``beta_components.py --region``: the region is the polygon less a ``buffer_m`` band along
+    every boundary (islands included), and an element counts if its centroid lies in it."""
+    import json
+
+    from beta_components import load_region, region_mask
+    from shapely.geometry import Point, box, mapping
+
+    poly = box(0, 0, 1000e3, 1000e3).difference(Point(500e3, 500e3).buffer(50e3))
+    f = tmp_path / "basin.geojson"
+    f.write_text(json.dumps({"type": "FeatureCollection",
+                             "features": [{"type": "Feature", "properties": {}, "geometry": mapping(poly)}]}))
+    region = load_region(f, 100e3)
+    # centroids: near the outer coast, near the island, in between, and far out
+    xy = np.array([[50e3, 500e3], [620e3, 500e3], [300e3, 300e3], [800e3, 800e3], [2e6, 2e6]], float)
+    tri = np.array([[i, i, i] for i in range(len(xy))])  # degenerate triangles: centroid = the point
+    np.testing.assert_array_equal(region_mask(xy, tri, region), [False, False, True, True, False])
+    with pytest.raises(Exception, match="km from its boundary"):
+        load_region(f, 600e3)
