@@ -73,7 +73,10 @@ VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.me
 
 
 def _value(v: str):
-    """A --set value as the scene wants it: an integer stays an integer, a word a string."""
+    """A --set value as the scene wants it: an integer stays an integer, true/false a boolean,
+    a word a string."""
+    if v in ("true", "false"):
+        return v == "true"
     for kind in (int, float):
         try:
             return kind(v)

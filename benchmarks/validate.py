@@ -389,6 +389,10 @@ def run_finished(run: Path) -> bool:
 #: by 0.008 of 142 kPa (6e-5), which "any positive drop" used to call a rupture. 1e-3 lies a factor
 #: 3 below the smallest failure and 17 above the wobble.
 RUPTURE_MIN_DROP = 1e-3
+#: the post-peak phase of the compression analysis: from the block of the peak stress until the
+#: strain has grown by this fraction of the peak strain (2026-11-27; a choice of the diagnostic,
+#: long enough to hold the first softening of a plate that does not drop at once)
+POST_PEAK_STRAIN_FRACTION = 0.2
 
 
 def analyse_compression(path: Path) -> dict:
@@ -428,6 +432,26 @@ def analyse_compression(path: Path) -> dict:
     # never failed, and the "faults" of the rate field would be its elastic or yielding pattern;
     # no fault angles then
     ruptured = bool(drop[k_rup] >= RUPTURE_MIN_DROP * abs(stress[k_peak]) and np.any(z["damage_block_end"][-1] > 0.0))
+    # the post-peak phase: the blocks from the peak's block until the strain has grown by a fifth
+    # of the peak strain. Where the plate softens gradually (no one large drop right after the
+    # peak), the block with the largest drop can be a small event late in the plateau; the
+    # faults active while the plate first softens are then those of this phase.
+    k_peak_block = min(k_peak // block, n_blocks - 1)
+    k_post_end = min(n_blocks, k_peak_block + max(1, int(POST_PEAK_STRAIN_FRACTION * (k_peak_block + 1))))
+    post_rate = np.zeros(tri.shape[0])
+    for b in range(k_peak_block, k_post_end):
+        post_rate += velocity_gradients(nodes, tri, z["velocity_block_mean"][b]).total_s
+    f_post = fault_orientations(centroids, post_rate * area, 2 * dx) if post_rate.sum() > 0 else None
+    d_post = np.clip(z["damage_block_end"][k_post_end - 1].astype(float)
+                     - (z["damage_block_end"][k_peak_block - 1] if k_peak_block > 0 else 0.0), 0.0, None)
+    f_post_dmg = fault_orientations(centroids, d_post * area, 2 * dx) if d_post.sum() > 0 else None
+    post_peak = {"blocks": [k_peak_block, k_post_end],
+                 "stress_drop_kpa": float((stress[k_peak] - s_end[k_post_end - 1]) / 1e3),
+                 "fault_angles_rate_deg": None if f_post is None else angle_to_axis_deg(f_post.angles_deg).tolist(),
+                 "fault_directions_rate_deg": None if f_post is None else f_post.angles_deg.tolist(),
+                 "fault_angles_damage_deg": None if f_post_dmg is None
+                 else angle_to_axis_deg(f_post_dmg.angles_deg).tolist(),
+                 "fault_directions_damage_deg": None if f_post_dmg is None else f_post_dmg.angles_deg.tolist()}
     # intermittency: skewness of the macroscopic stress increments
     inc = np.diff(stress) / dt
     mc = mohr_coulomb_fault_angle_deg(float(z["friction"]))
@@ -438,6 +462,7 @@ def analyse_compression(path: Path) -> dict:
         "rupture_block": k_rup, "rupture_time_s": float((k_rup + 1) * block * dt),
         "rupture_drop_kpa": float(drop[k_rup] / 1e3), "ruptured": ruptured,
         "rupture_min_drop_fraction": RUPTURE_MIN_DROP,
+        "rupture_blocks_after_peak": int(k_rup - k_peak_block), "post_peak": post_peak,
         "mohr_coulomb_angle_deg": mc,
         "fault_angles_rate_deg": angle_to_axis_deg(f_rate.angles_deg).tolist() if ruptured else None,
         "fault_directions_rate_deg": f_rate.angles_deg.tolist(), "fault_scores_rate": f_rate.scores.tolist(),

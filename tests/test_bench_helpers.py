@@ -348,3 +348,56 @@ def test_beta_components_region_keeps_elements_inside_another_basins_interior(tm
     np.testing.assert_array_equal(region_mask(xy, tri, region), [False, False, True, True, False])
     with pytest.raises(Exception, match="km from its boundary"):
         load_region(f, 600e3)
+
+
+def _band_velocity(nodes, angle_to_y_deg, speed=1e-3, width=5e3):
+    """A smoothed slip across a straight band through the plate's centre at ``angle_to_y_deg``
+    from the y axis: the nodes on one side move along the band at ``speed``."""
+    a = np.radians(90.0 + angle_to_y_deg)
+    t = np.array([np.cos(a), np.sin(a)])
+    n = np.array([-t[1], t[0]])
+    d = (nodes - nodes.mean(axis=0)) @ n
+    return np.outer(0.5 * (1.0 + np.tanh(d / width)), t * speed)
+
+
+def test_compression_analysis_reports_the_faults_of_the_post_peak_phase(tmp_path):
+    """``analyse_compression``: a plate that softens gradually after its peak (a band at 30° to
+    the load) and drops most, later, in a small event on another band (60°). The largest-drop
+    block is the late event; the post-peak phase (from the peak until the strain has grown by
+    a fifth) finds the 30° band in the rate and in the damage it made."""
+    from validate import POST_PEAK_STRAIN_FRACTION, analyse_compression
+
+    nx, ny, dx = 40, 80, 2.5e3
+    xs, ys = np.meshgrid(np.arange(nx + 1) * dx, np.arange(ny + 1) * dx)
+    nodes = np.column_stack([xs.ravel(), ys.ravel()])
+    idx = np.arange((nx + 1) * (ny + 1)).reshape(ny + 1, nx + 1)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(), idx[1:, :-1].ravel()
+    tri = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    cen = nodes[tri].mean(axis=1)
+    n_blocks, block, peak_block, late_block = 50, 2, 10, 40
+    s_end = np.concatenate([np.linspace(10e3, 100e3, peak_block + 1),           # loading to the peak
+                            100e3 - 0.4e3 * np.arange(1, 4),                    # gradual softening
+                            np.full(late_block - peak_block - 4, 98.8e3),       # plateau
+                            [96.8e3], np.full(n_blocks - late_block - 1, 96.8e3)])  # the late 2 kPa drop
+    stress = np.repeat(s_end, block)
+    vel = np.zeros((n_blocks, nodes.shape[0], 2))
+    n_post = max(1, int(POST_PEAK_STRAIN_FRACTION * (peak_block + 1)))
+    for k in range(peak_block, peak_block + n_post):
+        vel[k] = _band_velocity(nodes, 30.0)
+    vel[late_block] = _band_velocity(nodes, 60.0)
+    damage = np.zeros((n_blocks, tri.shape[0]), np.float32)
+    a30 = np.radians(120.0)
+    dist30 = np.abs((cen - nodes.mean(axis=0)) @ np.array([-np.sin(a30), np.cos(a30)]))
+    damage[peak_block:] = np.where(dist30 < 3e3, 0.8, 0.0)
+    path = tmp_path / "compression.npz"
+    np.savez(path, stress_pa=stress, dt_s=5.0, block_steps=block, nodes=nodes, triangles=tri,
+             velocity_block_mean=vel, damage_block_end=damage, width_m=nx * dx, n_across=nx,
+             length_m=ny * dx, push_speed_m_s=1e-3, friction=0.7, wall_s=1.0)
+    res = analyse_compression(path)
+    assert res["rupture_block"] == late_block and res["rupture_blocks_after_peak"] == late_block - peak_block
+    assert abs(res["fault_angles_rate_deg"][0] - 60.0) < 3.0
+    post = res["post_peak"]
+    assert post["blocks"] == [peak_block, peak_block + n_post]
+    assert abs(post["fault_angles_rate_deg"][0] - 30.0) < 3.0
+    assert abs(post["fault_angles_damage_deg"][0] - 30.0) < 3.0
+    assert n_post == 2 and abs(post["stress_drop_kpa"] - 0.4) < 1e-9  # peak to the phase's last block
