@@ -198,6 +198,44 @@ def _strip(o):
     return o
 
 
+def figure_compression(out: Path, n_across: int, variants, path: Path):
+    """One column per variant: the macroscopic stress (the post-peak phase shaded), the total
+    deformation rate summed over the post-peak phase (log, relative to its largest), and the
+    damage at the end of the run."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from lagice.diagnostics import velocity_gradients
+
+    fig, ax = plt.subplots(3, len(variants), figsize=(5.2 * len(variants), 13.5), squeeze=False)
+    for j, v in enumerate(variants):
+        z = np.load(out / f"compression_N{n_across}_{v}.npz")
+        r = run_compression(out, n_across, v)
+        s, dt, block = z["stress_pa"], float(z["dt_s"]), int(z["block_steps"])
+        nodes, tri = z["nodes"] / 1e3, z["triangles"]
+        b0, b1 = r["post_peak"]["blocks"]
+        rate = sum(velocity_gradients(z["nodes"], tri, z["velocity_block_mean"][b]).total_s for b in range(b0, b1))
+        ax[0, j].plot((np.arange(s.size) + 1) * dt / 1e3, s / 1e3, lw=0.8)
+        ax[0, j].axvspan(b0 * block * dt / 1e3, b1 * block * dt / 1e3, color="0.85")
+        ax[0, j].set(xlabel="time (ks)", ylabel="compressive stress (kPa)")
+        ax[0, j].set_title(f"N = {n_across}, {v}", fontsize=9)
+        pp = r["post_peak"]["fault_angles_damage_deg"] or []
+        ref = max(float(np.percentile(rate, 99.5)), 1e-300)
+        ax[1, j].tripcolor(nodes[:, 0], nodes[:, 1], tri, cmap="magma", vmin=-2, vmax=0,
+                           facecolors=np.log10(np.clip(rate / ref, 1e-2, 1.0)))
+        ax[1, j].set(aspect="equal", xlabel="x (km)")
+        ax[1, j].set_title("post-peak rate, log10 of rate / its 99.5th pct", fontsize=9)
+        tp = ax[2, j].tripcolor(nodes[:, 0], nodes[:, 1], tri, facecolors=z["damage_block_end"][-1].astype(float),
+                                cmap="viridis", vmin=0, vmax=1)
+        ax[2, j].set(aspect="equal", xlabel="x (km)")
+        ax[2, j].set_title("damage at the end; post-peak bands " + ", ".join(f"{a:.0f}°" for a in pp), fontsize=9)
+    fig.colorbar(tp, ax=ax[2, :].tolist(), shrink=0.6, label="damage")
+    fig.savefig(path, dpi=80)
+    print(f"wrote {path}")
+
+
 def figure_cyclone(out: Path, variants, path: Path):
     import matplotlib
 
@@ -245,6 +283,8 @@ def main(argv=None):
     ap.add_argument("--max-strain", type=float, default=1e-3)
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "out" / "mesh_imprint")
     ap.add_argument("--fig-dir", type=Path, default=ROOT / "docs" / "figures")
+    ap.add_argument("--figure", default=None, metavar="NAME",
+                    help="compression: also FIG_DIR/NAME.png, the variants side by side (stress, rate, damage)")
     args = ap.parse_args(argv)
     out = args.out.resolve()
     out.mkdir(parents=True, exist_ok=True)
@@ -281,10 +321,19 @@ def main(argv=None):
                       f"{[round(a, 1) for a in (r['fault_angles_damage_deg'] or [])]} MC "
                       f"{r['mohr_coulomb_angle_deg']:.1f}; imprint index (rate) {im['index']:.3f}; peak "
                       f"{r['peak_stress_kpa']:.0f} kPa; wall {r['wall_s']:.0f} s", flush=True)
+                pp = r["post_peak"]
+                print(f"      largest drop {r['rupture_drop_kpa']:.2f} kPa, {r['rupture_blocks_after_peak']} blocks "
+                      f"after the peak; post-peak phase (blocks {pp['blocks'][0]}-{pp['blocks'][1]}, drop "
+                      f"{pp['stress_drop_kpa']:.2f} kPa): faults (rate) "
+                      f"{[round(a, 1) for a in (pp['fault_angles_rate_deg'] or [])]} (damage gained) "
+                      f"{[round(a, 1) for a in (pp['fault_angles_damage_deg'] or [])]}", flush=True)
                 allres.setdefault("compression", {}).setdefault(f"N{n}", {})[v] = _strip(
                     {k: r[k] for k in ("fault_angles_rate_deg", "fault_angles_damage_deg", "fault_directions_rate_deg",
                                        "mohr_coulomb_angle_deg", "peak_stress_kpa", "rupture_time_s", "wall_s",
-                                       "imprint", "ruptured", "rupture_drop_kpa")} | {"git_commit": git_commit()})
+                                       "imprint", "ruptured", "rupture_drop_kpa", "rupture_blocks_after_peak",
+                                       "post_peak")} | {"git_commit": git_commit()})
+            if args.figure:
+                figure_compression(out, n, args.variants, args.fig_dir / f"{args.figure}.png")
     else:
         figure_cyclone(out, [v for v in allres.get("cyclone", {})], args.fig_dir / "mesh_imprint_cyclone.png")
     args.fig_dir.mkdir(parents=True, exist_ok=True)
