@@ -110,11 +110,11 @@ COMPLIANCE50 = ["healing.params.form=compliance", "healing.params.compliance_fac
 #: the basin twice as wide (radius 1000 km instead of 500 km; the coastline and island
 #: scaled): written by :func:`prepare_inputs`, not shipped
 BASIN_X2 = OUT / "winter_basin_coast_x2.geojson"
+#: the published copy of every run's record (experiments.json with paths made repository-relative)
+PUBLISHED = ROOT / "docs" / "figures" / "physics_experiments.json"
 #: the shipped basin with seven more islands near its coast (an archipelago): written by
 #: :func:`prepare_inputs`, not shipped; (bearing from the centroid [deg], radius [m])
 BASIN_ARCH = OUT / "winter_basin_coast_archipelago.geojson"
-#: the published copy of every run's record (experiments.json with paths made repository-relative)
-PUBLISHED = ROOT / "docs" / "figures" / "physics_experiments.json"
 ARCHIPELAGO = ((115, 40e3), (140, 30e3), (160, 35e3), (20, 40e3), (-60, 35e3), (-125, 30e3), (75, 30e3))
 SPINUPS = {"shipped": ([], ROOT / "data_stubs" / "winter_basin_spinup.npz", 10e3),
            "K50": (COMPLIANCE50, OUT / "spinup-K50.npz", 10e3),
@@ -972,7 +972,7 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 
 
 # --- 2026-11-27 (sixteenth session): an archipelago (a diagnostic of geometry) -----------------
-# EVP and Maxwell-EB give the same beta in this basin (0.04 and 0.05 closed, 0.04 and 0.03 strait;
+# EVP and Maxwell-EB give the same beta in this basin (0.05 and 0.04 closed, 0.04 and 0.03 strait;
 # docs/validation.md), although their rheologies differ in everything that localises. So what
 # holds beta near 0.04 may lie outside the rheology: in the forcing (winds, eddies: tried) or in
 # the geometry. The basin has a smooth coast and one island; the Arctic Ocean is ringed by
