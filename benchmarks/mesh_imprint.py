@@ -198,25 +198,22 @@ def _strip(o):
     return o
 
 
-def figure_compression(out: Path, n_across: int, variants, path: Path):
-    """One column per variant: the macroscopic stress (the post-peak phase shaded), the total
-    deformation rate summed over the post-peak phase (log, relative to its largest), and the
-    damage at the end of the run."""
+def figure_compression(out: Path, n_across: int, results: dict, path: Path):
+    """One column per variant of ``results`` (variant -> :func:`run_compression`'s result): the
+    macroscopic stress (the post-peak phase shaded), the total deformation rate summed over the
+    post-peak phase (log, relative to its 99.5th percentile), and the damage at the end of the run."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from lagice.diagnostics import velocity_gradients
-
-    fig, ax = plt.subplots(3, len(variants), figsize=(5.2 * len(variants), 13.5), squeeze=False)
-    for j, v in enumerate(variants):
+    fig, ax = plt.subplots(3, len(results), figsize=(5.2 * len(results), 13.5), squeeze=False)
+    for j, (v, r) in enumerate(results.items()):
         z = np.load(out / f"compression_N{n_across}_{v}.npz")
-        r = run_compression(out, n_across, v)
         s, dt, block = z["stress_pa"], float(z["dt_s"]), int(z["block_steps"])
         nodes, tri = z["nodes"] / 1e3, z["triangles"]
         b0, b1 = r["post_peak"]["blocks"]
-        rate = sum(velocity_gradients(z["nodes"], tri, z["velocity_block_mean"][b]).total_s for b in range(b0, b1))
+        rate = r["_plot"]["post_peak_rate"]
         ax[0, j].plot((np.arange(s.size) + 1) * dt / 1e3, s / 1e3, lw=0.8)
         ax[0, j].axvspan(b0 * block * dt / 1e3, b1 * block * dt / 1e3, color="0.85")
         ax[0, j].set(xlabel="time (ks)", ylabel="compressive stress (kPa)")
@@ -309,8 +306,9 @@ def main(argv=None):
         figure_cyclone(out, args.variants, args.fig_dir / "mesh_imprint_cyclone.png")
     elif args.what == "compression":
         for n in args.n_across:
+            results = {}
             for v in args.variants:
-                r = run_compression(out, n, v, args.max_strain)
+                r = results[v] = run_compression(out, n, v, args.max_strain)
                 im = r["imprint"]["rate_rupture"]
                 if not r["ruptured"]:
                     print(f"  compression N={n} {v:10s}: NO RUPTURE (largest stress drop {r['rupture_drop_kpa']:.3f} "
@@ -333,7 +331,7 @@ def main(argv=None):
                                        "imprint", "ruptured", "rupture_drop_kpa", "rupture_blocks_after_peak",
                                        "post_peak")} | {"git_commit": git_commit()})
             if args.figure:
-                figure_compression(out, n, args.variants, args.fig_dir / f"{args.figure}.png")
+                figure_compression(out, n, results, args.fig_dir / f"{args.figure}.png")
     else:
         figure_cyclone(out, [v for v in allres.get("cyclone", {})], args.fig_dir / "mesh_imprint_cyclone.png")
     args.fig_dir.mkdir(parents=True, exist_ok=True)

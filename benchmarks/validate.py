@@ -475,7 +475,7 @@ def analyse_compression(path: Path) -> dict:
         "beta_blocks": betas.tolist(),
         "_plot": {"stress": stress, "betas": betas, "scale_curves": scale_curves, "centroids": centroids,
                   "tri": tri, "nodes": nodes, "rate": r_rate.total_s, "d_gain": d_gain, "f_rate": f_rate,
-                  "f_dmg": f_dmg},
+                  "f_dmg": f_dmg, "post_peak_rate": post_rate},
     }
 
 
