@@ -63,6 +63,7 @@ from lagice.diagnostics import spatial_scaling, velocity_gradients, window_stati
 from lagice.diagnostics.drift import THORNDIKE_COLONY_WINTER
 from lagice.diagnostics.faults import (
     angle_to_axis_deg,
+    damage_mode_fault_angle_deg,
     fault_orientations,
     mohr_coulomb_fault_angle_deg,
 )
@@ -371,7 +372,8 @@ def run_compression(out: Path, n_across: int, max_strain: float, seed: int = 0, 
                         damage_block_end=rec.damage_end, nodes=m.mesh.nodes, triangles=m.mesh.triangles,
                         dt_s=sim.dt, block_steps=block, n_across=n_across, length_m=length,
                         width_m=width, push_speed_m_s=push, friction=m.rheology.params.friction,
-                        wall_s=wall, seed=seed)
+                        poisson=m.rheology.params.poisson,
+                        stress_correction=str(m.rheology.params.stress_correction), wall_s=wall, seed=seed)
     return path
 
 
@@ -455,6 +457,9 @@ def analyse_compression(path: Path) -> dict:
     # intermittency: skewness of the macroscopic stress increments
     inc = np.diff(stress) / dt
     mc = mohr_coulomb_fault_angle_deg(float(z["friction"]))
+    # the most unstable damage band (origin correction only; records before 2026-11-27 lack ν)
+    origin = "poisson" in z and str(z["stress_correction"]) == "origin"
+    mode = damage_mode_fault_angle_deg(float(z["friction"]), poisson_ratio=float(z["poisson"])) if origin else None
     return {
         "n_across": int(z["n_across"]), "steps": int(stress.size), "dt_s": dt, "block_steps": block,
         "wall_s": float(z["wall_s"]), "peak_stress_kpa": float(stress[k_peak] / 1e3),
@@ -463,7 +468,7 @@ def analyse_compression(path: Path) -> dict:
         "rupture_drop_kpa": float(drop[k_rup] / 1e3), "ruptured": ruptured,
         "rupture_min_drop_fraction": RUPTURE_MIN_DROP,
         "rupture_blocks_after_peak": int(k_rup - k_peak_block), "post_peak": post_peak,
-        "mohr_coulomb_angle_deg": mc,
+        "mohr_coulomb_angle_deg": mc, "damage_mode_angle_deg": mode,
         "fault_angles_rate_deg": angle_to_axis_deg(f_rate.angles_deg).tolist() if ruptured else None,
         "fault_directions_rate_deg": f_rate.angles_deg.tolist(), "fault_scores_rate": f_rate.scores.tolist(),
         "fault_angles_damage_deg": None if f_dmg is None else angle_to_axis_deg(f_dmg.angles_deg).tolist(),

@@ -42,7 +42,9 @@ class MaxwellEBParams:
             deviatoric part scaled, the mean kept; implicit solver only; docs/physics.md,
             compression test) or ``"associated"`` (along K n, n the envelope's normal: the
             return of an associated plasticity; implicit solver only)
-        stress_correction_mean_fraction: θ ∈ (0, 1] of ``"mean_stress"`` (None: 1) [-]
+        stress_correction_mean_fraction: θ ∈ (0, 2] of ``"mean_stress"`` (None: 1) [-]; θ > 1
+            returns towards a pressure above the element's own, so the inelastic strain dilates
+            (sin ψ = (θ − 1)(1 − ν)/(1 + ν) in uniaxial compression; docs/physics.md §4)
         max_pressure_pa: P* of neXtSIM's compressive term [Pa] (None or 0: off). Where the mean
             normal stress is compressive, −σn > 0, the Maxwell relaxation acts only on the part
             above P_max = P* (h / 1 m)^k exp(−c*(1−A)): the relaxation factor becomes
@@ -107,7 +109,7 @@ class MaxwellEBParams:
                 theta = self.stress_correction_mean_fraction
                 raise ConfigError(f"rheology.stress_correction_mean_fraction = {theta!r} applies to "
                                   f"stress_correction = 'mean_stress' only (it is {self.stress_correction!r})")
-            check_range("stress_correction_mean_fraction (θ)", self.stress_correction_mean_fraction, 0.0, 1.0,
+            check_range("stress_correction_mean_fraction (θ)", self.stress_correction_mean_fraction, 0.0, 2.0,
                         low_open=True)
 
     @property

@@ -147,7 +147,7 @@ def test_mean_stress_correction_keeps_the_mean_and_lands_on_the_envelope(rng):
     r = r_env * rng.uniform(1.05, 3.0, n)
     sig = rotate(m + r, m - r, rng.uniform(0, np.pi, n))
     dcs = {}
-    for theta in (0.0, 0.5, 1.0):
+    for theta in (0.0, 0.5, 1.0, 1.5):
         kw = {} if theta == 0.0 else {"stress_correction": "mean_stress",
                                       "stress_correction_mean_fraction": None if theta == 1.0 else theta}
         rh = MaxwellEB(cohesion_min_pa=C, cohesion_max_pa=C, friction=mu, **kw)
@@ -163,7 +163,28 @@ def test_mean_stress_correction_keeps_the_mean_and_lands_on_the_envelope(rng):
         dcs[theta] = dc
     np.testing.assert_allclose(dcs[1.0], r_env / r, rtol=1e-9)
     # keeping more of the (compressive) mean costs less damage
-    assert np.all(dcs[0.0] < dcs[0.5]) and np.all(dcs[0.5] < dcs[1.0])
+    assert np.all(dcs[0.0] < dcs[0.5]) and np.all(dcs[0.5] < dcs[1.0]) and np.all(dcs[1.0] < dcs[1.5])
+
+
+@pytest.mark.parametrize("theta", [0.5, 1.0, 1.25, 1.5])
+def test_mean_stress_correction_dilatancy(theta):
+    """Uniaxial compression along y past the envelope: the correction towards θ m I takes out
+    the inelastic strain K⁻¹(σ − σ'), whose dilatancy is sin ψ = (θ − 1)(1 − ν)/(1 + ν):
+    compactive below θ = 1, isochoric at 1, dilatant above (the angle that
+    damage_mode_fault_angle_deg turns into a fault angle)."""
+    C, mu, nu = 30e3, 0.7, 0.3
+    q, sc, st = envelope(C, mu)
+    rh = MaxwellEB(cohesion_min_pa=C, cohesion_max_pa=C, friction=mu, poisson=nu, stress_correction="mean_stress",
+                   stress_correction_mean_fraction=theta)
+    sig = np.array([[0.0, -1.3 * sc, 0.0]])
+    s = sig.copy()
+    rh.damage_update(s, np.zeros(1), np.full(1, C), 1.0, np.ones(1), np.zeros(1))
+    s1, s2 = principal_stresses(s)
+    assert q * s1[0] - s2[0] == pytest.approx(sc, rel=1e-9)
+    eps = np.linalg.solve(plane_stress_matrix(nu), (sig - s)[0])   # xx lateral, yy axial
+    sin_psi = (eps[0] + eps[1]) / (eps[0] - eps[1])
+    assert sin_psi == pytest.approx((theta - 1.0) * (1.0 - nu) / (1.0 + nu), abs=1e-12)
+    assert np.sign(round(sin_psi, 9)) == np.sign(theta - 1.0)
 
 
 def test_associated_correction_returns_along_the_envelope_normal(rng):
@@ -244,7 +265,7 @@ def test_mean_stress_correction_falls_back_to_the_origin_beyond_the_tensile_stre
     ({"cohesion_max_pa": 1.0}, "cohesion_max_pa"), ({"relaxation_time_s": 0}, "relaxation_time_s"),
     ({"stress_correction": "normal"}, "stress_correction"),
     ({"stress_correction_mean_fraction": 0.0, "stress_correction": "mean_stress"}, "stress_correction_mean_fraction"),
-    ({"stress_correction_mean_fraction": 1.5, "stress_correction": "mean_stress"}, "stress_correction_mean_fraction"),
+    ({"stress_correction_mean_fraction": 2.5, "stress_correction": "mean_stress"}, "stress_correction_mean_fraction"),
 ])
 def test_bad_parameters_name_the_parameter(kw, name):
     with pytest.raises(ConfigError, match=name) as e:

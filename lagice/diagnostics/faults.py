@@ -19,6 +19,8 @@ between a shear fault and the most compressive principal stress,
 ``θ = 45° − φ/2`` with ``φ = atan μ`` (Girard 2010 §1.3: μ internal friction
 coefficient; Dansereau et al. 2016 uses μ = 0.7, hence θ = 27.5° and conjugate faults
 55° apart; observed conjugate leads intersect at 20–50°, Girard 2010 ch. 1).
+:func:`damage_mode_fault_angle_deg` gives what a damage model with that envelope
+predicts instead: the direction of the damage band that grows fastest.
 
 :func:`distance_to_boundary` and :func:`interior_triangles` build the
 "away from the coast" masks of Girard et al. 2011 (statistics from elements more than
@@ -174,6 +176,69 @@ def mohr_coulomb_fault_angle_deg(friction_coefficient):
     ``45° − φ/2``, ``φ = atan μ`` (degrees; μ = 0.7 gives 27.5°)."""
     mu = positive("friction_coefficient", friction_coefficient)
     return 45.0 - 0.5 * float(np.degrees(np.arctan(mu)))
+
+
+def damage_mode_fault_angle_deg(friction_coefficient, poisson_ratio=None, dilatancy_angle_deg=None):
+    """Fault angle to the compression axis predicted by the most unstable damage band of a
+    homogeneously damaged plate in uniaxial compression (degrees; docs/physics.md §4,
+    "The damage band that grows fastest").
+
+    A straight band of extra damage keeps the traction of the plate around it (σnn, σnt) and
+    its strain along the band (εtt); a damage event in the band (a drop of its stiffness, or
+    the stress correction, read as an inelastic strain εi) changes only the stress along the
+    band, by −E′ εi,tt. The envelope q σ1 − σ2 in the band then grows in proportion to
+
+        G(θ) ∝ (cos²θ − cos²θR) (cos²θC − cos²θ),
+
+    θ the band's angle to the compression axis, θC = 45° − φ/2 (Coulomb: the envelope does
+    not feel the stress along a band of that direction) and θR = 45° − ψ/2 (Roscoe: εi has
+    no component along the band), tan φ = μ, sin ψ = (εi,1 + εi,2)/(εi,1 − εi,2) the
+    dilatancy of the inelastic strain. G is largest half way between the two roots in
+    cos²θ:
+
+        cos 2θ* = (sin φ + sin ψ) / 2.
+
+    Give ``poisson_ratio`` ν for the correction towards the origin (Dansereau et al. 2016,
+    neXtSIM, lagice's explicit steppers): εi ∝ K⁻¹σ, so sin ψ = −(1 − ν)/(1 + ν) (it
+    compacts); or ``dilatancy_angle_deg`` ψ for another path (ψ = φ, the associated return,
+    gives the Coulomb angle). The approach, a linear stability analysis of the uniformly
+    damaged state, is that of Dansereau, Démery, Berthier, Weiss and Ponson (2019,
+    "Collective damage growth controls fault orientation in quasibrittle compressive
+    failure", PRL 122); this closed form for lagice's envelope and plane stress is ours.
+    """
+    mu = float(friction_coefficient)
+    if not np.isfinite(mu) or mu < 0.0:
+        raise ConfigError(f"friction_coefficient = {friction_coefficient!r}: expected a finite value >= 0")
+    if (poisson_ratio is None) == (dilatancy_angle_deg is None):
+        raise ConfigError("damage_mode_fault_angle_deg: give exactly one of poisson_ratio (origin correction) "
+                          "and dilatancy_angle_deg")
+    if poisson_ratio is not None:
+        nu = float(poisson_ratio)
+        if not 0.0 <= nu < 1.0:
+            raise ConfigError(f"poisson_ratio = {poisson_ratio!r}: expected 0 <= ν < 1 (plane stress)")
+        sin_psi = -(1.0 - nu) / (1.0 + nu)
+    else:
+        psi = float(dilatancy_angle_deg)
+        if not -90.0 <= psi <= 90.0:
+            raise ConfigError(f"dilatancy_angle_deg = {dilatancy_angle_deg!r}: expected -90 to 90")
+        sin_psi = float(np.sin(np.radians(psi)))
+    sin_phi = float(np.sin(np.arctan(mu)))
+    return 0.5 * float(np.degrees(np.arccos(0.5 * (sin_phi + sin_psi))))
+
+
+def damage_mode_growth(theta_deg, friction_coefficient, sin_psi):
+    """G(θ) of :func:`damage_mode_fault_angle_deg`, up to a positive factor: the change of
+    the envelope q σ1 − σ2 inside a band at θ (degrees from the compression axis) per unit
+    inelastic strain of the band, under σ = (0, −1) (x lateral, y the compression axis).
+    Computed from the band's stress change, not from the closed form: δσtt = −εi,tt with
+    εi = ((1 + sin ψ)/2, −(1 − sin ψ)/2) in the principal axes, and the envelope's
+    derivative q sin²θ − cos²θ along the band."""
+    t = np.radians(np.asarray(theta_deg, np.float64))
+    mu = float(friction_coefficient)
+    q = (np.sqrt(mu * mu + 1.0) + mu) ** 2
+    e1, e2 = 0.5 * (1.0 + sin_psi), -0.5 * (1.0 - sin_psi)
+    eps_tt = e1 * np.sin(t) ** 2 + e2 * np.cos(t) ** 2   # band direction t = (sin θ, cos θ)
+    return -eps_tt * (q * np.sin(t) ** 2 - np.cos(t) ** 2)
 
 
 def boundary_edges(triangles):

@@ -134,8 +134,9 @@ def damage_step(d, dc, dt, td, heal_rate, max_damage):
 @njit(cache=True, inline="always")
 def _dcrit_towards(sxx, syy, sxy, cohesion, q, denom, theta):
     """The factor f ∈ [0, 1] that brings a stress onto the envelope along the straight path
-    towards the isotropic stress P = θ m I (m = (σ1 + σ2)/2, 0 < θ ≤ 1): σ' = P + f (σ − P).
-    θ = 1 scales only the deviatoric part (the mean kept); θ → 0 is the origin path of
+    towards the isotropic stress P = θ m I (m = (σ1 + σ2)/2, 0 < θ ≤ 2): σ' = P + f (σ − P).
+    θ = 1 scales only the deviatoric part (the mean kept); θ > 1 raises the pressure of a
+    compressed element (a dilatant return); θ → 0 is the origin path of
     :func:`_dcrit`. With σ1,2 = m ± r, the corrected mean is θ m + f (1 − θ) m and the
     radius f r, so q σ1' − σ2' = σc gives f = (σc − (q − 1) θ m)/((q − 1)(1 − θ) m + (q + 1) r)
     and σ1' = σT gives f = (σT − θ m)/((1 − θ) m + r), each where the path crosses that
