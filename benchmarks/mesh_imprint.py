@@ -173,7 +173,7 @@ def run_compression(out: Path, n_across: int, variant: str, max_strain=1e-3, see
     from validate import analyse_compression
     from validate import run_compression as validate_compression
 
-    tag = f"compression_N{n_across}_{variant}"
+    tag = f"compression_N{n_across}_{variant}" + (f"_s{seed}" if seed else "")
     path = out / f"{tag}.npz"
     if not path.exists():
         print(f"mesh_imprint: run {tag}", flush=True)
@@ -301,6 +301,8 @@ def main(argv=None):
     ap.add_argument("--variants", nargs="+", default=["base"])
     ap.add_argument("--n-across", type=int, nargs="+", default=[40])
     ap.add_argument("--max-strain", type=float, default=1e-3)
+    ap.add_argument("--seed", type=int, default=0,
+                    help="compression: run.seed (the cohesion disorder); results keyed VARIANT_sSEED when not 0")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "out" / "mesh_imprint")
     ap.add_argument("--fig-dir", type=Path, default=ROOT / "docs" / "figures")
     ap.add_argument("--figure", default=None, metavar="NAME",
@@ -331,13 +333,14 @@ def main(argv=None):
         for n in args.n_across:
             results = {}
             for v in args.variants:
-                r = results[v] = run_compression(out, n, v, args.max_strain)
+                r = results[v] = run_compression(out, n, v, args.max_strain, args.seed)
+                key = v + (f"_s{args.seed}" if args.seed else "")
                 im = r["imprint"]["rate_rupture"]
                 if not r["ruptured"]:
-                    print(f"  compression N={n} {v:10s}: NO RUPTURE (largest stress drop {r['rupture_drop_kpa']:.3f} "
+                    print(f"  compression N={n} {key:10s}: NO RUPTURE (largest stress drop {r['rupture_drop_kpa']:.3f} "
                           f"kPa, below {100 * r['rupture_min_drop_fraction']:g} % of the peak, or no damage) up to "
                           f"strain {args.max_strain:g}; peak {r['peak_stress_kpa']:.0f} kPa", flush=True)
-                print(f"  compression N={n} {v:10s}: fault angles (rate) "
+                print(f"  compression N={n} {key:10s}: fault angles (rate) "
                       f"{[round(a, 1) for a in (r['fault_angles_rate_deg'] or [])]} (damage) "
                       f"{[round(a, 1) for a in (r['fault_angles_damage_deg'] or [])]} MC "
                       f"{r['mohr_coulomb_angle_deg']:.1f}, damage band "
@@ -350,7 +353,7 @@ def main(argv=None):
                       f"{pp['stress_drop_kpa']:.2f} kPa): faults (rate) "
                       f"{[round(a, 1) for a in (pp['fault_angles_rate_deg'] or [])]} (damage gained) "
                       f"{[round(a, 1) for a in (pp['fault_angles_damage_deg'] or [])]}", flush=True)
-                allres.setdefault("compression", {}).setdefault(f"N{n}", {})[v] = _strip(
+                allres.setdefault("compression", {}).setdefault(f"N{n}", {})[key] = _strip(
                     {k: r[k] for k in ("fault_angles_rate_deg", "fault_angles_damage_deg", "fault_directions_rate_deg",
                                        "mohr_coulomb_angle_deg", "damage_mode_angle_deg", "peak_stress_kpa",
                                        "rupture_time_s", "wall_s",
