@@ -27,6 +27,7 @@ combine with ``+``, e.g. ``delaunay+meanstress``.
     python benchmarks/mesh_imprint.py cyclone --variants base jitter delaunay
     python benchmarks/mesh_imprint.py compression --n-across 40 80 --variants base jitter delaunay
     python benchmarks/mesh_imprint.py report          # figure + JSON from the runs in --out
+    python benchmarks/mesh_imprint.py final-faults --n-across 40 --variants delaunay+mean125
 
 Runs one simulation at a time (``NUMBA_NUM_THREADS`` as set by the caller). Writes
 ``--out`` (default ``benchmarks/out/mesh_imprint``), ``docs/figures/mesh_imprint.json``
@@ -92,7 +93,8 @@ VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.me
             # within 10 deg of 27.5 deg.
             # Then (16:14 UTC, after the N = 40 runs: one wide fault at 33.6-36.3 deg): at N = 80
             # (to strain 3.5e-4) the main fault of the final damage lies within 3 deg of N = 40's
-            # and within 10 deg of 27.5 deg.
+            # and within 10 deg of 27.5 deg. (Not run: started at 16:14, it ran at 5-6 steps/s
+            # beside the other runs, over 80 minutes for its 28 000 steps, and was stopped.)
             **{f"mean{int(round(100 * t)):03d}": ["rheology.stress_correction=mean_stress",
                                                   f"rheology.stress_correction_mean_fraction={t}"]
                for t in (0.25, 0.5, 0.75, 1.25, 1.5)}}
@@ -211,6 +213,35 @@ def _compression_imprint(z, res):
     return out
 
 
+def final_damage_faults(path: Path) -> dict:
+    """The faults of a compression run's final damage (weights: damage x element area; the
+    fault finder's two highest directions with their scores, the share of the damage in the
+    best strip) and the principal axis of the elements with damage above 0.5 and 0.8 (its
+    angle to the load and the axes' ratio: above about 5 the damage is one straight band).
+    Cheap: no block analysis. Angles in degrees from the compression axis (y)."""
+    from lagice.diagnostics.faults import angle_to_axis_deg, fault_orientations
+
+    z = np.load(path)
+    nodes, tri = z["nodes"], z["triangles"]
+    xy = nodes[tri].mean(axis=1)
+    e1, e2 = nodes[tri[:, 1]] - nodes[tri[:, 0]], nodes[tri[:, 2]] - nodes[tri[:, 0]]
+    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    d = z["damage_block_end"][-1].astype(float)
+    dx = float(z["width_m"]) / int(z["n_across"])
+    f = fault_orientations(xy, d * area, 2 * dx)
+    out = {"angles_deg": angle_to_axis_deg(f.angles_deg).tolist(), "scores": f.scores.tolist(),
+           "median_trial_score": float(np.median(f.trial_scores))}
+    for thr in (0.5, 0.8):
+        p = xy[d > thr]
+        if len(p) < 3:
+            continue
+        q = p - p.mean(axis=0)
+        w, v = np.linalg.eigh(q.T @ q / len(q))
+        out[f"axis_d{int(10 * thr)}"] = {"angle_deg": float(np.degrees(np.arctan2(abs(v[0, 1]), abs(v[1, 1])))),
+                                        "aspect": float(np.sqrt(w[1] / max(w[0], 1e-30))), "n": int(len(p))}
+    return out
+
+
 # -- report ------------------------------------------------------------------------------
 def _strip(o):
     if isinstance(o, dict):
@@ -300,7 +331,7 @@ def figure_cyclone(out: Path, variants, path: Path):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("what", choices=("cyclone", "compression", "report"))
+    ap.add_argument("what", choices=("cyclone", "compression", "report", "final-faults"))
     ap.add_argument("--variants", nargs="+", default=["base"])
     ap.add_argument("--n-across", type=int, nargs="+", default=[40])
     ap.add_argument("--max-strain", type=float, default=1e-3)
@@ -365,6 +396,18 @@ def main(argv=None):
                                        "post_peak")} | {"git_commit": git_commit()})
             if args.figure:
                 figure_compression(out, n, results, args.fig_dir / f"{args.figure}.png")
+    elif args.what == "final-faults":   # the final damage's faults of runs already made (no block analysis)
+        for n in args.n_across:
+            for v in args.variants:
+                key = v + (f"_s{args.seed}" if args.seed else "")
+                path = out / f"compression_N{n}_{key}.npz"
+                r = final_damage_faults(path)
+                axes = "; ".join(f"damage > 0.{k[-1]}: axis {a['angle_deg']:.1f} deg, aspect {a['aspect']:.1f}"
+                                 for k, a in r.items() if k.startswith("axis_"))
+                print(f"  N={n} {key:24s} final damage faults {[round(a, 1) for a in r['angles_deg']]} scores "
+                      f"{[round(x, 3) for x in r['scores']]} (median trial {r['median_trial_score']:.3f}); {axes}")
+                entry = allres.setdefault("compression", {}).setdefault(f"N{n}", {}).setdefault(key, {})
+                entry["final_damage_faults"] = r
     else:
         figure_cyclone(out, [v for v in allres.get("cyclone", {})], args.fig_dir / "mesh_imprint_cyclone.png")
     js.write_text(json.dumps(allres, indent=1))

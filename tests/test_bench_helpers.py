@@ -401,3 +401,44 @@ def test_compression_analysis_reports_the_faults_of_the_post_peak_phase(tmp_path
     assert abs(post["fault_angles_rate_deg"][0] - 30.0) < 3.0
     assert abs(post["fault_angles_damage_deg"][0] - 30.0) < 3.0
     assert n_post == 2 and abs(post["stress_drop_kpa"] - 0.4) < 1e-9  # peak to the phase's last block
+
+
+def test_final_damage_faults_find_one_straight_band_and_the_analysis_reports_the_damage_band_angle(tmp_path):
+    """``mesh_imprint.final_damage_faults``: a plate whose final damage is one straight band at
+    35° to the load gives that direction as its main fault, and the axis of its damaged
+    elements is long and thin; ``analyse_compression`` reports the damage-band angle θ* only
+    for a record that names ν and the origin correction."""
+    from mesh_imprint import final_damage_faults
+    from validate import analyse_compression
+
+    from lagice.diagnostics.faults import damage_mode_fault_angle_deg
+
+    nx, ny, dx = 40, 80, 2.5e3
+    xs, ys = np.meshgrid(np.arange(nx + 1) * dx, np.arange(ny + 1) * dx)
+    nodes = np.column_stack([xs.ravel(), ys.ravel()])
+    idx = np.arange((nx + 1) * (ny + 1)).reshape(ny + 1, nx + 1)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(), idx[1:, :-1].ravel()
+    tri = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    cen = nodes[tri].mean(axis=1)
+    n_blocks, block, peak_block = 20, 2, 10
+    band = np.radians(90.0 - 35.0)  # a direction 35° from the y axis
+    dist = np.abs((cen - nodes.mean(axis=0)) @ np.array([-np.sin(band), np.cos(band)]))
+    damage = np.zeros((n_blocks, tri.shape[0]), np.float32)
+    damage[peak_block:] = np.where(dist < 3e3, 0.9, 0.0)
+    stress = np.repeat(np.concatenate([np.linspace(10e3, 100e3, peak_block + 1),
+                                       100e3 - 1e3 * np.arange(1, n_blocks - peak_block)]), block)
+    vel = np.zeros((n_blocks, nodes.shape[0], 2))
+    vel[peak_block:] = _band_velocity(nodes, 55.0)
+    common = dict(stress_pa=stress, dt_s=5.0, block_steps=block, nodes=nodes, triangles=tri,
+                  velocity_block_mean=vel, damage_block_end=damage, width_m=nx * dx, n_across=nx,
+                  length_m=ny * dx, push_speed_m_s=1e-3, friction=0.7, wall_s=1.0)
+    old, new = tmp_path / "old.npz", tmp_path / "new.npz"
+    np.savez(old, **common)
+    np.savez(new, **common, poisson=0.3, stress_correction="origin")
+    r = final_damage_faults(new)
+    assert abs(r["angles_deg"][0] - 35.0) < 2.0
+    assert abs(r["axis_d8"]["angle_deg"] - 35.0) < 2.0 and r["axis_d8"]["aspect"] > 5.0
+    assert r["scores"][0] > 3 * r["median_trial_score"]
+    assert analyse_compression(old)["damage_mode_angle_deg"] is None
+    assert analyse_compression(new)["damage_mode_angle_deg"] == pytest.approx(
+        damage_mode_fault_angle_deg(0.7, poisson_ratio=0.3))
