@@ -93,8 +93,9 @@ VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.me
             # within 10 deg of 27.5 deg.
             # Then (16:14 UTC, after the N = 40 runs: one wide fault at 33.6-36.3 deg): at N = 80
             # (to strain 3.5e-4) the main fault of the final damage lies within 3 deg of N = 40's
-            # and within 10 deg of 27.5 deg. (Not run: started at 16:14, it ran at 5-6 steps/s
-            # beside the other runs, over 80 minutes for its 28 000 steps, and was stopped.)
+            # and within 10 deg of 27.5 deg. (Started at 16:14 to strain 3.5e-4 and stopped: at
+            # 5-6 steps/s beside the other runs it needed over 80 minutes; restarted at 16:17 to
+            # strain 3.3e-4, past N = 40's peak at 2.8e-4.)
             **{f"mean{int(round(100 * t)):03d}": ["rheology.stress_correction=mean_stress",
                                                   f"rheology.stress_correction_mean_fraction={t}"]
                for t in (0.25, 0.5, 0.75, 1.25, 1.5)}}
