@@ -19,8 +19,9 @@ domain); ``jitter`` (interior nodes moved by up to 0.3 × their edge length,
 ``domain.jitter``); ``delaunay`` (gmsh's Delaunay algorithm, ``domain.mesh_algorithm = 5``:
 no domain-wide lattice direction); ``meanstress`` (``rheology.stress_correction =
 "mean_stress"``: the damage correction keeps the mean normal stress); ``mean025``,
-``mean050``, ``mean075``, ``mean125``, ``mean150`` (the correction towards 0.25 ... 1.5
-times the mean stress, ``stress_correction_mean_fraction``; above 1 the return dilates);
+``mean050``, ``mean075``, ``mean125``, ``mean150``, ``mean200`` (the correction towards
+0.25 ... 2 times the mean stress, ``stress_correction_mean_fraction``; above 1 the return
+dilates);
 ``nu010``, ``nu045``, ``mu040``, ``mu100`` (Poisson's ratio 0.1, 0.45, friction 0.4, 1.0);
 combine with ``+``, e.g. ``delaunay+meanstress``.
 
