@@ -181,12 +181,17 @@ def analyse_cyclone(out: Path, variant: str):
 
 
 # -- uniaxial compression ---------------------------------------------------------------
+def run_key(variant: str, seed: int) -> str:
+    """A compression run's name in the records: the variant, with ``_sSEED`` for a seed other than 0."""
+    return variant + (f"_s{seed}" if seed else "")
+
+
 def run_compression(out: Path, n_across: int, variant: str, max_strain=1e-3, seed=0) -> dict:
     """validate.py's compression run (scene builder + Simulation) with the variant's mesh option."""
     from validate import analyse_compression
     from validate import run_compression as validate_compression
 
-    tag = f"compression_N{n_across}_{variant}" + (f"_s{seed}" if seed else "")
+    tag = f"compression_N{n_across}_{run_key(variant, seed)}"
     path = out / f"{tag}.npz"
     if not path.exists():
         print(f"mesh_imprint: run {tag}", flush=True)
@@ -228,12 +233,12 @@ def final_damage_faults(path: Path) -> dict:
     angle to the load and the axes' ratio: above about 5 the damage is one straight band).
     Cheap: no block analysis. Angles in degrees from the compression axis (y)."""
     from lagice.diagnostics.faults import angle_to_axis_deg, fault_orientations
+    from lagice.mesh.core import signed_areas
 
     z = np.load(path)
     nodes, tri = z["nodes"], z["triangles"]
     xy = nodes[tri].mean(axis=1)
-    e1, e2 = nodes[tri[:, 1]] - nodes[tri[:, 0]], nodes[tri[:, 2]] - nodes[tri[:, 0]]
-    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    area = np.abs(signed_areas(nodes, tri))
     d = z["damage_block_end"][-1].astype(float)
     dx = float(z["width_m"]) / int(z["n_across"])
     f = fault_orientations(xy, d * area, 2 * dx)
@@ -377,7 +382,7 @@ def main(argv=None):
             results = {}
             for v in args.variants:
                 r = results[v] = run_compression(out, n, v, args.max_strain, args.seed)
-                key = v + (f"_s{args.seed}" if args.seed else "")
+                key = run_key(v, args.seed)
                 im = r["imprint"]["rate_rupture"]
                 if not r["ruptured"]:
                     print(f"  compression N={n} {key:10s}: NO RUPTURE (largest stress drop {r['rupture_drop_kpa']:.3f} "
@@ -407,7 +412,7 @@ def main(argv=None):
     elif args.what == "final-faults":   # the final damage's faults of runs already made (no block analysis)
         for n in args.n_across:
             for v in args.variants:
-                key = v + (f"_s{args.seed}" if args.seed else "")
+                key = run_key(v, args.seed)
                 path = out / f"compression_N{n}_{key}.npz"
                 r = final_damage_faults(path)
                 axes = "; ".join(f"damage > 0.{k[-1]}: axis {a['angle_deg']:.1f} deg, aspect {a['aspect']:.1f}"

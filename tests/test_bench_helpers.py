@@ -360,6 +360,16 @@ def _band_velocity(nodes, angle_to_y_deg, speed=1e-3, width=5e3):
     return np.outer(0.5 * (1.0 + np.tanh(d / width)), t * speed)
 
 
+def _plate_grid(nx, ny, dx):
+    """A structured triangulation of an nx × ny plate of dx squares: nodes, triangles, centroids."""
+    xs, ys = np.meshgrid(np.arange(nx + 1) * dx, np.arange(ny + 1) * dx)
+    nodes = np.column_stack([xs.ravel(), ys.ravel()])
+    idx = np.arange((nx + 1) * (ny + 1)).reshape(ny + 1, nx + 1)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(), idx[1:, :-1].ravel()
+    tri = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    return nodes, tri, nodes[tri].mean(axis=1)
+
+
 def test_compression_analysis_reports_the_faults_of_the_post_peak_phase(tmp_path):
     """``analyse_compression``: a plate that softens gradually after its peak (a band at 30° to
     the load) and drops most, later, in a small event on another band (60°). The largest-drop
@@ -368,12 +378,7 @@ def test_compression_analysis_reports_the_faults_of_the_post_peak_phase(tmp_path
     from validate import POST_PEAK_STRAIN_FRACTION, analyse_compression
 
     nx, ny, dx = 40, 80, 2.5e3
-    xs, ys = np.meshgrid(np.arange(nx + 1) * dx, np.arange(ny + 1) * dx)
-    nodes = np.column_stack([xs.ravel(), ys.ravel()])
-    idx = np.arange((nx + 1) * (ny + 1)).reshape(ny + 1, nx + 1)
-    a, b, c, d = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(), idx[1:, :-1].ravel()
-    tri = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
-    cen = nodes[tri].mean(axis=1)
+    nodes, tri, cen = _plate_grid(nx, ny, dx)
     n_blocks, block, peak_block, late_block = 50, 2, 10, 40
     s_end = np.concatenate([np.linspace(10e3, 100e3, peak_block + 1),           # loading to the peak
                             100e3 - 0.4e3 * np.arange(1, 4),                    # gradual softening
@@ -414,12 +419,7 @@ def test_final_damage_faults_find_one_straight_band_and_the_analysis_reports_the
     from lagice.diagnostics.faults import damage_mode_fault_angle_deg
 
     nx, ny, dx = 40, 80, 2.5e3
-    xs, ys = np.meshgrid(np.arange(nx + 1) * dx, np.arange(ny + 1) * dx)
-    nodes = np.column_stack([xs.ravel(), ys.ravel()])
-    idx = np.arange((nx + 1) * (ny + 1)).reshape(ny + 1, nx + 1)
-    a, b, c, d = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(), idx[1:, :-1].ravel()
-    tri = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
-    cen = nodes[tri].mean(axis=1)
+    nodes, tri, cen = _plate_grid(nx, ny, dx)
     n_blocks, block, peak_block = 20, 2, 10
     band = np.radians(90.0 - 35.0)  # a direction 35° from the y axis
     dist = np.abs((cen - nodes.mean(axis=0)) @ np.array([-np.sin(band), np.cos(band)]))
