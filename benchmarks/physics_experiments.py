@@ -1012,6 +1012,34 @@ for _basin, _e in (("closed", "E10h"), ("strait", "E10hs")):
 # beta 0.046 -> 0.052 and 0.044 -> 0.055 (below its 0.02), rate and drift about the same.
 
 
+# --- 2026-11-27 (eighteenth session): the dilatant return in the basin (a diagnostic) -------------
+# The explicit CPU stepper now has rheology.stress_correction = "mean_stress" (the return towards
+# theta times the element's mean stress; theta > 1 dilates: docs/physics.md, "The damage band that
+# grows fastest"). In the compression test theta = 2 turned the fault to 31-35 deg (implicit, N = 40)
+# but made the plate sag. Here: the shipped month (from the shipped spin-up, made with the origin
+# path) with theta = 2 and theta = 1 (the mean kept at damage events), both basins.
+# Stated before the runs (2026-11-27, 18:00 UTC), for each theta: the pack counts as moving if its
+# median rate is at least half the shipped month's (0.0024, 0.0028 per day) in both basins; a lead
+# for beta if beta rises by 0.04 or more over the shipped month's (0.038, 0.030) in both basins
+# with no band of the six lost (2 and 3 inside). Predicted: not a lead (beta within +-0.02): the
+# correction acts only at damage events, while the Maxwell relaxation sigma/lambda keeps letting
+# damaged ice shed its pressure and compact (the fifteenth session's mechanism), so the interior
+# still closes as a whole (net-divergence ratio's magnitude above half the shipped month's 0.73,
+# 0.71). theta has no source; nothing here is adopted.
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    for _t in (1.0, 2.0):
+        EXPERIMENTS[f"{_p}-hthick-1125-mean{int(round(100 * _t)):03d}"] = (
+            _basin, from_spinup("H1125") + ["rheology.stress_correction=mean_stress",
+                                            f"rheology.stress_correction_mean_fraction={_t}"], 10e3, 28,
+            f"{_p}-hthick-1125 with the damage correction towards {_t:g} x the mean stress (diagnostic)")
+# Result (2026-11-27, eighteenth session): NOT a lead, as predicted. beta 0.038 -> 0.050 (theta 1),
+# 0.051 (theta 2) closed; 0.030 -> 0.040, 0.055 strait (the strait's +0.025 is just outside the
+# predicted +-0.02). The interior closes more coherently (net-divergence ratio -0.86, -0.86 closed;
+# -0.86, -0.83 strait). The pack stiffens: rate x0.61-0.71 (still above half: it moves), drift 22-25
+# km against 40-48, wind factor 0.0017-0.0019 against 0.0034-0.0043, 35-50 % fewer remeshes. Bands
+# inside: closed 4 (theta 1) and 3 (theta 2) against 2; strait 2 and 2 against 3.
+
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]

@@ -394,13 +394,26 @@ def test_compression_analysis_reports_the_faults_of_the_post_peak_phase(tmp_path
     a30 = np.radians(120.0)
     dist30 = np.abs((cen - nodes.mean(axis=0)) @ np.array([-np.sin(a30), np.cos(a30)]))
     damage[peak_block:] = np.where(dist30 < 3e3, 0.8, 0.0)
+    a60 = np.radians(150.0)
+    dist60 = np.abs((cen - nodes.mean(axis=0)) @ np.array([-np.sin(a60), np.cos(a60)]))
+    damage[late_block:] = np.maximum(damage[late_block], np.where(dist60 < 3e3, 0.5, 0.0))  # the late event's
     path = tmp_path / "compression.npz"
-    np.savez(path, stress_pa=stress, dt_s=5.0, block_steps=block, nodes=nodes, triangles=tri,
-             velocity_block_mean=vel, damage_block_end=damage, width_m=nx * dx, n_across=nx,
-             length_m=ny * dx, push_speed_m_s=1e-3, friction=0.7, wall_s=1.0)
+    rec = dict(stress_pa=stress, dt_s=5.0, block_steps=block, nodes=nodes, triangles=tri,
+               velocity_block_mean=vel, damage_block_end=damage, width_m=nx * dx, n_across=nx,
+               length_m=ny * dx, push_speed_m_s=1e-3, friction=0.7, wall_s=1.0)
+    np.savez(path, **rec)
     res = analyse_compression(path)
+    assert res["ruptured"]
     assert res["rupture_block"] == late_block and res["rupture_blocks_after_peak"] == late_block - peak_block
     assert abs(res["fault_angles_rate_deg"][0] - 60.0) < 3.0
+    assert abs(res["fault_angles_damage_deg"][0] - 60.0) < 3.0
+    # the same drop with no damage made in its block (an elastic wave) is not a rupture
+    undamaged = damage.copy()
+    undamaged[late_block:] = undamaged[late_block - 1]
+    np.savez(tmp_path / "elastic.npz", **(rec | {"damage_block_end": undamaged}))
+    res_el = analyse_compression(tmp_path / "elastic.npz")
+    assert res_el["rupture_block"] == late_block and not res_el["ruptured"]
+    assert res_el["fault_angles_rate_deg"] is None
     post = res["post_peak"]
     assert post["blocks"] == [peak_block, peak_block + n_post]
     assert abs(post["fault_angles_rate_deg"][0] - 30.0) < 3.0

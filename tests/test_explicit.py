@@ -30,17 +30,23 @@ def linear_velocity(comp):
     return lambda t, x, y: G[comp, 0] * x + G[comp, 1] * y
 
 
-@pytest.mark.parametrize("kernel", [element_stress_damage_kernel, element_stress_damage_kernel_serial])
-def test_element_kernel_damage_matches_rheology(kernel):
+@pytest.mark.parametrize("theta", [None, 1.0, 2.0])
+@pytest.mark.parametrize("kernel", [element_stress_damage_kernel, element_stress_damage_kernel_serial,
+                                    element_stress_damage_kernel_a4_serial])
+def test_element_kernel_damage_matches_rheology(kernel, theta):
     """With zero strain rate and γ = 1 the element kernel is the rheology's damage/healing
     update (same formulas; to round-off, since the kernel may fuse a multiply-add into one
     FMA, ``explicit.KERNEL_FASTMATH``): the same elements damage, and stress and damage
     agree to 1e-13 relative (a wrong factor or a missed correction is ≥ 1e-3 off). The
     kernel's cheap inside-the-envelope test (``envelope_factors``) must not change which
-    elements damage."""
+    elements damage. θ None: the origin correction; θ = 1, 2: ``stress_correction =
+    "mean_stress"`` (towards θ times the mean stress), against the implicit solver's
+    ``damage_update`` with the same θ; the corrected stresses then differ from the origin
+    path's by ≥ 1e-3."""
     rng = np.random.default_rng(0)
     m = 500
-    rheo = MaxwellEB()
+    rheo = (MaxwellEB() if theta is None else
+            MaxwellEB(stress_correction="mean_stress", stress_correction_mean_fraction=theta))
     sigma = rng.normal(0, 8e4, (m, 3))
     damage = rng.uniform(0, 0.9, m)
     damage[:50] = 0.0
@@ -58,8 +64,13 @@ def test_element_kernel_damage_matches_rheology(kernel):
     kc, kt = envelope_factors(rheo)
     e_dt, gam = np.zeros(m), np.ones(m)
     kernel(tri, zeros3, zeros3, np.zeros((1, 2)), s2, d2, conc_factor, coh, kc, kt, td, heal, e_dt, gam, None,
-           None, 7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, p.alpha, flag)
+           None, theta, 7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, p.alpha,
+           flag)
     assert (dc < 1).sum() > 100
+    if theta is not None:  # the path differs from the origin's where the correction acted
+        s0, d0 = sigma.copy(), damage.copy()
+        MaxwellEB().damage_update(s0, d0, coh, 7.0, td, heal)
+        assert np.abs(s2 - s0).max() > 1e-3 * np.abs(s0).max()
     assert np.allclose(s2, s1, rtol=1e-13, atol=1e-13 * np.abs(s1).max())
     assert np.allclose(d2, d1, rtol=1e-13, atol=1e-15)
     assert not np.allclose(s1, sigma, rtol=1e-6)  # the correction acted
@@ -101,7 +112,8 @@ def test_element_kernel_stress_update_uses_rheology_moduli(kernel):
         kc, kt = envelope_factors(rheo)
         E, lam = rheo.moduli(damage, conc)
         kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, conc_factor, np.full(m, 1e15), kc, kt,
-               np.full(m, 20.0), np.zeros(m), dt_s * E, lam / (lam + dt_s), None, None, dt_s, *rheo.K[0, :2],
+               np.full(m, 20.0), np.zeros(m), dt_s * E, lam / (lam + dt_s), None, None, None, dt_s,
+               *rheo.K[0, :2],
                rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, float(alpha),
                np.zeros(m, np.int8))
         eps = strain_rate(mesh.triangles, b, c, vel)
@@ -137,7 +149,8 @@ def test_alpha4_builds_equal_general_builds():
         sigma, d, flag = sigma0.copy(), damage0.copy(), np.zeros(m, np.int8)
         e_dt, gam = dt_s * E, lam / (lam + dt_s)
         capped = kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, np.full(m, 0.9),
-                        coh, kc, kt, np.full(m, 30.0), np.full(m, 1e-6), e_dt, gam, None, None, dt_s, *rheo.K[0, :2],
+                        coh, kc, kt, np.full(m, 30.0), np.full(m, 1e-6), e_dt, gam, None, None, None, dt_s,
+                        *rheo.K[0, :2],
                         rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
         out.append((sigma, d, flag, capped, e_dt, gam))
     assert 0 < out[0][2].sum() < m  # some elements damage, some do not
@@ -443,11 +456,16 @@ def test_implicit_limit_named_when_measured(monkeypatch):
     assert stab.check_implicit_step(50.0, 10e3) == pytest.approx(80.0)
 
 
-def test_explicit_stepper_refuses_the_mean_stress_correction():
-    """The mean-stress damage correction is in the implicit solver only; the explicit
+def test_explicit_stepper_refuses_the_associated_correction():
+    """The associated damage correction is in the implicit solver only; the explicit
     stepper must not silently correct towards the origin instead."""
-    with pytest.raises(ConfigError, match="stress_correction = 'mean_stress': the explicit stepper"):
-        ExplicitSolver(MaxwellEB(stress_correction="mean_stress"), mesh=None)
+    with pytest.raises(ConfigError, match="stress_correction = 'associated': the explicit CPU stepper implements "
+                                          "the origin and mean_stress paths"):
+        ExplicitSolver(MaxwellEB(stress_correction="associated"), mesh=None)
+    # the CUDA stepper (which calls this before anything else once a GPU is found) has the origin path only
+    with pytest.raises(ConfigError, match="stress_correction = 'mean_stress': the CUDA explicit stepper implements "
+                                          "the origin path only"):
+        MaxwellEB(stress_correction="mean_stress").require_origin_correction("the CUDA explicit stepper")
 
 
 def test_elementwise_stability_bound(tmp_path):

@@ -307,12 +307,17 @@ class MaxwellEB:
         rate = 0.0 if th is None or not np.isfinite(th) else 1.0 / th
         return np.full(n, rate)
 
-    def require_origin_correction(self):
-        """Raise :class:`ConfigError` unless the stress correction is the origin path, the
-        only one the explicit steppers (CPU and CUDA) implement."""
-        if self.params.stress_correction != "origin":
-            raise ConfigError(f"rheology.stress_correction = {self.params.stress_correction!r}: the explicit "
-                              "stepper corrects towards the origin only (the option is in the implicit solver)")
+    def require_origin_correction(self, where: str, allow_mean_stress: bool = False):
+        """Raise :class:`ConfigError` unless ``where`` implements the stress correction asked
+        for: the origin path everywhere, and ``"mean_stress"`` where ``allow_mean_stress``
+        (the explicit CPU stepper; the CUDA stepper has the origin path only, and the
+        associated path is in the implicit solver only)."""
+        sc = self.params.stress_correction
+        if sc == "origin" or (allow_mean_stress and sc == "mean_stress"):
+            return
+        has = "origin and mean_stress paths" if allow_mean_stress else "origin path only"
+        raise ConfigError(f"rheology.stress_correction = {sc!r}: {where} implements the {has} "
+                          "(the implicit solver implements every path)")
 
     def require_whole_relaxation(self, where: str):
         """Raise :class:`ConfigError` if ``relax_mean_stress`` is false: only the explicit CPU

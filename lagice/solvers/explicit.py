@@ -47,6 +47,7 @@ from ..errors import ConfigError
 from ..fem import STRAIN_RATE, NodeSystem, element_strain_rate
 from ..forces import explicit_terms
 from ..rheology import MaxwellEB, _dcrit, damage_step
+from ..rheology.maxwell_eb import _dcrit_towards
 from ..stability import effective_dx
 from ..state import IceState
 from .base import StepInfo
@@ -199,7 +200,7 @@ _ALPHA_IS_4 = False
 
 
 def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion, kc, kt,
-                           td, heal_rate, e_dt, gamma, pmax, keep_mean, dt_s, kxx, kxy, kss, q, denom,
+                           td, heal_rate, e_dt, gamma, pmax, keep_mean, theta, dt_s, kxx, kxy, kss, q, denom,
                            max_damage, E0, lambda0, alpha, damaged_flag):
     """Maxwell stress update and damage/healing of one sub-step, in place (module doc, step 2).
 
@@ -220,6 +221,12 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     relaxation factor scales the whole stress. True: it scales the deviatoric stress
     σ − m I only (m = (σxx + σyy)/2 after the elastic increment), and the mean m is kept, or,
     with pmax, scaled by the compressive term's factor (it creeps in tension and above P_max).
+    theta: None (rheology.stress_correction = "origin", the default; pruned as pmax is): a
+    super-critical stress is scaled towards the origin. A float θ ∈ (0, 2]
+    (``"mean_stress"``, θ = ``stress_correction_mean_fraction``): it is brought back along
+    the straight path towards P = θ m I, σ ← P + f (σ − P), with d_crit the factor of
+    ``rheology._dcrit_towards`` (the origin path where that factor does not exist), as
+    ``rheology.damage_update_kernel`` does for the implicit solver.
     Returns the number of elements whose damage hit the cap.
     """
     m = tri.shape[0]
@@ -261,12 +268,30 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
             dc = 1.0
         else:
             dc = _dcrit(sxx, syy, sxy, ce, q, denom)
+        towards = False
+        pm = 0.0
+        if theta is not None:
+            if dc < 1.0:
+                fm = _dcrit_towards(sxx, syy, sxy, ce, q, denom, theta)
+                if fm >= 0.0:
+                    dc = fm
+                    pm = theta * mm
+                    towards = True
         d0 = damage[e]
         d, f, capped = damage_step(d0, dc, dt_s, td[e], heal_rate[e], max_damage)
         if dc < 1.0:
-            sxx *= f
-            syy *= f
-            sxy *= f
+            if theta is None:
+                sxx *= f
+                syy *= f
+                sxy *= f
+            elif towards:
+                sxx = pm + f * (sxx - pm)
+                syy = pm + f * (syy - pm)
+                sxy *= f
+            else:
+                sxx *= f
+                syy *= f
+                sxy *= f
             damaged_flag[e] = 1
         n_capped += capped
         sigma[e, 0] = sxx
@@ -303,8 +328,8 @@ PARALLEL_MIN_ELEMENTS = PARALLEL_MIN_SIZE
 
 @njit(cache=True, error_model="numpy")
 def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
-                      c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, dt_s, kxx, kxy,
-                      kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+                      c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dt_s, kxx,
+                      kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
     """All ``n_sub`` sub-steps of one outer step in compiled code (one call per outer
     step, no Python per sub-step): the node kernel then the element kernel, serial
     builds; the same calls as a Python loop over the kernels, bit-identical results."""
@@ -313,15 +338,15 @@ def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t,
         node_velocity_kernel_serial(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
                                     (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel_serial(
-            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, dt_s,
-            kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta,
+            dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
 
 @njit(cache=True, error_model="numpy")
 def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
-                      c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, dt_s, kxx, kxy,
-                      kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+                      c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dt_s, kxx,
+                      kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
     """:func:`substeps_serial` with the parallel kernel builds (one fork/join per
     kernel and sub-step, launched from compiled code)."""
     n_capped = 0
@@ -329,8 +354,8 @@ def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_
         node_velocity_kernel(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
                              (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel(
-            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, dt_s,
-            kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta,
+            dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
 
@@ -413,7 +438,7 @@ class ExplicitSolver:
         if not isinstance(rheology, MaxwellEB):
             raise ConfigError(f"the explicit stepper solves the Maxwell-EB rheology; got "
                               f"{type(rheology).__name__} (use solver 'evp' for viscous-plastic)")
-        rheology.require_origin_correction()
+        rheology.require_origin_correction("the explicit CPU stepper", allow_mean_stress=True)
         if substeps is not None:
             if int(substeps) != substeps or int(substeps) < 1:
                 raise ConfigError(f"substeps = {substeps!r} must be an integer >= 1 (or None: automatic)")
@@ -555,8 +580,8 @@ class ExplicitSolver:
     def _profiled_substeps(self, par, n_sub, args):
         """The sub-step loop in Python with each kernel timed (``profile_kernels``)."""
         (vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b, c, damage, conc_factor,
-         coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0,
-         alpha, flag) = args
+         coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dt_s, kxx, kxy, kss, q, denom, max_damage, E0,
+         lambda0, alpha, flag) = args
         node_k = node_velocity_kernel if par else node_velocity_kernel_serial
         elem_k = element_kernels(alpha)[int(par)]
         n_capped = 0
@@ -566,7 +591,8 @@ class ExplicitSolver:
             node_k(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, (k + 1) / n_sub)
             tb = time.perf_counter()
             n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma,
-                               pmax, keep_mean, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha,
+                               pmax, keep_mean, theta, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0,
+                               alpha,
                                flag)
             tc = time.perf_counter()
             tn += tb - ta
@@ -605,6 +631,7 @@ class ExplicitSolver:
         pmax = rh.max_pressure(state.thickness, state.concentration)  # None: off
         pmax = None if pmax is None else np.ascontiguousarray(pmax, np.float64)
         keep_mean = None if p.relax_mean_stress else True
+        theta = None if p.stress_correction == "origin" else float(p.mean_fraction)
         heal = (self.heal_rate(state, t_s) if self.heal_rate is not None
                 else self.rheology.constant_heal_rate(mesh.n_elements))
         heal = np.ascontiguousarray(heal, np.float64)
@@ -624,7 +651,7 @@ class ExplicitSolver:
         ptr32, elems32, tri32 = self._indices(mesh)
         args = (vel, vel_sum, sigma, ptr32, elems32, su.w, nc, terms.cos_turn, terms.sin_turn, ns.fixed, pres0,
                 pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, k_c, k_t, self.td, heal, e_dt, gamma, pmax,
-                keep_mean, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s,
+                keep_mean, theta, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s,
                 float(p.alpha), flag)
         if self.kernel_choice is None or (
                 self.parallel_setting is None
