@@ -40,8 +40,9 @@ class MaxwellEBParams:
             ``"origin"`` (Dansereau et al. 2016, neXtSIM: the whole tensor scaled towards 0)
             or ``"mean_stress"`` (towards θ times the mean normal stress; θ = 1: only the
             deviatoric part scaled, the mean kept; the implicit solver and the explicit CPU
-            stepper; docs/physics.md, compression test) or ``"associated"`` (along K n, n the envelope's normal: the
-            return of an associated plasticity; implicit solver only)
+            stepper; docs/physics.md, compression test) or ``"associated"`` (along K n, n
+            the envelope's normal: the return of an associated plasticity; implicit solver
+            only)
         stress_correction_mean_fraction: θ ∈ (0, 2] of ``"mean_stress"`` (None: 1) [-]; θ > 1
             returns towards a pressure above the element's own, so the inelastic strain dilates
             (sin ψ = (θ − 1)(1 − ν)/(1 + ν) in uniaxial compression; docs/physics.md §4)

@@ -280,18 +280,13 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
         d0 = damage[e]
         d, f, capped = damage_step(d0, dc, dt_s, td[e], heal_rate[e], max_damage)
         if dc < 1.0:
-            if theta is None:
-                sxx *= f
-                syy *= f
-                sxy *= f
-            elif towards:
+            if towards:  # False whenever theta is None (the branch above is pruned)
                 sxx = pm + f * (sxx - pm)
                 syy = pm + f * (syy - pm)
-                sxy *= f
             else:
                 sxx *= f
                 syy *= f
-                sxy *= f
+            sxy *= f
             damaged_flag[e] = 1
         n_capped += capped
         sigma[e, 0] = sxx
