@@ -30,7 +30,7 @@ combine with ``+``, e.g. ``delaunay+meanstress``.
     python benchmarks/mesh_imprint.py report          # figure + JSON from the runs in --out
     python benchmarks/mesh_imprint.py final-faults --n-across 40 --variants delaunay+mean125
     python benchmarks/mesh_imprint.py final-faults --n-across 80 --variants delaunay+explicit+mean200 \
-        --seeds 0 1 --figure compression_explicit_dilatant    # + the stress and final damage, side by side
+        --seed 0 1 --figure compression_explicit_dilatant    # + the stress and final damage, side by side
 
 Runs one simulation at a time (``NUMBA_NUM_THREADS`` as set by the caller). Writes
 ``--out`` (default ``benchmarks/out/mesh_imprint``), ``docs/figures/mesh_imprint.json``
@@ -286,7 +286,7 @@ def _strip(o):
 
 
 def figure_compression(out: Path, n_across: int, results: dict, path: Path):
-    """One column per variant of ``results`` (variant -> :func:`run_compression`'s result): the
+    """One column per run of ``results`` (:func:`run_key` -> :func:`run_compression`'s result): the
     macroscopic stress (the post-peak phase shaded), the total deformation rate summed over the
     post-peak phase (log, relative to its 99.5th percentile), and the damage at the end of the run."""
     import matplotlib
@@ -397,18 +397,15 @@ def main(argv=None):
     ap.add_argument("--variants", nargs="+", default=["base"])
     ap.add_argument("--n-across", type=int, nargs="+", default=[40])
     ap.add_argument("--max-strain", type=float, default=1e-3)
-    ap.add_argument("--seed", type=int, default=0,
-                    help="compression: run.seed (the cohesion disorder); results keyed VARIANT_sSEED when not 0")
-    ap.add_argument("--seeds", type=int, nargs="+", default=None, dest="final_seeds",
-                    help="final-faults: the seeds of the runs to read (default: --seed)")
+    ap.add_argument("--seed", type=int, nargs="+", default=[0],
+                    help="compression, final-faults: run.seed (the cohesion disorder), one run per seed; "
+                         "results keyed VARIANT_sSEED when not 0")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "out" / "mesh_imprint")
     ap.add_argument("--fig-dir", type=Path, default=ROOT / "docs" / "figures")
     ap.add_argument("--figure", default=None, metavar="NAME",
                     help="compression: also FIG_DIR/NAME.png, the variants side by side (stress, rate, damage); "
                          "final-faults: the stress and the final damage of each run")
     args = ap.parse_args(argv)
-    if args.final_seeds is None:
-        args.final_seeds = [args.seed]
     out = args.out.resolve()
     out.mkdir(parents=True, exist_ok=True)
     args.fig_dir.mkdir(parents=True, exist_ok=True)   # before any figure is drawn into it
@@ -434,9 +431,9 @@ def main(argv=None):
     elif args.what == "compression":
         for n in args.n_across:
             results = {}
-            for v in args.variants:
-                r = results[v] = run_compression(out, n, v, args.max_strain, args.seed)
-                key = run_key(v, args.seed)
+            for v, sd in ((v, sd) for v in args.variants for sd in args.seed):
+                key = run_key(v, sd)
+                r = results[key] = run_compression(out, n, v, args.max_strain, sd)
                 im = r["imprint"]["rate_rupture"]
                 if not r["ruptured"]:
                     print(f"  compression N={n} {key:10s}: NO RUPTURE (largest stress drop {r['rupture_drop_kpa']:.3f} "
@@ -465,7 +462,7 @@ def main(argv=None):
             if args.figure:
                 figure_compression(out, n, results, args.fig_dir / f"{args.figure}.png")
     elif args.what == "final-faults":   # the final damage's faults of runs already made (no block analysis)
-        keys = [(n, run_key(v, sd)) for n in args.n_across for v in args.variants for sd in args.final_seeds]
+        keys = [(n, run_key(v, sd)) for n in args.n_across for v in args.variants for sd in args.seed]
         for n, key in keys:
             path = out / f"compression_N{n}_{key}.npz"
             r = final_damage_faults(path)

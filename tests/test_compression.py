@@ -134,8 +134,10 @@ def test_outputs_readable(heal_run):
     ({"rheology.stress_correction_mean_fraction": 0.5},
      "stress_correction_mean_fraction = 0.5 applies to stress_correction = 'mean_stress' only"),
     ({"rheology.stress_correction": "associated", "solver.name": "explicit"},
-     "rheology.stress_correction = 'associated' is implemented in the implicit solver's damage update only; "
-     "solver.name = 'explicit' does not have it"),
+     "rheology.stress_correction = 'associated': the explicit CPU stepper \\(solver.name = 'explicit', "
+     "solver.device = 'cpu'\\) implements origin, mean_stress only"),
+    ({"rheology.stress_correction": "mean_stress", "solver.name": "prescribed"},
+     "rheology.stress_correction = 'mean_stress': the prescribed-velocity stepper .* implements origin only"),
     ({"rheology.max_pressure_pa": 10e3},
      "rheology.max_pressure_pa = 10000.0 \\(neXtSIM's compressive term\\) is implemented in the explicit "
      "stepper only \\(CPU and CUDA\\); solver.name = 'implicit'"),

@@ -20,7 +20,7 @@ from numba import njit, prange
 
 from .._numba import pick, serial_copy
 from ..errors import ConfigError
-from ..params import MaxwellEBParams
+from ..params import STRESS_CORRECTIONS, MaxwellEBParams
 
 
 def plane_stress_matrix(poisson: float) -> np.ndarray:
@@ -260,6 +260,16 @@ def damage_update_kernel(sigma, damage, cohesion, dt, td, heal_rate, q, denom, m
 DAMAGE_UPDATE = (serial_copy(damage_update_kernel), damage_update_kernel)
 
 
+#: the stress-correction paths (``rheology.stress_correction``) each stepper implements
+#: (the prescribed-velocity stepper updates no damage: only the default is not an ignored setting)
+CORRECTION_PATHS = {"implicit": STRESS_CORRECTIONS, "explicit": ("origin", "mean_stress"), "explicit_cuda": ("origin",),
+                    "prescribed": ("origin",)}
+STEPPER_LABELS = {"implicit": "the implicit solver (solver.name = 'implicit')",
+                  "prescribed": "the prescribed-velocity stepper (solver.name = 'prescribed', no damage update)",
+                  "explicit": "the explicit CPU stepper (solver.name = 'explicit', solver.device = 'cpu')",
+                  "explicit_cuda": "the CUDA explicit stepper (solver.name = 'explicit', solver.device = 'cuda')"}
+
+
 def draw_cohesion(n_elements: int, params: MaxwellEBParams, rng: np.random.Generator) -> np.ndarray:
     """Cohesion C [Pa] per element, uniform in [C_min, C_max] from a seeded generator
     (quenched disorder, Dansereau et al. 2016 §2.2)."""
@@ -307,17 +317,15 @@ class MaxwellEB:
         rate = 0.0 if th is None or not np.isfinite(th) else 1.0 / th
         return np.full(n, rate)
 
-    def require_origin_correction(self, where: str, allow_mean_stress: bool = False):
-        """Raise :class:`ConfigError` unless ``where`` implements the stress correction asked
-        for: the origin path everywhere, and ``"mean_stress"`` where ``allow_mean_stress``
-        (the explicit CPU stepper; the CUDA stepper has the origin path only, and the
-        associated path is in the implicit solver only)."""
+    def require_stress_correction(self, stepper: str):
+        """Raise :class:`ConfigError` unless ``stepper`` (a key of :data:`CORRECTION_PATHS`)
+        implements the stress correction asked for (``rheology.stress_correction``). The
+        scene builder calls this before meshing, and each stepper again when it is built."""
         sc = self.params.stress_correction
-        if sc == "origin" or (allow_mean_stress and sc == "mean_stress"):
-            return
-        has = "origin and mean_stress paths" if allow_mean_stress else "origin path only"
-        raise ConfigError(f"rheology.stress_correction = {sc!r}: {where} implements the {has} "
-                          "(the implicit solver implements every path)")
+        paths = CORRECTION_PATHS[stepper]
+        if sc not in paths:
+            raise ConfigError(f"rheology.stress_correction = {sc!r}: {STEPPER_LABELS[stepper]} implements "
+                              f"{', '.join(paths)} only (the implicit solver implements every path)")
 
     def require_whole_relaxation(self, where: str):
         """Raise :class:`ConfigError` if ``relax_mean_stress`` is false: only the explicit CPU

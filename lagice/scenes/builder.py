@@ -291,16 +291,9 @@ def validate_config(cfg: dict) -> None:
     if sv["name"] in SOLVERS and want is not None and rheo.name != want:
         raise ConfigError(f"solver.name = {sv['name']!r} solves the {want} rheology, but rheology.law = "
                           f"{cfg['rheology']['law']!r}; set rheology.law = {want!r}")
-    sc = rheo.params.stress_correction if rheo.name == "maxwell_eb" else "origin"
-    if sc == "associated" and sv["name"] != "implicit":
-        raise ConfigError(f"rheology.stress_correction = 'associated' is implemented in the implicit solver's "
-                          f"damage update only; solver.name = {sv['name']!r} does not have it. Use "
-                          "solver.name = 'implicit' or stress_correction = 'origin'")
-    if sc == "mean_stress" and (sv["name"] not in ("implicit", "explicit") or (
-            sv["name"] == "explicit" and sv["device"] != "cpu")):
-        raise ConfigError(f"rheology.stress_correction = 'mean_stress' is implemented in the implicit solver and "
-                          f"the explicit stepper on the CPU only; solver.name = {sv['name']!r}, solver.device = "
-                          f"{sv['device']!r}. Use one of those or stress_correction = 'origin'")
+    if rheo.name == "maxwell_eb" and sv["name"] in SOLVERS:
+        rheo.require_stress_correction("explicit_cuda" if sv["name"] == "explicit" and sv["device"] != "cpu"
+                                       else sv["name"])
     if rheo.name == "maxwell_eb" and rheo.params.max_pressure_pa and sv["name"] != "explicit":
         raise ConfigError(f"rheology.max_pressure_pa = {rheo.params.max_pressure_pa!r} (neXtSIM's compressive "
                           f"term) is implemented in the explicit stepper only (CPU and CUDA); solver.name = "
