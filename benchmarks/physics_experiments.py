@@ -1040,6 +1040,27 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # inside: closed 4 (theta 1) and 3 (theta 2) against 2; strait 2 and 2 against 3.
 
 
+
+# --- 2026-11-27 (nineteenth session): broken ice that dilates as it shears (a diagnostic) ---------
+# rheology.dilatancy_angle_deg (new; explicit CPU stepper): the Maxwell viscous flow of damaged ice
+# gets an isotropic part, its divergence sin(psi) times its shear rate (Reynolds dilatancy; Tremblay
+# and Mysak 1997 built it into a granular sea-ice model). Plante and Tremblay (2021) found shear and
+# convergence still dominating along the faults of Maxwell-EB after their correction scheme and
+# called for a change of the post-fracture viscosity; the fifteenth session found the interior
+# closing as a whole (net-divergence ratio -0.71, -0.73) with the divergence part's beta near 0.
+# psi = 20 deg is a strong value chosen to learn whether the mechanism can matter (Bolton's rule
+# psi ~ phi - phi_cv would give about 5 deg for tan(phi) = 0.7); it has no sea-ice source.
+# Stated before the runs (2026-11-27, 19:55 UTC): a lead for beta if beta rises by 0.04 or more over
+# the shipped month's (0.038 closed, 0.030 strait) in both basins with no band of the six lost (2
+# and 3 inside). The mechanism acts if the interior's net-divergence ratio (beta_components.py)
+# moves towards 0 by 0.2 or more in both basins. Predicted: the mechanism acts, but beta rises by
+# less than 0.02 (the bands open, all in the same sense, so their divergence does not cancel
+# between 10 and 300 km either), and the rate rises by x1.0-1.5.
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    EXPERIMENTS[f"{_p}-hthick-1125-dil20"] = (
+        _basin, from_spinup("H1125") + ["rheology.dilatancy_angle_deg=20"], 10e3, 28,
+        f"{_p}-hthick-1125 with a dilatant Maxwell viscous flow, psi = 20 deg (diagnostic)")
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]

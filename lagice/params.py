@@ -62,6 +62,15 @@ class MaxwellEBParams:
             mean takes the compressive term's factor above (it creeps where it is tensile or
             compressive beyond P_max). The ice then converges elastically, at damage events or
             above P_max. Explicit CPU stepper only
+        dilatancy_angle_deg: ψ [degrees] ∈ [0, 45) of a dilatant Maxwell viscous flow (None or 0:
+            off, the default; a diagnostic of lagice, 2026-11-27; docs/physics.md §4, "Broken ice
+            that dilates as it shears"). The viscous (permanent) strain rate K⁻¹σ/(Eλ) of
+            Dansereau et al. (2016) gets an isotropic part, so that its divergence is sin ψ
+            times its shear rate, as the Reynolds dilatancy of a granular material (Tremblay
+            and Mysak 1997 for sea ice; ψ = 0 is their incompressible flow). Where the ice
+            cannot open, the flow builds a pressure k_ψ r, k_ψ = sin ψ (1 + ν)/(1 − ν), r the
+            radius of Mohr's circle. Explicit CPU stepper only, with ``relax_mean_stress`` true
+            and no ``max_pressure_pa``
     """
 
     poisson: float = 0.3
@@ -81,6 +90,7 @@ class MaxwellEBParams:
     max_pressure_pa: float | None = None
     max_pressure_thickness_exponent: float = 1.5
     relax_mean_stress: bool = True
+    dilatancy_angle_deg: float | None = None
 
     def __post_init__(self):
         check_range("poisson (ν)", self.poisson, 0.0, 0.5, high_open=True)
@@ -102,6 +112,14 @@ class MaxwellEBParams:
         check_range("max_pressure_thickness_exponent (k)", self.max_pressure_thickness_exponent, 0.0, 3.0)
         if not isinstance(self.relax_mean_stress, bool):
             raise ConfigError(f"rheology.relax_mean_stress = {self.relax_mean_stress!r}: expected true or false")
+        if self.dilatancy_angle_deg:
+            check_range("dilatancy_angle_deg (ψ)", self.dilatancy_angle_deg, 0.0, 45.0, high_open=True,
+                        unit="degrees")
+            if not self.relax_mean_stress or self.max_pressure_pa:
+                raise ConfigError(f"rheology.dilatancy_angle_deg = {self.dilatancy_angle_deg!r} is implemented "
+                                  f"with the whole stress relaxing and no compressive term only; it is set with "
+                                  f"relax_mean_stress = {self.relax_mean_stress!r}, max_pressure_pa = "
+                                  f"{self.max_pressure_pa!r}")
         if self.stress_correction not in STRESS_CORRECTIONS:
             raise ConfigError(f"rheology.stress_correction = {self.stress_correction!r}: expected one of "
                               f"{list(STRESS_CORRECTIONS)}")
@@ -119,6 +137,13 @@ class MaxwellEBParams:
         if self.stress_correction in ("origin", "associated"):
             return 0.0
         return 1.0 if self.stress_correction_mean_fraction is None else float(self.stress_correction_mean_fraction)
+
+    @property
+    def dilatancy_factor(self) -> float | None:
+        """k_ψ = sin ψ (1 + ν)/(1 − ν) of the dilatant viscous flow, or None when it is off."""
+        if not self.dilatancy_angle_deg:
+            return None
+        return math.sin(math.radians(self.dilatancy_angle_deg)) * (1.0 + self.poisson) / (1.0 - self.poisson)
 
     @property
     def E0(self) -> float:

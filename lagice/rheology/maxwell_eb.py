@@ -334,6 +334,13 @@ class MaxwellEB:
             raise ConfigError(f"rheology.relax_mean_stress = False: {where} relaxes the whole stress (the "
                               "deviatoric-only relaxation is in the explicit CPU stepper)")
 
+    def require_no_dilatancy(self, where: str):
+        """Raise :class:`ConfigError` if the dilatant viscous flow (``dilatancy_angle_deg``) is
+        set: only the explicit CPU stepper implements it, and ``where`` must not ignore it."""
+        if self.params.dilatancy_angle_deg:
+            raise ConfigError(f"rheology.dilatancy_angle_deg = {self.params.dilatancy_angle_deg!r}: {where} has "
+                              "no dilatant viscous flow (the explicit CPU stepper has)")
+
     def require_no_max_pressure(self, where: str):
         """Raise :class:`ConfigError` if neXtSIM's compressive term (``max_pressure_pa``) is
         set: only the explicit stepper (CPU and CUDA) implements it, and ``where`` must not ignore it."""

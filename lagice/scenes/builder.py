@@ -303,6 +303,12 @@ def validate_config(cfg: dict) -> None:
         raise ConfigError(f"rheology.relax_mean_stress = false is implemented in the explicit stepper on the CPU "
                           f"only; solver.name = {sv['name']!r}, solver.device = {sv['device']!r}. Use "
                           f"solver.name = 'explicit' with device = 'cpu', or leave relax_mean_stress = true")
+    if rheo.name == "maxwell_eb" and rheo.params.dilatancy_angle_deg and (
+            sv["name"] != "explicit" or sv["device"] != "cpu"):
+        raise ConfigError(f"rheology.dilatancy_angle_deg = {rheo.params.dilatancy_angle_deg!r} is implemented in "
+                          f"the explicit stepper on the CPU only; solver.name = {sv['name']!r}, solver.device = "
+                          f"{sv['device']!r}. Use solver.name = 'explicit' with device = 'cpu', or leave "
+                          f"dilatancy_angle_deg unset")
     if sv["name"] == "evp" and cfg["healing"]["law"] not in ("none",):
         raise ConfigError(f"healing.law = {cfg['healing']['law']!r}: the viscous-plastic rheology (solver 'evp') "
                           f"has no damage to heal; set healing.law = 'none'")

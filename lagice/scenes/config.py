@@ -64,6 +64,8 @@ SCHEMA = {
         "max_pressure_pa": (NUM, None), "max_pressure_thickness_exponent": (NUM, 1.5),
         # false: the Maxwell relaxation acts on the deviatoric stress only (MaxwellEBParams.relax_mean_stress)
         "relax_mean_stress": (bool, True),
+        # a dilatant Maxwell viscous flow, angle ψ in degrees (MaxwellEBParams.dilatancy_angle_deg; 0/None off)
+        "dilatancy_angle_deg": (NUM, None),
         "p_star": (NUM, 27.5e3), "c_star": (NUM, 20.0), "ellipse": (NUM, 2.0), "delta_min": (NUM, 2e-9),
         "replacement_pressure": (bool, False),
         # strength law (lagice.strength; issue 12): "uniform" = cohesion_min/max_pa,
@@ -111,7 +113,8 @@ RHEOLOGY_KEYS = {
     "maxwell_eb": ("poisson", "friction", "rho_ice", "shear_wave_speed", "young_modulus_pa", "relaxation_time_s",
                    "alpha", "cohesion_min_pa", "cohesion_max_pa", "healing_time_s", "concentration_c",
                    "max_damage", "stress_correction", "stress_correction_mean_fraction", "max_pressure_pa",
-                   "max_pressure_thickness_exponent", "relax_mean_stress"),
+                   "max_pressure_thickness_exponent", "relax_mean_stress",
+                   "dilatancy_angle_deg"),
     "viscous_plastic": ("p_star", "c_star", "ellipse", "delta_min", "replacement_pressure", "rho_ice"),
 }
 
@@ -144,6 +147,7 @@ LEGACY_VALUES = {
     "rheology.max_pressure_pa": (None, 0, 0.0),      # 2026-11-26: no compressive term
     "rheology.max_pressure_thickness_exponent": (1.5,),
     "rheology.relax_mean_stress": (True,),            # 2026-11-27: the whole stress relaxes
+    "rheology.dilatancy_angle_deg": (None, 0, 0.0),   # 2026-11-27: the viscous flow does not dilate
     "initial.state_file": (None, ""),                # 2026-11-24: no spin-up state
     "solver.substep_limit": (None, "mesh"),          # 2026-11-25: the whole-mesh limit
 }

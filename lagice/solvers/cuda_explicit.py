@@ -336,6 +336,7 @@ class CudaExplicitSolver:
             raise ConfigError(f"the explicit stepper solves the Maxwell-EB rheology; got {type(rheology).__name__}")
         rheology.require_stress_correction("explicit_cuda")
         rheology.require_whole_relaxation("the CUDA explicit stepper")
+        rheology.require_no_dilatancy("the CUDA explicit stepper")
         if substeps is not None:
             if int(substeps) != substeps or int(substeps) < 1:
                 raise ConfigError(f"substeps = {substeps!r} must be an integer >= 1 (or None: automatic)")

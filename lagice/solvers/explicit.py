@@ -200,7 +200,7 @@ _ALPHA_IS_4 = False
 
 
 def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion, kc, kt,
-                           td, heal_rate, e_dt, gamma, pmax, keep_mean, theta, dt_s, kxx, kxy, kss, q, denom,
+                           td, heal_rate, e_dt, gamma, pmax, keep_mean, theta, dilat, dt_s, kxx, kxy, kss, q, denom,
                            max_damage, E0, lambda0, alpha, damaged_flag):
     """Maxwell stress update and damage/healing of one sub-step, in place (module doc, step 2).
 
@@ -227,6 +227,13 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     the straight path towards P = θ m I, σ ← P + f (σ − P), with d_crit the factor of
     ``rheology._dcrit_towards`` (the origin path where that factor does not exist), as
     ``rheology.damage_update_kernel`` does for the implicit solver.
+    dilat: None (rheology.dilatancy_angle_deg unset or 0, the default; pruned as pmax is). A
+    float k_ψ = sin ψ (1 + ν)/(1 − ν): the Maxwell viscous flow dilates (Reynolds dilatancy of
+    broken ice): to the viscous strain rate K⁻¹σ/(Eλ) it adds δ I with 2δ = sin ψ times its
+    shear rate 2(1 + ν) r/(Eλ), r the radius of Mohr's circle. Backward Euler, like the
+    relaxation: σ ← γ σ* − (1 − γ) k_ψ r I, r that of the relaxed stress γ σ* (exact, since
+    the isotropic term leaves r unchanged). Only with the whole stress relaxing and no
+    compressive term (params refuse the rest).
     Returns the number of elements whose damage hit the cap.
     """
     m = tri.shape[0]
@@ -245,6 +252,10 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
             sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * gp
             syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * gp
             sxy = (sigma[e, 2] + ed * (kss * exy)) * gp
+            if dilat is not None:  # only with pmax None (the builder refuses both): gp == g here
+                pd = (1.0 - g) * dilat * math.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
+                sxx -= pd
+                syy -= pd
         else:
             axx = sigma[e, 0] + ed * (kxx * exx + kxy * eyy)
             ayy = sigma[e, 1] + ed * (kxy * exx + kxx * eyy)
@@ -323,8 +334,8 @@ PARALLEL_MIN_ELEMENTS = PARALLEL_MIN_SIZE
 
 @njit(cache=True, error_model="numpy")
 def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
-                      c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dt_s, kxx,
-                      kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+                      c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat,
+                      dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
     """All ``n_sub`` sub-steps of one outer step in compiled code (one call per outer
     step, no Python per sub-step): the node kernel then the element kernel, serial
     builds; the same calls as a Python loop over the kernels, bit-identical results."""
@@ -334,14 +345,14 @@ def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t,
                                     (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel_serial(
             tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta,
-            dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            dilat, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
 
 @njit(cache=True, error_model="numpy")
 def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
-                      c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dt_s, kxx,
-                      kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+                      c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat,
+                      dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
     """:func:`substeps_serial` with the parallel kernel builds (one fork/join per
     kernel and sub-step, launched from compiled code)."""
     n_capped = 0
@@ -350,7 +361,7 @@ def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_
                              (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel(
             tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta,
-            dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            dilat, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
 
@@ -575,8 +586,8 @@ class ExplicitSolver:
     def _profiled_substeps(self, par, n_sub, args):
         """The sub-step loop in Python with each kernel timed (``profile_kernels``)."""
         (vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b, c, damage, conc_factor,
-         coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dt_s, kxx, kxy, kss, q, denom, max_damage, E0,
-         lambda0, alpha, flag) = args
+         coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat, dt_s, kxx, kxy, kss, q, denom, max_damage,
+         E0, lambda0, alpha, flag) = args
         node_k = node_velocity_kernel if par else node_velocity_kernel_serial
         elem_k = element_kernels(alpha)[int(par)]
         n_capped = 0
@@ -586,7 +597,7 @@ class ExplicitSolver:
             node_k(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, (k + 1) / n_sub)
             tb = time.perf_counter()
             n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma,
-                               pmax, keep_mean, theta, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0,
+                               pmax, keep_mean, theta, dilat, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0,
                                alpha,
                                flag)
             tc = time.perf_counter()
@@ -627,6 +638,7 @@ class ExplicitSolver:
         pmax = None if pmax is None else np.ascontiguousarray(pmax, np.float64)
         keep_mean = None if p.relax_mean_stress else True
         theta = None if p.stress_correction == "origin" else float(p.mean_fraction)
+        dilat = p.dilatancy_factor  # None: off
         heal = (self.heal_rate(state, t_s) if self.heal_rate is not None
                 else self.rheology.constant_heal_rate(mesh.n_elements))
         heal = np.ascontiguousarray(heal, np.float64)
@@ -646,7 +658,7 @@ class ExplicitSolver:
         ptr32, elems32, tri32 = self._indices(mesh)
         args = (vel, vel_sum, sigma, ptr32, elems32, su.w, nc, terms.cos_turn, terms.sin_turn, ns.fixed, pres0,
                 pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, k_c, k_t, self.td, heal, e_dt, gamma, pmax,
-                keep_mean, theta, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s,
+                keep_mean, theta, dilat, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s,
                 float(p.alpha), flag)
         if self.kernel_choice is None or (
                 self.parallel_setting is None
