@@ -147,6 +147,10 @@ def test_outputs_readable(heal_run):
      "rheology.relax_mean_stress = false is implemented in the explicit stepper on the CPU only; "
      "solver.name = 'implicit'"),
     ({"rheology.relax_mean_stress": "no"}, "relax_mean_stress"),
+    ({"rheology.dilatancy_angle_deg": 20.0},
+     "rheology.dilatancy_angle_deg = 20.0 is implemented in the explicit stepper on the CPU only; "
+     "solver.name = 'implicit'"),
+    ({"rheology.dilatancy_angle_deg": 45.0}, "dilatancy_angle_deg \\(ψ\\) = 45.0"),
 ])
 def test_bad_input_fails_before_meshing(ov, match, monkeypatch, tmp_path):
     import lagice.scenes.builder as mod

@@ -526,3 +526,87 @@ def test_elementwise_stability_bound(tmp_path):
     assert blew_up
     with pytest.raises(ConfigError, match=r"solver.substep_limit = 'cell': expected one of \['mesh', 'element'\]"):
         scene_sim("wind_square", tmp_path / "bad", {"solver.substep_limit": "cell"})
+
+
+def test_dilatant_viscous_flow_builds_pressure_analytically():
+    """``rheology.dilatancy_angle_deg``: with no motion (uniform stress, boundary nodes
+    coast) the deviator still decays by γ per sub-step, and the backward-Euler update
+    σ ← γ σ − (1 − γ) k_ψ r I, k_ψ = sin ψ (1 + ν)/(1 − ν), r the relaxed Mohr radius,
+    has the closed form m_N = γ^N (m_0 − N (1 − γ) k_ψ r_0) for the mean normal stress
+    after N sub-steps. ψ = 0 is the default path bit for bit."""
+    poly, _ = rectangle_domain(50e3, 50e3)
+    mesh = generate_mesh(poly, 10e3)
+    lam, dts, n_steps, nu = 900.0, 5.0, 40, 0.3
+    dev = np.array([2e3, -2e3, 1e3])
+    r0 = np.hypot(2e3, 1e3)
+    m0 = -5e3
+
+    def run(**kw):
+        s = ExplicitSolver(MaxwellEB(relaxation_time_s=lam, healing_time_s=None, poisson=nu, **kw), mesh,
+                           substeps=6)
+        st = IceState.uniform(mesh, cohesion_pa=1e12)
+        st.stress[:] = dev + [m0, m0, 0.0]
+        for _ in range(n_steps):
+            step(s, st, 6 * dts)
+        assert np.abs(st.velocity).max() < 1e-12
+        return st.stress
+
+    g = lam / (lam + dts)
+    n = 6 * n_steps
+    k = np.sin(np.radians(20.0)) * (1 + nu) / (1 - nu)
+    assert MaxwellEB(dilatancy_angle_deg=20.0).params.dilatancy_factor == pytest.approx(k, rel=1e-15)
+    out = run(dilatancy_angle_deg=20.0)
+    m_ref = g ** n * (m0 - n * (1 - g) * k * r0)
+    assert np.allclose(out, dev * g ** n + [m_ref, m_ref, 0.0], rtol=1e-11, atol=1e-9)
+    assert m_ref < 1.3 * m0 * g ** n  # the dilatant pressure is large enough to tell apart
+    assert np.array_equal(run(dilatancy_angle_deg=0.0), run())
+
+
+def test_sheared_broken_ice_opens_with_dilatancy():
+    """Simple shear of broken ice (damage 0.99, so its Maxwell time is 10 s and the flow is
+    viscous within seconds), bottom held, top driven along x with its v free, the sides
+    free. The flow rule of ``dilatancy_angle_deg`` makes the divergence sin ψ times the
+    viscous shear rate e1 − e2; the held bottom keeps the plate from widening, so a small
+    pressure builds and the interior opens at 0.6-1 times that (0.28 at ψ = 20°, in
+    proportion to sin ψ: ψ = 10° gives half), and at about 0 without dilatancy; the top rises."""
+    poly, segs = rectangle_domain(20e3, 20e3)
+    mesh = generate_mesh(poly, 2e3, segments=segs, exterior_tag="free")
+    u_top = 0.05
+
+    def run(psi):
+        rheo = MaxwellEB(healing_time_s=None, dilatancy_angle_deg=psi)
+        s = ExplicitSolver(rheo, mesh, bcs=[VelocityBC("bottom", u=0.0, v=0.0), VelocityBC("top", u=u_top)],
+                           substeps=20)
+        st = IceState.uniform(mesh, cohesion_pa=1e12)
+        st.damage[:] = 0.99
+        for _ in range(60):
+            step(s, st, 60.0)
+        e = strain_rate(mesh.triangles, s.nodes.b, s.nodes.c, st.velocity)
+        cen = mesh.nodes[mesh.triangles].mean(axis=1)
+        inner = (np.abs(cen[:, 0] - 10e3) < 5e3) & (np.abs(cen[:, 1] - 10e3) < 5e3)
+        div = e[inner, 0] + e[inner, 1]
+        shear = np.sqrt((e[inner, 0] - e[inner, 1]) ** 2 + 4 * e[inner, 2] ** 2)
+        top = mesh.nodes_with_tag("top")
+        return np.median(div / shear), float(st.velocity[top, 1].mean()), float(np.median(shear))
+
+    s20, s10 = np.sin(np.radians(20.0)), np.sin(np.radians(10.0))
+    ratio, v_top, shear = run(20.0)
+    assert shear > 0.3 * u_top / 20e3  # the interior shears
+    assert 0.6 * s20 < ratio < s20
+    assert v_top > 0.0
+    ratio10, _, _ = run(10.0)
+    assert ratio10 / ratio == pytest.approx(s10 / s20, rel=0.05)
+    ratio0, v_top0, _ = run(None)
+    assert abs(ratio0) < 0.01 and v_top > 100 * abs(v_top0)
+
+
+def test_dilatancy_is_refused_where_it_is_not_implemented():
+    from lagice.solvers.implicit import ImplicitSolver
+    with pytest.raises(ConfigError, match="dilatancy_angle_deg = 20.0: the implicit solver has no dilatant"):
+        ImplicitSolver(MaxwellEB(dilatancy_angle_deg=20.0), mesh=None)
+    with pytest.raises(ConfigError, match="dilatancy_angle_deg .ψ. = 50.0 .*45"):
+        MaxwellEB(dilatancy_angle_deg=50.0)
+    with pytest.raises(ConfigError, match="dilatancy_angle_deg = 20.0 is implemented with the whole stress relaxing"):
+        MaxwellEB(dilatancy_angle_deg=20.0, relax_mean_stress=False)
+    with pytest.raises(ConfigError, match="max_pressure_pa = 10000.0"):
+        MaxwellEB(dilatancy_angle_deg=20.0, max_pressure_pa=10e3)
