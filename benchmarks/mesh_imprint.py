@@ -120,6 +120,16 @@ VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.me
             # (origin, same draws: 44.5 and 39.5); the control 36.6 deg. No theta = 2 plate
             # ruptures (post-peak sag 0.04-0.57 kPa; the largest block drop is the ringing before
             # any damage), and only the seed-1 plates make one straight band: item 7 not met.
+            # The dilatant Maxwell viscous flow (rheology.dilatancy_angle_deg, nineteenth session;
+            # explicit CPU stepper only), "delaunay+explicit+dil20" at N = 40, seed 0. Stated before
+            # the run (2026-11-27, 20:05 UTC): the faults move by less than 3 deg from the explicit
+            # origin run's, and the peak by less than 2 %, because this plate's viscous flow is
+            # negligible (it heals before its damage nears 1: "The basin's stepper in the
+            # compression test"); the dilatancy acts on the viscous flow, not on the damage event.
+            # Result: the peak holds (113.0 against 112.9 kPa) and the main final-damage fault
+            # (40.3 against 40.8 deg; the second 27.1 against 31.0), the rupture-block faults do
+            # not (rate 0.0, 29.7 against 19.3, 32.1 deg): this plate rings without a clean rupture.
+            "dil20": ["rheology.dilatancy_angle_deg=20"],
             **{f"mean{int(round(100 * t)):03d}": ["rheology.stress_correction=mean_stress",
                                                   f"rheology.stress_correction_mean_fraction={t}"]
                for t in (0.25, 0.5, 0.75, 1.25, 1.5, 2.0)}}

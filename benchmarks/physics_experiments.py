@@ -1060,6 +1060,13 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-1125-dil20"] = (
         _basin, from_spinup("H1125") + ["rheology.dilatancy_angle_deg=20"], 10e3, 28,
         f"{_p}-hthick-1125 with a dilatant Maxwell viscous flow, psi = 20 deg (diagnostic)")
+# Result (2026-11-27, nineteenth session): NOT a lead, and the mechanism does not act (the
+# prediction failed there). beta 0.038 -> 0.031 (closed), 0.030 -> 0.034 (strait); the interior
+# closes more coherently (net-divergence ratio -0.83, -0.77), and |div|/shear at the element scale
+# does not rise (0.54, 0.56): inside the pack the faults build pressure instead of opening, and the
+# envelope's friction stiffens the pack. Rate x0.39-0.41 (0.00095, 0.0011 per day), drift 21-26 km,
+# wind factor 0.0017, 0.0021, 57 and 79 remeshes; bands inside 0 (closed) and 2 (strait) against 2
+# and 3.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
