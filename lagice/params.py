@@ -138,6 +138,18 @@ class MaxwellEBParams:
             return 0.0
         return 1.0 if self.stress_correction_mean_fraction is None else float(self.stress_correction_mean_fraction)
 
+    def optional_terms(self) -> dict:
+        """The optional terms set away from their defaults, key → value (not every stepper
+        implements each: :data:`lagice.rheology.maxwell_eb.OPTIONAL_TERMS`)."""
+        out = {}
+        if self.max_pressure_pa:
+            out["max_pressure_pa"] = self.max_pressure_pa
+        if not self.relax_mean_stress:
+            out["relax_mean_stress"] = self.relax_mean_stress
+        if self.dilatancy_angle_deg:
+            out["dilatancy_angle_deg"] = self.dilatancy_angle_deg
+        return out
+
     @property
     def dilatancy_factor(self) -> float | None:
         """k_ψ = sin ψ (1 + ν)/(1 − ν) of the dilatant viscous flow, or None when it is off."""

@@ -139,17 +139,19 @@ def test_outputs_readable(heal_run):
     ({"rheology.stress_correction": "mean_stress", "solver.name": "prescribed"},
      "rheology.stress_correction = 'mean_stress': the prescribed-velocity stepper .* implements origin only"),
     ({"rheology.max_pressure_pa": 10e3},
-     "rheology.max_pressure_pa = 10000.0 \\(neXtSIM's compressive term\\) is implemented in the explicit "
-     "stepper only \\(CPU and CUDA\\); solver.name = 'implicit'"),
+     "rheology.max_pressure_pa = 10000.0: the implicit solver \\(solver.name = 'implicit'\\) does not implement it "
+     "\\(implemented in the explicit CPU stepper .* and the CUDA explicit stepper .*\\); use one of those"),
+    ({"rheology.max_pressure_pa": 10e3, "solver.name": "prescribed"},
+     "rheology.max_pressure_pa = 10000.0: the prescribed-velocity stepper .* does not implement it"),
     ({"rheology.max_pressure_pa": -1.0}, "max_pressure_pa \\(P\\*\\) = -1.0 Pa is out of range"),
     ({"rheology.max_pressure_thickness_exponent": 4.0}, "max_pressure_thickness_exponent \\(k\\) = 4.0"),
     ({"rheology.relax_mean_stress": False},
-     "rheology.relax_mean_stress = false is implemented in the explicit stepper on the CPU only; "
-     "solver.name = 'implicit'"),
+     "rheology.relax_mean_stress = false: the implicit solver .* does not implement it \\(implemented in the "
+     "explicit CPU stepper \\(solver.name = 'explicit', solver.device = 'cpu'\\)\\)"),
     ({"rheology.relax_mean_stress": "no"}, "relax_mean_stress"),
     ({"rheology.dilatancy_angle_deg": 20.0},
-     "rheology.dilatancy_angle_deg = 20.0 is implemented in the explicit stepper on the CPU only; "
-     "solver.name = 'implicit'"),
+     "rheology.dilatancy_angle_deg = 20.0: the implicit solver .* does not implement it \\(implemented in the "
+     "explicit CPU stepper"),
     ({"rheology.dilatancy_angle_deg": 45.0}, "dilatancy_angle_deg \\(ψ\\) = 45.0"),
 ])
 def test_bad_input_fails_before_meshing(ov, match, monkeypatch, tmp_path):

@@ -294,7 +294,7 @@ def test_max_pressure_is_refused_where_it_is_not_implemented():
     """The implicit solver does not implement the term and must not silently ignore it
     (scenes: tests/test_compression.py::test_bad_input_fails_before_meshing)."""
     from lagice.solvers.implicit import ImplicitSolver
-    with pytest.raises(ConfigError, match="max_pressure_pa = 10000.0: the implicit solver"):
+    with pytest.raises(ConfigError, match="max_pressure_pa = 10000.0: the implicit solver .* does not implement it"):
         ImplicitSolver(MaxwellEB(max_pressure_pa=10e3), mesh=None)
 
 
@@ -337,7 +337,7 @@ def test_deviatoric_relaxation_keeps_the_mean_stress():
 
 def test_deviatoric_relaxation_is_refused_where_it_is_not_implemented():
     from lagice.solvers.implicit import ImplicitSolver
-    with pytest.raises(ConfigError, match="relax_mean_stress = False: the implicit solver relaxes the whole"):
+    with pytest.raises(ConfigError, match="relax_mean_stress = false: the implicit solver .* does not implement it"):
         ImplicitSolver(MaxwellEB(relax_mean_stress=False), mesh=None)
     with pytest.raises(ConfigError, match="relax_mean_stress = 1: expected true or false"):
         MaxwellEB(relax_mean_stress=1)
@@ -465,7 +465,18 @@ def test_explicit_stepper_refuses_the_associated_correction():
     # the CUDA stepper (which calls this before anything else once a GPU is found) has the origin path only
     with pytest.raises(ConfigError, match="stress_correction = 'mean_stress': the CUDA explicit stepper .* implements "
                                           "origin only"):
-        MaxwellEB(stress_correction="mean_stress").require_stress_correction("explicit_cuda")
+        MaxwellEB(stress_correction="mean_stress").require_stepper("explicit_cuda")
+    # the optional terms: one table (maxwell_eb.OPTIONAL_TERMS) for the builder and every stepper
+    with pytest.raises(ConfigError, match="dilatancy_angle_deg = 20.0: the CUDA explicit stepper .* does not "
+                                          "implement it"):
+        MaxwellEB(dilatancy_angle_deg=20.0).require_stepper("explicit_cuda")
+    with pytest.raises(ConfigError, match="relax_mean_stress = false: the CUDA explicit stepper"):
+        MaxwellEB(relax_mean_stress=False).require_stepper("explicit_cuda")
+    MaxwellEB(max_pressure_pa=10e3).require_stepper("explicit_cuda")  # implemented there
+    for term in ({"max_pressure_pa": 10e3}, {"relax_mean_stress": False}, {"dilatancy_angle_deg": 20.0}):
+        MaxwellEB(**term).require_stepper("explicit")
+        with pytest.raises(ConfigError, match="the prescribed-velocity stepper .* does not implement it"):
+            MaxwellEB(**term).require_stepper("prescribed")
 
 
 def test_elementwise_stability_bound(tmp_path):
@@ -602,7 +613,8 @@ def test_sheared_broken_ice_opens_with_dilatancy():
 
 def test_dilatancy_is_refused_where_it_is_not_implemented():
     from lagice.solvers.implicit import ImplicitSolver
-    with pytest.raises(ConfigError, match="dilatancy_angle_deg = 20.0: the implicit solver has no dilatant"):
+    with pytest.raises(ConfigError, match="dilatancy_angle_deg = 20.0: the implicit solver .* does not implement it "
+                                          ".implemented in the explicit CPU"):
         ImplicitSolver(MaxwellEB(dilatancy_angle_deg=20.0), mesh=None)
     with pytest.raises(ConfigError, match="dilatancy_angle_deg .ψ. = 50.0 .*45"):
         MaxwellEB(dilatancy_angle_deg=50.0)

@@ -264,6 +264,11 @@ DAMAGE_UPDATE = (serial_copy(damage_update_kernel), damage_update_kernel)
 #: (the prescribed-velocity stepper updates no damage: only the default is not an ignored setting)
 CORRECTION_PATHS = {"implicit": STRESS_CORRECTIONS, "explicit": ("origin", "mean_stress"), "explicit_cuda": ("origin",),
                     "prescribed": ("origin",)}
+#: the optional terms of :class:`lagice.params.MaxwellEBParams` that each stepper implements.
+#: A term set away from its default (:meth:`MaxwellEBParams.optional_terms`) is refused by a
+#: stepper that does not list it, so no stepper silently runs without it
+OPTIONAL_TERMS = {"implicit": (), "explicit": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg"),
+                  "explicit_cuda": ("max_pressure_pa",), "prescribed": ()}
 STEPPER_LABELS = {"implicit": "the implicit solver (solver.name = 'implicit')",
                   "prescribed": "the prescribed-velocity stepper (solver.name = 'prescribed', no damage update)",
                   "explicit": "the explicit CPU stepper (solver.name = 'explicit', solver.device = 'cpu')",
@@ -317,36 +322,23 @@ class MaxwellEB:
         rate = 0.0 if th is None or not np.isfinite(th) else 1.0 / th
         return np.full(n, rate)
 
-    def require_stress_correction(self, stepper: str):
-        """Raise :class:`ConfigError` unless ``stepper`` (a key of :data:`CORRECTION_PATHS`)
-        implements the stress correction asked for (``rheology.stress_correction``). The
-        scene builder calls this before meshing, and each stepper again when it is built."""
+    def require_stepper(self, stepper: str):
+        """Raise :class:`ConfigError` unless ``stepper`` (a key of :data:`STEPPER_LABELS`)
+        implements the stress correction asked for (``rheology.stress_correction``,
+        :data:`CORRECTION_PATHS`) and every optional term that is set (:data:`OPTIONAL_TERMS`).
+        The scene builder calls this before meshing, and each stepper again when it is built."""
         sc = self.params.stress_correction
         paths = CORRECTION_PATHS[stepper]
         if sc not in paths:
             raise ConfigError(f"rheology.stress_correction = {sc!r}: {STEPPER_LABELS[stepper]} implements "
                               f"{', '.join(paths)} only (the implicit solver implements every path)")
-
-    def require_whole_relaxation(self, where: str):
-        """Raise :class:`ConfigError` if ``relax_mean_stress`` is false: only the explicit CPU
-        stepper relaxes the deviatoric stress alone, and ``where`` must not ignore it."""
-        if not self.params.relax_mean_stress:
-            raise ConfigError(f"rheology.relax_mean_stress = False: {where} relaxes the whole stress (the "
-                              "deviatoric-only relaxation is in the explicit CPU stepper)")
-
-    def require_no_dilatancy(self, where: str):
-        """Raise :class:`ConfigError` if the dilatant viscous flow (``dilatancy_angle_deg``) is
-        set: only the explicit CPU stepper implements it, and ``where`` must not ignore it."""
-        if self.params.dilatancy_angle_deg:
-            raise ConfigError(f"rheology.dilatancy_angle_deg = {self.params.dilatancy_angle_deg!r}: {where} has "
-                              "no dilatant viscous flow (the explicit CPU stepper has)")
-
-    def require_no_max_pressure(self, where: str):
-        """Raise :class:`ConfigError` if neXtSIM's compressive term (``max_pressure_pa``) is
-        set: only the explicit stepper (CPU and CUDA) implements it, and ``where`` must not ignore it."""
-        if self.params.max_pressure_pa:
-            raise ConfigError(f"rheology.max_pressure_pa = {self.params.max_pressure_pa!r}: {where} does not "
-                              "implement neXtSIM's compressive term (the explicit stepper does, on CPU and GPU)")
+        for key, value in self.params.optional_terms().items():
+            if key not in OPTIONAL_TERMS[stepper]:
+                where = [STEPPER_LABELS[k] for k, terms in OPTIONAL_TERMS.items() if key in terms]
+                shown = str(value).lower() if isinstance(value, bool) else repr(value)  # as the scene file has it
+                raise ConfigError(f"rheology.{key} = {shown}: {STEPPER_LABELS[stepper]} does not implement it "
+                                  f"(implemented in {' and '.join(where)}); use one of those, or leave "
+                                  f"{key} at its default")
 
     def max_pressure(self, thickness, concentration):
         """P_max = P* (h / 1 m)^k exp(−c*(1−A)) [Pa] per element (neXtSIM's compressive term;

@@ -292,23 +292,7 @@ def validate_config(cfg: dict) -> None:
         raise ConfigError(f"solver.name = {sv['name']!r} solves the {want} rheology, but rheology.law = "
                           f"{cfg['rheology']['law']!r}; set rheology.law = {want!r}")
     if rheo.name == "maxwell_eb" and sv["name"] in SOLVERS:
-        rheo.require_stress_correction("explicit_cuda" if sv["name"] == "explicit" and sv["device"] != "cpu"
-                                       else sv["name"])
-    if rheo.name == "maxwell_eb" and rheo.params.max_pressure_pa and sv["name"] != "explicit":
-        raise ConfigError(f"rheology.max_pressure_pa = {rheo.params.max_pressure_pa!r} (neXtSIM's compressive "
-                          f"term) is implemented in the explicit stepper only (CPU and CUDA); solver.name = "
-                          f"{sv['name']!r}. Use solver.name = 'explicit', or leave max_pressure_pa unset")
-    if rheo.name == "maxwell_eb" and not rheo.params.relax_mean_stress and (
-            sv["name"] != "explicit" or sv["device"] != "cpu"):
-        raise ConfigError(f"rheology.relax_mean_stress = false is implemented in the explicit stepper on the CPU "
-                          f"only; solver.name = {sv['name']!r}, solver.device = {sv['device']!r}. Use "
-                          f"solver.name = 'explicit' with device = 'cpu', or leave relax_mean_stress = true")
-    if rheo.name == "maxwell_eb" and rheo.params.dilatancy_angle_deg and (
-            sv["name"] != "explicit" or sv["device"] != "cpu"):
-        raise ConfigError(f"rheology.dilatancy_angle_deg = {rheo.params.dilatancy_angle_deg!r} is implemented in "
-                          f"the explicit stepper on the CPU only; solver.name = {sv['name']!r}, solver.device = "
-                          f"{sv['device']!r}. Use solver.name = 'explicit' with device = 'cpu', or leave "
-                          f"dilatancy_angle_deg unset")
+        rheo.require_stepper("explicit_cuda" if sv["name"] == "explicit" and sv["device"] != "cpu" else sv["name"])
     if sv["name"] == "evp" and cfg["healing"]["law"] not in ("none",):
         raise ConfigError(f"healing.law = {cfg['healing']['law']!r}: the viscous-plastic rheology (solver 'evp') "
                           f"has no damage to heal; set healing.law = 'none'")

@@ -334,9 +334,7 @@ class CudaExplicitSolver:
         self.device_name = require_cuda("solver.device")
         if not isinstance(rheology, MaxwellEB):
             raise ConfigError(f"the explicit stepper solves the Maxwell-EB rheology; got {type(rheology).__name__}")
-        rheology.require_stress_correction("explicit_cuda")
-        rheology.require_whole_relaxation("the CUDA explicit stepper")
-        rheology.require_no_dilatancy("the CUDA explicit stepper")
+        rheology.require_stepper("explicit_cuda")
         if substeps is not None:
             if int(substeps) != substeps or int(substeps) < 1:
                 raise ConfigError(f"substeps = {substeps!r} must be an integer >= 1 (or None: automatic)")

@@ -444,7 +444,7 @@ class ExplicitSolver:
         if not isinstance(rheology, MaxwellEB):
             raise ConfigError(f"the explicit stepper solves the Maxwell-EB rheology; got "
                               f"{type(rheology).__name__} (use solver 'evp' for viscous-plastic)")
-        rheology.require_stress_correction("explicit")
+        rheology.require_stepper("explicit")
         if substeps is not None:
             if int(substeps) != substeps or int(substeps) < 1:
                 raise ConfigError(f"substeps = {substeps!r} must be an integer >= 1 (or None: automatic)")

@@ -57,9 +57,7 @@ class ImplicitSolver:
         if not isinstance(rheology, MaxwellEB):
             raise ConfigError(f"the implicit stepper solves the Maxwell-EB rheology; got "
                               f"{type(rheology).__name__} (use solver 'evp' for viscous-plastic)")
-        rheology.require_no_max_pressure("the implicit solver")
-        rheology.require_whole_relaxation("the implicit solver")
-        rheology.require_no_dilatancy("the implicit solver")
+        rheology.require_stepper("implicit")
         if not tol > 0:
             raise ConfigError(f"tol = {tol!r} must be > 0")
         if int(max_iter) < 1:
