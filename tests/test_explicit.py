@@ -473,10 +473,13 @@ def test_explicit_stepper_refuses_the_associated_correction():
     with pytest.raises(ConfigError, match="relax_mean_stress = false: the CUDA explicit stepper"):
         MaxwellEB(relax_mean_stress=False).require_stepper("explicit_cuda")
     MaxwellEB(max_pressure_pa=10e3).require_stepper("explicit_cuda")  # implemented there
+    from lagice.solvers.prescribed import PrescribedStepper
+    mesh = generate_mesh(rectangle_domain(20e3, 20e3)[0], 10e3)
     for term in ({"max_pressure_pa": 10e3}, {"relax_mean_stress": False}, {"dilatancy_angle_deg": 20.0}):
         MaxwellEB(**term).require_stepper("explicit")
         with pytest.raises(ConfigError, match="the prescribed-velocity stepper .* does not implement it"):
-            MaxwellEB(**term).require_stepper("prescribed")
+            PrescribedStepper(MaxwellEB(**term), mesh=mesh, velocity=(0.1, 0.0))
+    assert PrescribedStepper(MaxwellEB(), mesh=mesh, velocity=(0.1, 0.0)).rheology is not None
 
 
 def test_elementwise_stability_bound(tmp_path):

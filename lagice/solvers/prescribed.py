@@ -25,7 +25,9 @@ class PrescribedStepper:
     """Kinematic stepper.
 
     Args:
-        rheology: ignored (accepted because :class:`~lagice.model.Model` passes one).
+        rheology: not used (accepted because :class:`~lagice.model.Model` passes one); a
+            Maxwell-EB rheology that asks for a non-origin stress correction or an optional
+            term is refused (:meth:`~lagice.rheology.MaxwellEB.require_stepper`).
         mesh: the mesh.
         velocity: callable ``f(t_s, x_m, y_m) -> (u, v)`` [m s-1] (or a ``(2, n)``
             array), or a constant pair.
@@ -51,6 +53,8 @@ class PrescribedStepper:
         if heal_rate is not None:
             raise ConfigError("solver 'prescribed' updates no damage: a healing law would be ignored "
                               "(set healing.law = 'none')")
+        if hasattr(rheology, "require_stepper"):  # Maxwell-EB: no correction path or term it would ignore
+            rheology.require_stepper("prescribed")
         self.rheology = rheology
         self.velocity = velocity
         self.bcs = list(bcs)
