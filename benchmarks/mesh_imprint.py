@@ -49,7 +49,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from validate import run_finished  # noqa: E402  (a run that reached its stop time)
+from validate import load_npz, run_finished  # noqa: E402  (load_npz: every array read once)
 
 ROTATIONS = (0.0, 15.0, 30.0)
 VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.mesh_algorithm=5"],
@@ -229,7 +229,7 @@ def run_compression(out: Path, n_across: int, variant: str, max_strain=1e-3, see
                                  overrides={k: _value(v) for k, v in overrides.items()})
         p.replace(path)
     res = analyse_compression(path)
-    z = np.load(path)
+    z = load_npz(path)
     res["tag"] = tag
     res["imprint"] = _compression_imprint(z, res)
     return res
@@ -262,7 +262,7 @@ def final_damage_faults(path: Path) -> dict:
     from lagice.diagnostics.faults import angle_to_axis_deg, fault_orientations
     from lagice.mesh.core import signed_areas
 
-    z = np.load(path)
+    z = load_npz(path)
     nodes, tri = z["nodes"], z["triangles"]
     xy = nodes[tri].mean(axis=1)
     area = np.abs(signed_areas(nodes, tri))
@@ -306,7 +306,7 @@ def figure_compression(out: Path, n_across: int, results: dict, path: Path):
 
     fig, ax = plt.subplots(3, len(results), figsize=(5.2 * len(results), 13.5), squeeze=False)
     for j, (v, r) in enumerate(results.items()):
-        z = np.load(out / f"compression_N{n_across}_{v}.npz")
+        z = load_npz(out / f"compression_N{n_across}_{v}.npz")
         s, dt, block = z["stress_pa"], float(z["dt_s"]), int(z["block_steps"])
         nodes, tri = z["nodes"] / 1e3, z["triangles"]
         b0, b1 = r["post_peak"]["blocks"]
@@ -343,7 +343,7 @@ def figure_final_damage(out: Path, runs: list, path: Path):
                            gridspec_kw={"height_ratios": [1, 2.2], "wspace": 0.5})
     for j, (n, key) in enumerate(runs):
         p = out / f"compression_N{n}_{key}.npz"
-        z = np.load(p)
+        z = load_npz(p)
         s, dt = z["stress_pa"], float(z["dt_s"])
         strain = (np.arange(s.size) + 1) * dt * float(z["push_speed_m_s"]) / float(z["length_m"])
         ax[0, j].plot(strain * 1e3, s / 1e3, lw=0.8)
