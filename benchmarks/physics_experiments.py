@@ -1067,6 +1067,19 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # envelope's friction stiffens the pack. Rate x0.39-0.41 (0.00095, 0.0011 per day), drift 21-26 km,
 # wind factor 0.0017, 0.0021, 57 and 79 remeshes; bands inside 0 (closed) and 2 (strait) against 2
 # and 3.
+# --- the internal friction, +-50 % (2026-11-27, nineteenth session; a sensitivity, not a choice) --
+# Three changes that leave broken ice with more pressure (theta, relax_mean_stress = false, the
+# dilatant flow) stiffened the pack, through the envelope's friction mu (0.7: Schulson's laboratory
+# value, as in Dansereau et al. 2016 and neXtSIM). mu is not in the sensitivity table (strength, air
+# drag, winds). Closed basin, from the shipped spin-up, as the X10h runs. mu = 0.35 / 1.05 also moves
+# the uniaxial compressive strength sigma_c = 2C/(sqrt(mu^2+1) - mu) by -27 % / +30 % at the same C.
+# Stated before the runs (2026-11-27, 20:30 UTC): mu - 50 % loosens the pack (rate x1.5-3, wind
+# factor up by at least 30 %), mu + 50 % stiffens it (rate x0.3-0.7), and beta stays within +-0.02
+# of the shipped month's 0.038 in both (a lead for beta only with +0.04 and no band lost, as before).
+EXPERIMENTS["X10h-fric-50"] = ("closed", from_spinup("H1125") + ["rheology.friction=0.35"], 10e3, 28,
+                               "internal friction -50 % (mu = 0.35), 10 km, thick-and-thin pack")
+EXPERIMENTS["X10h-fric+50"] = ("closed", from_spinup("H1125") + ["rheology.friction=1.05"], 10e3, 28,
+                               "internal friction +50 % (mu = 1.05), 10 km, thick-and-thin pack")
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
