@@ -1073,7 +1073,7 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # value, as in Dansereau et al. 2016 and neXtSIM). mu is not in the sensitivity table (strength, air
 # drag, winds). Closed basin, from the shipped spin-up, as the X10h runs. mu = 0.35 / 1.05 also moves
 # the uniaxial compressive strength sigma_c = 2C/(sqrt(mu^2+1) - mu) by -27 % / +30 % at the same C.
-# Stated before the runs (2026-11-27, 20:30 UTC): mu - 50 % loosens the pack (rate x1.5-3, wind
+# Stated before the runs (2026-11-27, 20:25 UTC): mu - 50 % loosens the pack (rate x1.5-3, wind
 # factor up by at least 30 %), mu + 50 % stiffens it (rate x0.3-0.7), and beta stays within +-0.02
 # of the shipped month's 0.038 in both (a lead for beta only with +0.04 and no band lost, as before).
 EXPERIMENTS["X10h-fric-50"] = ("closed", from_spinup("H1125") + ["rheology.friction=0.35"], 10e3, 28,
