@@ -612,6 +612,17 @@ def test_sheared_broken_ice_opens_with_dilatancy():
     assert ratio10 / ratio == pytest.approx(s10 / s20, rel=0.05)
     ratio0, v_top0, _ = run(None)
     assert abs(ratio0) < 0.01 and v_top > 100 * abs(v_top0)
+    # the parallel kernels (prange over elements, no races) give the serial ones' state bit for bit
+    states = []
+    for par in (False, True):
+        s = ExplicitSolver(MaxwellEB(healing_time_s=None, dilatancy_angle_deg=20.0), mesh, substeps=20,
+                           bcs=[VelocityBC("bottom", u=0.0, v=0.0), VelocityBC("top", u=u_top)], parallel=par)
+        st = IceState.uniform(mesh, cohesion_pa=1e12)
+        st.damage[:] = 0.99
+        for _ in range(5):
+            step(s, st, 60.0)
+        states.append(np.concatenate([st.velocity.ravel(), st.stress.ravel()]))
+    assert np.array_equal(states[0], states[1])
 
 
 def test_dilatancy_is_refused_where_it_is_not_implemented():
