@@ -118,7 +118,7 @@ class MaxwellEBParams:
             if not self.relax_mean_stress or self.max_pressure_pa:
                 raise ConfigError(f"rheology.dilatancy_angle_deg = {self.dilatancy_angle_deg!r} is implemented "
                                   f"with the whole stress relaxing and no compressive term only; it is set with "
-                                  f"relax_mean_stress = {self.relax_mean_stress!r}, max_pressure_pa = "
+                                  f"relax_mean_stress = {str(self.relax_mean_stress).lower()}, max_pressure_pa = "
                                   f"{self.max_pressure_pa!r}")
         if self.stress_correction not in STRESS_CORRECTIONS:
             raise ConfigError(f"rheology.stress_correction = {self.stress_correction!r}: expected one of "

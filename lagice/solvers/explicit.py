@@ -252,7 +252,7 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
             sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * gp
             syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * gp
             sxy = (sigma[e, 2] + ed * (kss * exy)) * gp
-            if dilat is not None:  # only with pmax None (the builder refuses both): gp == g here
+            if dilat is not None:  # only with pmax None (MaxwellEBParams refuses both), so gp == g here
                 pd = (1.0 - g) * dilat * math.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
                 sxx -= pd
                 syy -= pd
