@@ -1490,10 +1490,78 @@ def spinup(name="shipped", days=14):
     print(f"physics: wrote {save_spinup(out, target)}")
 
 
+#: every change tried on the shipped set-up in its validation month (wind seed 2026), closed and
+#: strait runs (None: not run), and the docs/physics.md §4 section that reports it. "own spin-up":
+#: the run starts from a spin-up made with the change, so the difference includes the spin-up.
+LEADS = (
+    ("the shipped set (reference)", "F10-hthick-1125", "F10s-hthick-1125", "A weather ensemble"),
+    ("EVP rheology (control)", "E10h", "E10hs", "A weather ensemble"),
+    ("compliance healing K = 50 (own spin-up)", "F10-hthick-K50", "F10s-hthick-K50",
+     "Compliance healing on the thick-and-thin pack"),
+    ("neXtSIM's compressive term P* = 10 kPa (own spin-up)", "F10-hthick-P", "F10s-hthick-P",
+     "neXtSIM's compressive term"),
+    ("white strength disorder ×4", "F10-hthick-dis3", "F10s-hthick-dis3", "A wider strength disorder"),
+    ("strength correlated over 50 km", "F10-hthick-cor50", "F10s-hthick-cor50", "Strength correlated over 50 km"),
+    ("C_lab halved", "X10h-str-50", "F10s-hthick-str50", "How freely the pack answers the wind"),
+    ("ocean turning angle 25° (own spin-up)", "F10-hthick-turn25sp", "F10s-hthick-turn25sp",
+     "neXtSIM's ocean turning angle"),
+    ("lead-closing thickness 0.25 m (own spin-up)", "F10-hthick-hnullsp", "F10s-hthick-hnullsp",
+     "How long leads stay open"),
+    ("C_lab halved + lead closing 0.25 m (own spin-up)", "F10-hthick-str50hnullsp", "F10s-hthick-str50hnullsp",
+     "How long leads stay open"),
+    ("a 56-day spin-up", "F10-hthick-long", "F10s-hthick-long", "A spin-up four times longer"),
+    ("ocean eddies 10 cm/s", "F10-hthick-1125-eddies", None, "How β was estimated (ocean eddies)"),
+    ("30–80 km thickness variability (own spin-up)", "F10-hthick-meso", None,
+     "How β was estimated (thickness variability)"),
+    ("damaged ice keeps its mean stress", "F10-hthick-1125-keepmean", "F10s-hthick-1125-keepmean",
+     "Where β is lost"),
+    ("… below neXtSIM's P_max", "F10-hthick-1125-keepmeanP", "F10s-hthick-1125-keepmeanP", "Where β is lost"),
+    ("seven more islands (own spin-up)", "F10-hthick-arch", "F10s-hthick-arch", "An archipelago"),
+    ("damage return towards the mean stress, θ = 1", "F10-hthick-1125-mean100", "F10s-hthick-1125-mean100",
+     "The dilatant return in the basin's stepper"),
+    ("damage return towards 2 × the mean stress, θ = 2", "F10-hthick-1125-mean200", "F10s-hthick-1125-mean200",
+     "The dilatant return in the basin's stepper"),
+    ("dilatant viscous flow, ψ = 20°", "F10-hthick-1125-dil20", "F10s-hthick-1125-dil20",
+     "Broken ice that dilates as it shears"),
+    ("internal friction μ −50 %", "X10h-fric-50", None, "The internal friction, ±50 %"),
+    ("internal friction μ +50 %", "X10h-fric+50", None, "The internal friction, ±50 %"),
+)
+
+
+def bands_inside(median: dict) -> int:
+    """How many of the six metrics of :data:`TARGETS` lie inside their observed bands."""
+    return sum(band_distance(k, median[k]) == 0.0 for k in TARGETS)
+
+
+def leads_table(records: dict, fits: dict, leads=LEADS) -> str:
+    """One row per change of :data:`LEADS` (the first row is the reference): β, the rate against
+    the reference's, the wind factor (drift_response.py) and the bands inside, closed / strait,
+    from the published records; a run not in ``records`` shows as "–"."""
+    ref_c, ref_s = (records.get(n) for n in leads[0][1:3])
+
+    def cell(name, ref, f):
+        r = records.get(name) if name else None
+        return "–" if r is None or ref is None else f(r, ref)
+
+    lines = ["| change (validation month) | β closed / strait | rate × the shipped set's | wind factor "
+             "| bands inside (of 6) | §4 section |", "|---|---|---|---|---|---|"]
+    for label, c, s_, section in leads:
+        beta = " / ".join(cell(n, ref, lambda r, _: f"{r['median']['beta_space']:.3f}")
+                          for n, ref in ((c, ref_c), (s_, ref_s)))
+        rate = " / ".join(cell(n, ref, lambda r, rf: "{:.2f}".format(
+            r["median"]["mean_total_deformation_rate_per_day"] / rf["median"]["mean_total_deformation_rate_per_day"]))
+            for n, ref in ((c, ref_c), (s_, ref_s)))
+        wind = " / ".join(f"{fits[n]['fit']['factor']:.4f}" if n in fits else "–" for n in (c, s_))
+        bands = " / ".join(cell(n, ref, lambda r, _: str(bands_inside(r["median"])))
+                           for n, ref in ((c, ref_c), (s_, ref_s)))
+        lines.append(f"| {label} | {beta} | {rate} | {wind} | {bands} | {section} |")
+    return "\n".join(lines)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("what", choices=("list", "run", "table", "spread", "spinup", "analyse", "figure", "screen",
-                                    "beta-by-rate"))
+                                    "beta-by-rate", "leads"))
     ap.add_argument("names", nargs="*")
     ap.add_argument("--force", action="store_true", help="run again even if the run finished")
     ap.add_argument("--jobs", type=int, default=1,
@@ -1532,6 +1600,10 @@ def main(argv=None):
         print(beta_by_rate_table(res))
         (ROOT / "docs" / "figures" / "beta_by_rate.json").write_text(json.dumps(res, indent=1) + "\n")
         print("physics: wrote docs/figures/beta_by_rate.json")
+    elif args.what == "leads":  # from the published records, so a fresh checkout gives the same
+        fits_path = ROOT / "docs" / "figures" / "drift_response.json"
+        print(leads_table(json.loads(PUBLISHED.read_text()),
+                          json.loads(fits_path.read_text()) if fits_path.exists() else {}))
     elif args.what == "screen":  # CANDIDATE_GROUP REFERENCE_GROUP
         if len(args.names) != 2:
             raise SystemExit("physics: screen needs two groups of ENSEMBLES: CANDIDATE REFERENCE")

@@ -455,3 +455,23 @@ def test_final_damage_faults_find_one_straight_band_and_the_analysis_reports_the
     assert analyse_compression(old)["damage_mode_angle_deg"] is None
     assert analyse_compression(new)["damage_mode_angle_deg"] == pytest.approx(
         damage_mode_fault_angle_deg(0.7, poisson_ratio=0.3))
+
+
+def test_leads_table_counts_bands_and_scales_rates_by_the_reference():
+    """``physics_experiments.py leads``: each change's rate is divided by the reference row's of
+    the same basin, bands are counted against the observed ranges, a run not recorded shows
+    "–", and every LEADS run is an experiment of the script (a typo would show "–" for ever)."""
+    import physics_experiments as pe
+
+    inside = {"beta_space": 0.18, "pdf_tail_exponent_shear": 2.0, "pdf_tail_exponent_divergence": 2.5,
+              "localisation_half_shear_area_fraction": 0.05, "shear_divergence_r2": 0.8,
+              "mean_total_deformation_rate_per_day": 0.02}
+    outside = {**inside, "beta_space": 0.04, "mean_total_deformation_rate_per_day": 0.002}
+    assert pe.bands_inside(inside) == 6 and pe.bands_inside(outside) == 4
+    records = {"ref": {"median": outside}, "refs": {"median": inside}, "new": {"median": inside}}
+    fits = {"new": {"fit": {"factor": 0.0071}}}
+    leads = (("reference", "ref", "refs", "S"), ("a change", "new", "missing", "T"))
+    row = pe.leads_table(records, fits, leads).splitlines()[3]
+    assert row == "| a change | 0.180 / – | 10.00 / – | 0.0071 / – | 6 / – | T |"
+    for _, c, s, _ in pe.LEADS:
+        assert c in pe.EXPERIMENTS and (s is None or s in pe.EXPERIMENTS)
