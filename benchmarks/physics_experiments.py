@@ -1080,6 +1080,9 @@ EXPERIMENTS["X10h-fric-50"] = ("closed", from_spinup("H1125") + ["rheology.frict
                                "internal friction -50 % (mu = 0.35), 10 km, thick-and-thin pack")
 EXPERIMENTS["X10h-fric+50"] = ("closed", from_spinup("H1125") + ["rheology.friction=1.05"], 10e3, 28,
                                "internal friction +50 % (mu = 1.05), 10 km, thick-and-thin pack")
+# Result (2026-11-27, nineteenth session): the rate predictions failed. mu = 0.35: rate x1.27
+# (0.0031 per day), wind factor 0.0052 (x1.53), beta 0.048, 4 bands inside; mu = 1.05: rate x1.15
+# (0.0028), wind factor 0.0036, beta 0.046, 2 bands. The pack hardly feels mu.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
