@@ -933,7 +933,7 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # (halved), beta 0.052 -> 0.059; strait: rate 0.0085 -> 0.0028, ratio -0.48 -> -0.50, beta 0.068 ->
 # 0.070; both lose bands (tails 3.5-4.3, R2 0.19-0.21). The pack's compressive mean stress climbs
 # from a median of 4-7 kPa to 55-90 kPa (90th percentile 150-180 kPa): the whole wind load is carried
-# elastically against the coast, the friction of the envelope (mu = 0.7) makes the pressed ice
+# elastically against the coast, the friction of the envelope (mu = 0.98) makes the pressed ice
 # strong in shear, the damaged fraction (d > 0.9) falls from about 0.5 to 0.02-0.14, and the pack
 # heals shut. What lets a Maxwell-EB pack move is that its damaged ice sheds its pressure.
 #
@@ -1067,22 +1067,28 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # envelope's friction stiffens the pack. Rate x0.39-0.41 (0.00095, 0.0011 per day), drift 21-26 km,
 # wind factor 0.0017, 0.0021, 57 and 79 remeshes; bands inside 0 (closed) and 2 (strait) against 2
 # and 3.
-# --- the internal friction, +-50 % (2026-11-27, nineteenth session; a sensitivity, not a choice) --
+# --- the internal friction (2026-11-27, nineteenth session; a sensitivity, not a choice) ---------
 # Three changes that leave broken ice with more pressure (theta, relax_mean_stress = false, the
 # dilatant flow) stiffened the pack, through the envelope's friction mu (0.7: Schulson's laboratory
-# value, as in Dansereau et al. 2016 and neXtSIM). mu is not in the sensitivity table (strength, air
-# drag, winds). Closed basin, from the shipped spin-up, as the X10h runs. mu = 0.35 / 1.05 also moves
-# the uniaxial compressive strength sigma_c = 2C/(sqrt(mu^2+1) - mu) by -27 % / +30 % at the same C.
+# value, as in Dansereau et al. 2016 and neXtSIM; see the CORRECTION below: the flagship's is
+# 0.98). mu is not in the sensitivity table (strength, air drag, winds). Closed basin, from the
+# shipped spin-up, as the X10h runs. mu = 0.35 / 1.05 also moves the uniaxial compressive strength
+# sigma_c = 2C/(sqrt(mu^2+1) - mu) by -27 % / +30 % at the same C.
 # Stated before the runs (2026-11-27, 20:25 UTC): mu - 50 % loosens the pack (rate x1.5-3, wind
 # factor up by at least 30 %), mu + 50 % stiffens it (rate x0.3-0.7), and beta stays within +-0.02
 # of the shipped month's 0.038 in both (a lead for beta only with +0.04 and no band lost, as before).
-EXPERIMENTS["X10h-fric-50"] = ("closed", from_spinup("H1125") + ["rheology.friction=0.35"], 10e3, 28,
-                               "internal friction -50 % (mu = 0.35), 10 km, thick-and-thin pack")
-EXPERIMENTS["X10h-fric+50"] = ("closed", from_spinup("H1125") + ["rheology.friction=1.05"], 10e3, 28,
-                               "internal friction +50 % (mu = 1.05), 10 km, thick-and-thin pack")
-# Result (2026-11-27, nineteenth session): the rate predictions failed. mu = 0.35: rate x1.27
-# (0.0031 per day), wind factor 0.0052 (x1.53), beta 0.048, 4 bands inside; mu = 1.05: rate x1.15
-# (0.0028), wind factor 0.0036, beta 0.046, 2 bands. The pack hardly feels mu.
+# CORRECTION (after the runs, 20:55 UTC): the flagship's mu is 0.98, not 0.7 (winter_basin_pack.toml:
+# neXtSIM's tan(phi) = 0.7 converted to lagice's criterion, docs/physics.md section 2), so the runs are
+# mu -64 % (0.35) and +7 % (1.05), and the sigma_c moves above are -41 % and +5 %. The runs were first
+# named X10h-fric-50 / X10h-fric+50 and renamed (records and output folders) so the names do not
+# claim +-50 %.
+EXPERIMENTS["X10h-mu035"] = ("closed", from_spinup("H1125") + ["rheology.friction=0.35"], 10e3, 28,
+                             "internal friction mu = 0.35 (the flagship's 0.98 -64 %), 10 km, thick-and-thin pack")
+EXPERIMENTS["X10h-mu105"] = ("closed", from_spinup("H1125") + ["rheology.friction=1.05"], 10e3, 28,
+                             "internal friction mu = 1.05 (the flagship's 0.98 +7 %), 10 km, thick-and-thin pack")
+# Result (2026-11-27, nineteenth session): mu = 0.35: rate x1.27 (0.0031 per day), wind factor 0.0052
+# (x1.53), beta 0.048, 4 bands inside; mu = 1.05: rate x1.15 (0.0028), wind factor 0.0036, beta 0.046,
+# 2 bands (a change of 7 %: about the spread between disorder draws). The pack hardly feels mu.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
@@ -1526,8 +1532,8 @@ LEADS = (
      "The dilatant return in the basin's stepper"),
     ("dilatant viscous flow, ψ = 20°", "F10-hthick-1125-dil20", "F10s-hthick-1125-dil20",
      "Broken ice that dilates as it shears"),
-    ("internal friction μ −50 %", "X10h-fric-50", None, "The internal friction, ±50 %"),
-    ("internal friction μ +50 %", "X10h-fric+50", None, "The internal friction, ±50 %"),
+    ("internal friction μ = 0.35 (−64 %)", "X10h-mu035", None, "The internal friction"),
+    ("internal friction μ = 1.05 (+7 %)", "X10h-mu105", None, "The internal friction"),
 )
 
 
