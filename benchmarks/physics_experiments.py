@@ -1089,6 +1089,13 @@ EXPERIMENTS["X10h-mu105"] = ("closed", from_spinup("H1125") + ["rheology.frictio
 # Result (2026-11-27, nineteenth session): mu = 0.35: rate x1.27 (0.0031 per day), wind factor 0.0052
 # (x1.53), beta 0.048, 4 bands inside; mu = 1.05: rate x1.15 (0.0028), wind factor 0.0036, beta 0.046,
 # 2 bands (a change of 7 %: about the spread between disorder draws). The pack hardly feels mu.
+# Then the true +-50 % about the flagship's mu = 0.98: 0.49 and 1.47. Stated before the runs
+# (2026-11-27, 20:47 UTC): mu = 0.49 gives a rate x1.05-1.3 (between the shipped month and mu =
+# 0.35's x1.27), mu = 1.47 a rate x0.7-1.0, and beta stays within +-0.02 of 0.038 in both.
+EXPERIMENTS["X10h-mu049"] = ("closed", from_spinup("H1125") + ["rheology.friction=0.49"], 10e3, 28,
+                             "internal friction mu = 0.49 (the flagship's 0.98 -50 %), 10 km, thick-and-thin pack")
+EXPERIMENTS["X10h-mu147"] = ("closed", from_spinup("H1125") + ["rheology.friction=1.47"], 10e3, 28,
+                             "internal friction mu = 1.47 (the flagship's 0.98 +50 %), 10 km, thick-and-thin pack")
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
@@ -1534,6 +1541,8 @@ LEADS = (
      "Broken ice that dilates as it shears"),
     ("internal friction μ = 0.35 (−64 %)", "X10h-mu035", None, "The internal friction"),
     ("internal friction μ = 1.05 (+7 %)", "X10h-mu105", None, "The internal friction"),
+    ("internal friction μ = 0.49 (−50 %)", "X10h-mu049", None, "The internal friction"),
+    ("internal friction μ = 1.47 (+50 %)", "X10h-mu147", None, "The internal friction"),
 )
 
 
