@@ -1050,6 +1050,8 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # closing as a whole (net-divergence ratio -0.71, -0.73) with the divergence part's beta near 0.
 # psi = 20 deg is a strong value chosen to learn whether the mechanism can matter (Bolton's rule
 # psi ~ phi - phi_cv would give about 5 deg for tan(phi) = 0.7); it has no sea-ice source.
+# (Corrected after the runs: the flagship's mu is 0.98, phi = 44 deg, so Bolton's rule with
+# phi_cv ~ 30 deg gives about 14 deg; 20 deg is on the strong side of it.)
 # Stated before the runs (2026-11-27, 19:55 UTC): a lead for beta if beta rises by 0.04 or more over
 # the shipped month's (0.038 closed, 0.030 strait) in both basins with no band of the six lost (2
 # and 3 inside). The mechanism acts if the interior's net-divergence ratio (beta_components.py)
