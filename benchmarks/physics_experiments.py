@@ -1560,24 +1560,22 @@ def leads_table(records: dict, fits: dict, leads=LEADS) -> str:
     """One row per change of :data:`LEADS` (the first row is the reference): β, the rate against
     the reference's, the wind factor (drift_response.py) and the bands inside, closed / strait,
     from the published records; a run not in ``records`` shows as "–"."""
-    ref_c, ref_s = (records.get(n) for n in leads[0][1:3])
+    refs = [records.get(n) for n in leads[0][1:3]]
+    rate = "mean_total_deformation_rate_per_day"
 
-    def cell(name, ref, f):
-        r = records.get(name) if name else None
-        return "–" if r is None or ref is None else f(r, ref)
+    def both(names, f):
+        """f(record, reference record) for the closed and the strait run, "–" where either is missing."""
+        return " / ".join("–" if r is None or ref is None else f(r["median"], ref["median"])
+                          for r, ref in zip((records.get(n) if n else None for n in names), refs))
 
     lines = ["| change (validation month) | β closed / strait | rate × the shipped set's | wind factor "
              "| bands inside (of 6) | §4 section |", "|---|---|---|---|---|---|"]
     for label, c, s_, section in leads:
-        beta = " / ".join(cell(n, ref, lambda r, _: f"{r['median']['beta_space']:.3f}")
-                          for n, ref in ((c, ref_c), (s_, ref_s)))
-        rate = " / ".join(cell(n, ref, lambda r, rf: "{:.2f}".format(
-            r["median"]["mean_total_deformation_rate_per_day"] / rf["median"]["mean_total_deformation_rate_per_day"]))
-            for n, ref in ((c, ref_c), (s_, ref_s)))
+        beta = both((c, s_), lambda m, _: f"{m['beta_space']:.3f}")
+        ratio = both((c, s_), lambda m, mr: f"{m[rate] / mr[rate]:.2f}")
         wind = " / ".join(f"{fits[n]['fit']['factor']:.4f}" if n in fits else "–" for n in (c, s_))
-        bands = " / ".join(cell(n, ref, lambda r, _: str(bands_inside(r["median"])))
-                           for n, ref in ((c, ref_c), (s_, ref_s)))
-        lines.append(f"| {label} | {beta} | {rate} | {wind} | {bands} | {section} |")
+        bands = both((c, s_), lambda m, _: str(bands_inside(m)))
+        lines.append(f"| {label} | {beta} | {ratio} | {wind} | {bands} | {section} |")
     return "\n".join(lines)
 
 
