@@ -1102,6 +1102,25 @@ EXPERIMENTS["X10h-mu147"] = ("closed", from_spinup("H1125") + ["rheology.frictio
 # too), beta 0.048, 3 bands. All four friction runs deform 15-29 % faster than the shipped month, as
 # the three other disorder draws of that month do (x1.14-1.24): one month does not resolve mu.
 
+# --- 2026-11-27 (twentieth session): new ice is undamaged (a diagnostic) ------------------------
+# thermo.new_ice_undamaged (new, off by default): where new ice raises the concentration from A to
+# A', d <- d A/A' (the damaged area d A is unchanged), as neXtSIM-DG's DamageHealing does
+# (ConstantHealing::updateElement, "newly formed ice is undamaged"); lagice's new ice took the
+# element's damage. Why: the spun-up pack is mostly broken (median damage 0.89; 79 % of its
+# elements relax stress in under a day, lambda0 ((1-d) e^(-20(1-A)))^3 < 1 day), and its deformation
+# closes as a whole instead of localising. Refrozen leads are the youngest, least cracked ice.
+# From the shipped spin-up (made without it), so only the month's own refreezing acts.
+# Stated before the runs (2026-11-27, 21:47 UTC): a lead for beta if beta rises by 0.04 or more in
+# both basins with no band of six lost (as for every lead). Predicted: the dilution acts only where
+# leads refreeze (the faults that opened), so the faults heal sooner after each storm: the pack's
+# mean damage at day 28 falls by 0.01-0.05, the rate moves by x0.8-1.05, and beta stays within
+# +-0.015 of the shipped month's (0.038 closed, 0.030 strait).
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    EXPERIMENTS[f"{_p}-hthick-1125-newice"] = (
+        _basin, from_spinup("H1125") + ["thermo.new_ice_undamaged=true"], 10e3, 28,
+        f"{_p}-hthick-1125 with undamaged new ice (neXtSIM-DG's lateral-growth healing; diagnostic)")
+
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]

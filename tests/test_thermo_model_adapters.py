@@ -51,6 +51,46 @@ def test_thermo_component_steps_and_books_into_the_ledger():
     assert again.totals_m3 == comp.totals_m3
 
 
+def test_new_ice_is_undamaged_and_keeps_the_damaged_ice_area():
+    """thermo.new_ice_undamaged (neXtSIM-DG's lateral-growth healing): where new ice raises the
+    concentration from A to A', d becomes d A/A', so the damaged area sum(d A a) is unchanged by a
+    cold step, while the default leaves d and lets the damaged area grow with A. Elements whose
+    concentration did not grow keep their damage bit for bit; the report and the running total
+    add up the damage removed, and a checkpoint carries the total."""
+    cold = lambda t, x, y: np.full(x.size, -30.0)  # noqa: E731
+    runs = {}
+    for flag in (False, True):
+        st = state()
+        st.concentration[:5] = 0.0  # open water: its new ice must be undamaged
+        st.thickness[:5] = 0.0
+        st.concentration[5:10] = 1.0  # full: nothing grows, the damage stays
+        area = np.abs(st.mesh.areas())
+        comp = ThermoComponent(cold, new_ice_undamaged=flag)
+        d0, a0 = st.damage.copy(), st.concentration.copy()
+        rep = comp.step(st, 0.0, 6 * 3600.0)
+        grew = st.concentration > a0
+        assert grew.sum() > 0.5 * st.mesh.n_elements  # most elements have open water that freezes
+        runs[flag] = (st, d0, a0, grew, area, rep, comp)
+    st, d0, a0, grew, area, rep, comp = runs[True]
+    assert np.sum(st.damage * st.concentration * area) == pytest.approx(np.sum(d0 * a0 * area), rel=1e-12)
+    np.testing.assert_allclose(st.damage[grew], d0[grew] * a0[grew] / st.concentration[grew], rtol=1e-15)
+    assert np.all(st.damage[:5] == 0.0) and np.all(st.concentration[:5] > 0.0)
+    assert np.array_equal(st.damage[~grew], d0[~grew]) and np.array_equal(st.damage[5:10], d0[5:10])
+    removed = np.sum((d0 - st.damage) * area)
+    assert removed > 0 and rep["damage_diluted_by_new_ice_m2"] == pytest.approx(removed, rel=1e-12)
+    assert comp.damage_diluted_m2 == rep["damage_diluted_by_new_ice_m2"]
+    again = ThermoComponent(cold, new_ice_undamaged=True)
+    again.restore(*comp.checkpoint_state())
+    assert again.damage_diluted_m2 == comp.damage_diluted_m2
+    off, d0_off, a0_off, _, area_off, rep_off, _ = runs[False]
+    assert np.array_equal(off.damage, d0_off) and "damage_diluted_by_new_ice_m2" not in rep_off
+    assert np.sum(off.damage * off.concentration * area_off) > 1.01 * np.sum(d0_off * a0_off * area_off)
+    # the two runs differ only in the damage
+    assert np.array_equal(off.concentration, st.concentration) and np.array_equal(off.thickness, st.thickness)
+    with pytest.raises(ConfigError, match="new_ice_undamaged"):
+        ThermoComponent(cold, new_ice_undamaged=1)
+
+
 def test_healing_component():
     st = state()
     st.damage[0] = 0.999999

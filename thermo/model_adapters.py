@@ -97,22 +97,39 @@ class ThermoComponent:
     ----------
     air_temperature : scalar field [°C] (a Field, callable ``f(t, x, y)`` or number)
     zero_layer : ZeroLayerThermo, optional (default parameters)
+    new_ice_undamaged : bool, default False
+        Ice formed in open water is undamaged (scene key ``thermo.new_ice_undamaged``).
+        Where the concentration grows from A to A' > A in a step, the element's damage
+        becomes the area-weighted mean of the old ice's damage and the new ice's 0,
+        d ← d A/A', so the damaged ice area d·A is unchanged by the growth. This is
+        neXtSIM-DG's lateral-growth healing (``ConstantHealing::updateElement`` in
+        ``physics/src/modules/DamageHealingModule``, which adds its constant healing after
+        it); neXtSIM before it left new ice in a young-ice category out of the rheology's
+        concentration instead. Off by default: lagice's new ice took the damage of the
+        element until 2026-11-27. Elements that reach the concentration floor and vanish
+        keep their damage (they have no ice for the rheology).
 
     The running breakdown of the volume change (congelation growth/melt, new
     ice in open water, ice removed below the thickness floor, snow removed) is
     kept in :attr:`totals_m3` [m³] and carried in checkpoints; the net change is
-    booked in the model's ledger as ``thermo``.
+    booked in the model's ledger as ``thermo``. With ``new_ice_undamaged``, the
+    damage that new ice removed (Σ Δd · area [m²] of fully damaged ice equivalent) is
+    added up in :attr:`damage_diluted_m2` and reported per step.
     """
 
     name = "thermodynamics"
     TOTALS = ("congelation", "new_ice", "floor_removed", "snow_removed")
 
-    def __init__(self, air_temperature, zero_layer=None):
+    def __init__(self, air_temperature, zero_layer=None, new_ice_undamaged=False):
         self.air_temperature = as_field(air_temperature, SCALAR, "degC")
         if self.air_temperature is None:
             raise ConfigError("ThermoComponent needs an air temperature field")
+        if not isinstance(new_ice_undamaged, bool):
+            raise ConfigError(f"thermo.new_ice_undamaged = {new_ice_undamaged!r}: expected true or false")
         self.zero_layer = zero_layer if zero_layer is not None else ZeroLayerThermo()
+        self.new_ice_undamaged = new_ice_undamaged
         self.totals_m3 = dict.fromkeys(self.TOTALS, 0.0)
+        self.damage_diluted_m2 = 0.0
         self._air = air_at_centroids(self.air_temperature)
 
     def step(self, state, t_s, dt_s, ledger=None):
@@ -122,12 +139,18 @@ class ThermoComponent:
         mesh = state.mesh
         area = np.abs(mesh.areas())
         ta = self._air.values(mesh, t_s)
+        a_old = state.concentration.copy() if self.new_ice_undamaged else None
         tend = self.zero_layer.step(state.thickness, state.concentration, ta, dt_s, hs=state.snow)
         dv = float(np.sum(tend.total * area))
         if ledger is not None:
             ledger.book("thermo", dv)
         rep = {"thermo_volume_change_m3": dv,
                "air_temperature_mean_c": float(np.mean(ta)) if ta.size else float("nan")}
+        if self.new_ice_undamaged:
+            removed = dilute_damage(state.damage, a_old, state.concentration)
+            diluted = float(np.sum(removed * area))
+            self.damage_diluted_m2 += diluted
+            rep["damage_diluted_by_new_ice_m2"] = diluted
         for k in self.TOTALS:
             v = float(np.sum(getattr(tend, k) * area))
             self.totals_m3[k] += v
@@ -140,10 +163,26 @@ class ThermoComponent:
         return self.step(model.state, model.clock.time_s + dt_s, dt_s, model.ledger)
 
     def checkpoint_state(self):
-        return {}, {"totals_m3": dict(self.totals_m3)}
+        meta = {"totals_m3": dict(self.totals_m3)}
+        if self.new_ice_undamaged:
+            meta["damage_diluted_m2"] = self.damage_diluted_m2
+        return {}, meta
 
     def restore(self, arrays, meta):
         self.totals_m3.update(meta.get("totals_m3", {}))
+        self.damage_diluted_m2 = float(meta.get("damage_diluted_m2", 0.0))
+
+
+def dilute_damage(damage, a_old, a_new):
+    """Undamaged new ice (:class:`ThermoComponent`, ``new_ice_undamaged``): where the
+    concentration grew (a_new > a_old), d ← d a_old/a_new in place, so d·A is unchanged.
+    Returns the decrease of each element's damage (≥ 0; 0 where A did not grow)."""
+    grew = a_new > a_old
+    old = damage[grew]
+    damage[grew] = old * (a_old[grew] / a_new[grew])
+    removed = np.zeros_like(damage)
+    removed[grew] = old - damage[grew]
+    return removed
 
 
 class HealingComponent(RateComponent):

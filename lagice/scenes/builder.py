@@ -298,6 +298,9 @@ def validate_config(cfg: dict) -> None:
                           f"has no damage to heal; set healing.law = 'none'")
     if sv["name"] == "prescribed" and cfg["healing"]["law"] != "none":
         raise ConfigError("solver 'prescribed' updates no damage: set healing.law = 'none'")
+    if cfg["thermo"]["new_ice_undamaged"] and rheo.name != "maxwell_eb":
+        raise ConfigError(f"thermo.new_ice_undamaged = true: rheology.law = {cfg['rheology']['law']!r} has no "
+                          f"damage for new ice to dilute; leave it false")
     solver_options(cfg)
     parse_schedule(cfg["output"]["every"], "output.every")
     checkpoint_schedule(cfg)

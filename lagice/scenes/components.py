@@ -250,6 +250,9 @@ def validate(cfg: dict, duration_s: float) -> None:
         checks.check_dataclass_params("forcing.drag", DragParams, fc["drag"])
     if cfg["thermo"]["params"] and not cfg["thermo"]["enabled"]:
         raise ConfigError("thermo.params is set but thermo.enabled = false: the parameters would not be used")
+    if cfg["thermo"]["new_ice_undamaged"] and not cfg["thermo"]["enabled"]:
+        raise ConfigError("thermo.new_ice_undamaged = true but thermo.enabled = false: without thermodynamics no "
+                          "new ice forms, so the setting would not be used")
     if cfg["thermo"]["enabled"]:
         from thermo.zero_layer import ThermoParams
 
@@ -603,7 +606,8 @@ def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
         from thermo.model_adapters import ThermoComponent
         from thermo.zero_layer import ThermoParams, ZeroLayerThermo
 
-        parts["thermo"] = ThermoComponent(air, ZeroLayerThermo(ThermoParams(**cfg["thermo"]["params"])))
+        parts["thermo"] = ThermoComponent(air, ZeroLayerThermo(ThermoParams(**cfg["thermo"]["params"])),
+                                          new_ice_undamaged=cfg["thermo"]["new_ice_undamaged"])
     if law in ("thermodynamic", "fdd"):
         from thermo.healing import FreezingDegreeDayHealing, ThermodynamicHealing
         from thermo.model_adapters import HealingComponent

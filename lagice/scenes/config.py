@@ -89,7 +89,9 @@ SCHEMA = {
         "wind": (dict, None), "ocean": (dict, None), "air_temperature": (dict, None),
         "coriolis": (dict, None), "drag": (dict, None),
     },
-    "thermo": {"enabled": (bool, False), "params": (dict, {})},
+    # new_ice_undamaged: ice formed in open water is undamaged, so lateral growth dilutes the
+    # element's damage, d <- d A_old/A_new (neXtSIM-DG's DamageHealing; thermo.model_adapters)
+    "thermo": {"enabled": (bool, False), "params": (dict, {}), "new_ice_undamaged": (bool, False)},
     "healing": {"law": (str, "constant"), "params": (dict, {})},
     "lagrangian": {"enabled": (bool, False), "min_area_ratio": (NUM, 0.05), "max_halvings": (int, 8)},
     "remesh": {"enabled": (bool, False), "min_angle_deg": (NUM, 10.0), "params": (dict, {})},
@@ -148,6 +150,7 @@ LEGACY_VALUES = {
     "rheology.max_pressure_thickness_exponent": (1.5,),
     "rheology.relax_mean_stress": (True,),            # 2026-11-27: the whole stress relaxes
     "rheology.dilatancy_angle_deg": (None, 0, 0.0),   # 2026-11-27: the viscous flow does not dilate
+    "thermo.new_ice_undamaged": (False,),            # 2026-11-27: new ice takes the element's damage
     "initial.state_file": (None, ""),                # 2026-11-24: no spin-up state
     "solver.substep_limit": (None, "mesh"),          # 2026-11-25: the whole-mesh limit
 }
