@@ -294,7 +294,23 @@ def scene_runs(tmp):
         sim.run()
         res = scene_arrays(Path(tmp) / f"{a}_to_{b}", 4)
         out[f"resume_{a}_to_{b}"] = {k: rel_diff(ref[k], v) for k, v in res.items() if v.dtype.kind == "f"}
+    # host code that edits the damage between steps (undamaged new ice, thermo.new_ice_undamaged) on a
+    # stepper that keeps the damage on the device (sync="explicit"): it must download it first
+    ni = {}
+    for dev in ("cpu", "cuda"):
+        sim = build_simulation(load_scene("wind_square", {**SCENE_OV, **NEW_ICE_OV, "solver.device": dev}),
+                               Path(tmp) / f"newice_{dev}")
+        sim.run()
+        ni[dev] = sim.model.state
+        out[f"newice_diluted_m2_{dev}"] = sim.model.component("thermodynamics").damage_diluted_m2
+    out["newice_cuda_vs_cpu"] = {k: rel_diff(getattr(ni["cpu"], k), getattr(ni["cuda"], k))
+                                 for k in ("velocity", "stress", "damage", "thickness", "concentration")}
     return out
+
+
+#: the scene with thermodynamics (air at -20 to -30 degC in January), 20 % open water, undamaged new ice
+NEW_ICE_OV = {"thermo.enabled": True, "thermo.new_ice_undamaged": True, "forcing.air_temperature.kind": "synthetic",
+              "run.start_date": "2026-01-15 00:00:00", "initial.concentration": 0.8}
 
 
 # -- rigid motion: the transport velocity moves nodes and drifters (tests/test_engine.py) ----

@@ -159,8 +159,10 @@ class ThermoComponent:
 
     def advance(self, model, dt_s):
         """Component protocol: the step ends at ``model.clock.time_s + dt_s``; the air
-        temperature is taken there (as the stepper's forcing)."""
-        return self.step(model.state, model.clock.time_s + dt_s, dt_s, model.ledger)
+        temperature is taken there (as the stepper's forcing). With ``new_ice_undamaged`` it
+        edits the damage, so a device stepper first brings it to the host (free on the CPU)."""
+        state = model.needs_host_state(("damage",)) if self.new_ice_undamaged else model.state
+        return self.step(state, model.clock.time_s + dt_s, dt_s, model.ledger)
 
     def checkpoint_state(self):
         meta = {"totals_m3": dict(self.totals_m3)}
