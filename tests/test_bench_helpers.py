@@ -475,3 +475,44 @@ def test_leads_table_counts_bands_and_scales_rates_by_the_reference():
     assert row == "| a change | 0.180 / – | 10.00 / – | 0.0071 / – | 6 / – | T |"
     for _, c, s, _ in pe.LEADS:
         assert c in pe.EXPERIMENTS and (s is None or s in pe.EXPERIMENTS)
+
+
+def test_envelope_branch_classes_are_the_branches_dcrit_scales_onto():
+    """benchmarks/envelope_branches.py classes a stress by the branch of Maxwell-EB's envelope
+    that the correction towards the origin meets: the tensile cut-off exactly where the minor
+    principal stress is tensile (s2 >= 0). Checked against the model's own d_crit on random
+    stresses outside the envelope: the corrected stress sits on s1 = sigma_T exactly for the
+    class 'cutoff', and on the Coulomb line for the two others, split by the mean stress's sign.
+    The class does not change when the stress is scaled (relaxation), so the end-of-step stress
+    keeps the class of the step's last event."""
+    from envelope_branches import CLASSES, classify, window_sums
+
+    from lagice.rheology.maxwell_eb import dcrit
+
+    rng = np.random.default_rng(3)
+    C, mu = 1.0e4, 0.98
+    s = np.sqrt(mu * mu + 1.0)
+    q, sigma_c = (s + mu) ** 2, 2.0 * C / (s - mu)
+    sigma_t = sigma_c / q
+    sig = rng.normal(0.0, 2.0e5, (4000, 3))
+    dc = dcrit(sig, C, mu)
+    out = dc < 1.0
+    assert out.mean() > 0.9
+    fixed = sig[out] * dc[out, None]
+    m = 0.5 * (fixed[:, 0] + fixed[:, 1])
+    r = np.sqrt(0.25 * (fixed[:, 0] - fixed[:, 1]) ** 2 + fixed[:, 2] ** 2)
+    s1, s2 = m + r, m - r
+    on_cutoff = np.isclose(s1, sigma_t, rtol=1e-9, atol=0.0)
+    on_coulomb = np.isclose(q * s1 - s2, sigma_c, rtol=1e-9, atol=0.0)
+    cls = classify(sig[out])
+    assert set(np.unique(cls)) == {0, 1, 2}  # all three classes occur
+    assert np.array_equal(cls == 0, on_cutoff)
+    assert np.all(on_coulomb[cls > 0])
+    assert np.array_equal(cls == 2, (m < 0.0) & (cls > 0))
+    assert np.array_equal(classify(0.3 * sig), classify(sig))
+    steps = [{"day": d, "area_m2": [1.0, 2.0, 3.0], "gain_m2": [0.0, 1.0, 3.0], "compressed_fraction": 0.5}
+             for d in (0.5, 1.0, 2.9, 3.1)]
+    w = window_sums(steps, 2)
+    assert [x["steps"] for x in w] == [3, 1]
+    assert w[0]["event_area_fraction"] == dict(zip(CLASSES, [round(1 / 6, 4), round(2 / 6, 4), 0.5]))
+    assert w[0]["damage_gain_fraction"]["coulomb_compression"] == 0.75 and w[0]["damage_gain_m2"] == 12.0

@@ -1,0 +1,170 @@
+"""Which branch of the failure envelope the flagship's damage meets (issue 12, a diagnostic).
+
+Three changes that leave broken ice with more pressure stiffened the flagship's pack
+(docs/physics.md §4), and the question left open was where the pack fails: in tension,
+or in shear under compression, where the envelope's friction makes pressed ice strong.
+Maxwell-EB's envelope (Dansereau et al. 2016, lagice's tension-positive form) has two
+branches: the tensile cut-off s1 = σT and the Coulomb line q s1 − s2 = σc. Scaled
+towards the origin from outside, a stress meets the cut-off exactly when its minor
+principal stress is tensile, s2 ≥ 0 (σT/s1 ≤ σc/(q s1 − s2) ⟺ s2 ≥ 0), and the Coulomb
+line otherwise. This script splits the Coulomb events by the sign of the mean stress
+m = (s1 + s2)/2:
+
+* ``cutoff``: s2 ≥ 0 (both principal stresses tensile; opening in tension),
+* ``coulomb_tension``: m ≥ 0 > s2 (shear with a tensile mean stress),
+* ``coulomb_compression``: m < 0 (shear under pressure).
+
+It runs the scene through the scene builder and ``Simulation`` (the same run as
+``physics_experiments.py run F10-hthick-1125`` / ``F10s-hthick-1125``: the shipped
+spin-up, which equals ``spinup-H1125.npz`` bit for bit) with a callback after every
+step. An element "damages" in a step when its damage rose over the step (the solver's
+damage events minus healing, net), and it is classed by its stress at the end of the
+step: the correction scales the stress towards the origin, and the relaxation that
+follows scales it again, which keeps the signs of s1, s2 and m, so the class of the
+last event of the step is read from the end-of-step stress unless the elastic
+increments of later sub-steps changed a sign (an approximation, stated with the
+result). Steps with a remesh (new elements) are skipped and counted. Area-weighted sums
+over the interior (≥ 100 km from the coast, the validation's buffer) go into 3-day
+windows.
+
+Stated before the month's runs (2026-11-27, 22:18 UTC; a one-day test run had given 0.18 /
+0.33 / 0.49 of the damage gain): over the month, most of the interior's damage gain comes
+under a compressive mean stress (more than half in both basins), and the cut-off carries less
+than a fifth.
+
+    python benchmarks/envelope_branches.py closed strait --jobs 2   # both basins, 28 days
+    python benchmarks/envelope_branches.py --table                   # the stored result
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "benchmarks" / "out" / "physics"
+PUBLISHED = ROOT / "docs" / "figures" / "envelope_branches.json"
+SCENES = {"closed": "winter_basin_pack", "strait": "winter_basin_pack_strait"}
+CLASSES = ("cutoff", "coulomb_tension", "coulomb_compression")
+DAY = 86400.0
+BUFFER_M = 100e3
+WINDOW_DAYS = 3
+
+
+def classify(stress: np.ndarray) -> np.ndarray:
+    """(m,) class index into :data:`CLASSES` of (m, 3) stresses [Pa]: 0 where the minor
+    principal stress s2 ≥ 0, 1 where the mean m ≥ 0 > s2, 2 where m < 0."""
+    sxx, syy, sxy = stress[:, 0], stress[:, 1], stress[:, 2]
+    m = 0.5 * (sxx + syy)
+    r = np.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
+    s2 = m - r
+    return np.where(s2 >= 0.0, 0, np.where(m >= 0.0, 1, 2))
+
+
+def window_sums(steps: list, n_windows: int) -> list:
+    """Per-step records (day, area per class [m2], damage-area gain per class [m2], interior
+    area [m2], compressed area [m2]) summed into ``WINDOW_DAYS``-day windows."""
+    out = []
+    for w in range(n_windows):
+        rows = [s for s in steps if w * WINDOW_DAYS <= s["day"] < (w + 1) * WINDOW_DAYS]
+        area = np.sum([s["area_m2"] for s in rows], axis=0) if rows else np.zeros(3)
+        gain = np.sum([s["gain_m2"] for s in rows], axis=0) if rows else np.zeros(3)
+        comp = float(np.mean([s["compressed_fraction"] for s in rows])) if rows else float("nan")
+        out.append({"days": [w * WINDOW_DAYS, (w + 1) * WINDOW_DAYS], "steps": len(rows),
+                    "event_area_fraction": dict(zip(CLASSES, (area / max(area.sum(), 1e-300)).round(4).tolist())),
+                    "damage_gain_fraction": dict(zip(CLASSES, (gain / max(gain.sum(), 1e-300)).round(4).tolist())),
+                    "damage_gain_m2": float(gain.sum()), "mean_compressed_area_fraction": round(comp, 4)})
+    return out
+
+
+def run(basin: str, days: float = 28.0) -> dict:
+    """One month of the scene of ``basin`` with the per-step callback; returns the record."""
+    from lagice.diagnostics.faults import interior_triangles
+    from lagice.scenes.builder import build_simulation
+    from lagice.scenes.config import load_scene
+
+    out_dir = OUT / f"branches-{basin}"
+    sets = {"run.duration": f"{days:g}d", "output.every": "1d", "output.plot": False, "run.progress": False,
+            "checkpoint.every": "7d"}
+    sim = build_simulation(load_scene(SCENES[basin], sets), out_dir)
+    model = sim.model
+    memo = {"mesh": None, "triangles": None, "interior": None}
+    prev = {"damage": model.state.damage.copy(), "triangles": model.state.mesh.triangles}
+    steps, skipped = [], [0]
+
+    def after_step(s):
+        st = s.model.state
+        mesh = st.mesh
+        if mesh.triangles is not prev["triangles"] or st.damage.shape != prev["damage"].shape:
+            skipped[0] += 1  # remeshed in this step: new elements, no per-element change to read
+        else:
+            if memo["triangles"] is not mesh.triangles:
+                memo["triangles"] = mesh.triangles
+                memo["interior"] = interior_triangles(mesh.nodes, mesh.triangles, BUFFER_M)
+            inner = memo["interior"]
+            area = np.abs(mesh.areas())
+            gain = st.damage - prev["damage"]
+            hit = inner & (gain > 0.0)
+            cls = classify(st.stress)
+            m = 0.5 * (st.stress[:, 0] + st.stress[:, 1])
+            steps.append({"day": s.model.clock.time_s / DAY,
+                          "area_m2": [float(area[hit & (cls == k)].sum()) for k in range(3)],
+                          "gain_m2": [float((gain * area)[hit & (cls == k)].sum()) for k in range(3)],
+                          "compressed_fraction": float(area[inner & (m < 0.0)].sum() / area[inner].sum())})
+        prev["damage"] = st.damage.copy()
+        prev["triangles"] = mesh.triangles
+
+    sim.add_callback(after_step, "1 steps", name="envelope_branches")
+    t0 = time.perf_counter()
+    sim.run()
+    n_win = int(days // WINDOW_DAYS)
+    return {"basin": basin, "scene": SCENES[basin], "days": days, "buffer_m": BUFFER_M,
+            "steps_read": len(steps), "steps_skipped_remesh": skipped[0], "wall_s": round(time.perf_counter() - t0, 1),
+            "classes": list(CLASSES), "windows": window_sums(steps, n_win),
+            "month": window_sums([{**s, "day": 0.0} for s in steps], 1)[0]}
+
+
+def table(records: dict) -> str:
+    lines = ["| basin | days | damage gain: cut-off / Coulomb, tensile mean / Coulomb, compressive mean "
+             "| event area, same order | interior area under compression (mean) |", "|---|---|---|---|---|"]
+    for basin, rec in records.items():
+        for w in [rec["month"], *rec["windows"]]:
+            g, a = w["damage_gain_fraction"], w["event_area_fraction"]
+            days = "0–28" if w is rec["month"] else f"{w['days'][0]}–{w['days'][1]}"
+            lines.append(f"| {basin} | {days} | {g['cutoff']:.2f} / {g['coulomb_tension']:.2f} / "
+                         f"{g['coulomb_compression']:.2f} | {a['cutoff']:.2f} / {a['coulomb_tension']:.2f} / "
+                         f"{a['coulomb_compression']:.2f} | {w['mean_compressed_area_fraction']:.2f} |")
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("basins", nargs="*", help=f"any of {sorted(SCENES)}")
+    ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--days", type=float, default=28.0)
+    ap.add_argument("--table", action="store_true")
+    a = ap.parse_args(argv)
+    bad = [b for b in a.basins if b not in SCENES]
+    if bad:
+        ap.error(f"unknown basin(s) {bad}: expected any of {sorted(SCENES)}")
+    records = json.loads(PUBLISHED.read_text()) if PUBLISHED.exists() else {}
+    if a.basins:
+        with ProcessPoolExecutor(max_workers=a.jobs) as ex:
+            for rec in ex.map(run, a.basins, [a.days] * len(a.basins)):
+                records[rec["basin"]] = rec
+                print(f"branches: {rec['basin']} done in {rec['wall_s']} s ({rec['steps_read']} steps read, "
+                      f"{rec['steps_skipped_remesh']} with a remesh skipped)", flush=True)
+        PUBLISHED.write_text(json.dumps(records, indent=1) + "\n")
+    if records:
+        print(table(records))
+    elif not a.basins:
+        sys.exit("no stored result: run the basins first")
+
+
+if __name__ == "__main__":
+    main()
