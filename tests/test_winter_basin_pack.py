@@ -167,22 +167,29 @@ def test_bad_state_file_fails_before_meshing(monkeypatch, tmp_path, scene, sets,
 def test_new_ice_undamaged_through_the_scene(tmp_path):
     """``thermo.new_ice_undamaged = true`` in the flagship scene (60 km, one day, through the
     scene builder and Simulation): the leads of the spun-up pack refreeze with undamaged ice, so
-    the pack ends less damaged than the same run without it, by the damage the component
-    reports having removed (the dynamics then differ too, so only the sign and the report's
-    consistency are asserted), and ice volume is conserved in both runs."""
+    the pack ends less damaged than the same run without it. The steps' reports add up to the
+    component's running total (the dynamics differ between the runs, so the difference of the
+    damaged areas is only asserted in sign), and ice volume is conserved in both runs."""
     sets = {"domain.resolution_m": 60e3, "run.duration": "1d", "output.every": "1d", "checkpoint.every": "100d",
             "output.plot": False}
-    runs = {}
+    runs, reported = {}, []
+
+    def collect(sim):
+        reported.append(sim.model.last_report["thermodynamics"]["damage_diluted_by_new_ice_m2"])
+
     for flag in (False, True):
         sim = scene_sim("winter_basin_pack", tmp_path / f"run-{flag}", {**sets, "thermo.new_ice_undamaged": flag})
         assert sim.model.component("thermodynamics").new_ice_undamaged is flag
+        if flag:
+            sim.add_callback(collect, "1 steps", needs_host_state=False)
         sim.run()
         runs[flag] = sim.model
     on, off = runs[True], runs[False]
     area_on = np.abs(on.state.mesh.areas())
     area_off = np.abs(off.state.mesh.areas())
     diluted = on.component("thermodynamics").damage_diluted_m2
-    assert diluted > 0
+    assert diluted > 0 and len(reported) == 144
+    assert sum(reported) == pytest.approx(diluted, rel=1e-12)
     assert np.sum(on.state.damage * area_on) < np.sum(off.state.damage * area_off)
     for m in (on, off):
         assert abs(m.ledger.budget(m.state.ice_volume_m3)["relative_residual"]) < 1e-12
