@@ -1119,9 +1119,10 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-1125-newice"] = (
         _basin, from_spinup("H1125") + ["thermo.new_ice_undamaged=true"], 10e3, 28,
         f"{_p}-hthick-1125 with undamaged new ice (neXtSIM-DG's lateral-growth healing; diagnostic)")
-# Result (2026-11-27, twentieth session): NOT a lead, and the rate prediction failed in the closed
-# basin. Closed: beta 0.038 -> 0.056 (+0.018), rate x0.60 (0.00146 per day), both tails lighter
-# (2.85, 3.15), half-shear area 8.1 %, R2 0.755: 1 band inside against 2; wind factor 0.0032,
+# Result (2026-11-27, twentieth session): NOT a lead; the rate and beta predictions failed in the closed
+# basin (the damage one held in both). Closed: beta 0.038 -> 0.056 (+0.018), rate x0.60 (0.00146
+# per day), both tails lighter (2.85, 3.15), half-shear area 8.1 %, R2 0.755: 1 band inside against
+# 2; wind factor 0.0032,
 # net-divergence ratio -0.80 (against -0.73). Strait: beta 0.030 -> 0.029, rate x1.01, tails 2.61 and
 # 3.04, half-shear area 8.0 %, R2 0.762: 1 band against 3; wind factor 0.0038, ratio -0.74 (-0.71).
 # The refrozen leads heal, the pack deforms more evenly (lighter tails, larger active area) and, in

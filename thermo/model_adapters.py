@@ -104,10 +104,10 @@ class ThermoComponent:
         d ← d A/A', so the damaged ice area d·A is unchanged by the growth. This is
         neXtSIM-DG's lateral-growth healing (``ConstantHealing::updateElement`` in
         ``physics/src/modules/DamageHealingModule``, which adds its constant healing after
-        it); neXtSIM before it left new ice in a young-ice category out of the rheology's
-        concentration instead. Off by default: lagice's new ice took the damage of the
-        element until 2026-11-27. Elements that reach the concentration floor and vanish
-        keep their damage (they have no ice for the rheology).
+        it); classic neXtSIM instead keeps new ice in a young-ice category that the
+        rheology's concentration leaves out. Off by default: new ice then takes the damage
+        of its element, as it always did in lagice. Elements whose concentration falls (the
+        thickness floor, or the ice vanishing) keep their damage.
 
     The running breakdown of the volume change (congelation growth/melt, new
     ice in open water, ice removed below the thickness floor, snow removed) is
