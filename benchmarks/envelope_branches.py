@@ -54,6 +54,9 @@ CLASSES = ("cutoff", "coulomb_tension", "coulomb_compression")
 DAY = 86400.0
 BUFFER_M = 100e3
 WINDOW_DAYS = 3
+#: the windows start at day 1, as the validation's (docs/validation.md), so that each window's shares
+#: sit beside that window's beta and rate in the published records
+WINDOW_START_DAY = 1.0
 
 
 def classify(stress: np.ndarray) -> np.ndarray:
@@ -66,16 +69,18 @@ def classify(stress: np.ndarray) -> np.ndarray:
     return np.where(s2 >= 0.0, 0, np.where(m >= 0.0, 1, 2))
 
 
-def window_sums(steps: list, n_windows: int) -> list:
-    """Per-step records (day, area per class [m2], damage-area gain per class [m2], interior
-    area [m2], compressed area [m2]) summed into ``WINDOW_DAYS``-day windows."""
+def window_sums(steps: list, n_windows: int, start_day: float = WINDOW_START_DAY, width: float = WINDOW_DAYS) -> list:
+    """Per-step records (``day``: the end of the step, area per class [m2], damage-area gain per
+    class [m2], the interior's compressed area fraction) summed into windows of ``width`` days
+    from ``start_day``; a step belongs to the window that holds its end."""
     out = []
     for w in range(n_windows):
-        rows = [s for s in steps if w * WINDOW_DAYS <= s["day"] < (w + 1) * WINDOW_DAYS]
+        lo, hi = start_day + w * width, start_day + (w + 1) * width
+        rows = [s for s in steps if lo < s["day"] <= hi]
         area = np.sum([s["area_m2"] for s in rows], axis=0) if rows else np.zeros(3)
         gain = np.sum([s["gain_m2"] for s in rows], axis=0) if rows else np.zeros(3)
         comp = float(np.mean([s["compressed_fraction"] for s in rows])) if rows else float("nan")
-        out.append({"days": [w * WINDOW_DAYS, (w + 1) * WINDOW_DAYS], "steps": len(rows),
+        out.append({"days": [lo, hi], "steps": len(rows),
                     "event_area_fraction": dict(zip(CLASSES, (area / max(area.sum(), 1e-300)).round(4).tolist())),
                     "damage_gain_fraction": dict(zip(CLASSES, (gain / max(gain.sum(), 1e-300)).round(4).tolist())),
                     "damage_gain_m2": float(gain.sum()), "mean_compressed_area_fraction": round(comp, 4)})
@@ -122,11 +127,12 @@ def run(basin: str, days: float = 28.0) -> dict:
     sim.add_callback(after_step, "1 steps", name="envelope_branches")
     t0 = time.perf_counter()
     sim.run()
-    n_win = int(days // WINDOW_DAYS)
+    n_win = int((days - WINDOW_START_DAY) // WINDOW_DAYS)
+    (OUT / f"branches-{basin}-steps.json").write_text(json.dumps(steps))
     return {"basin": basin, "scene": SCENES[basin], "days": days, "buffer_m": BUFFER_M,
             "steps_read": len(steps), "steps_skipped_remesh": skipped[0], "wall_s": round(time.perf_counter() - t0, 1),
             "classes": list(CLASSES), "windows": window_sums(steps, n_win),
-            "month": window_sums([{**s, "day": 0.0} for s in steps], 1)[0]}
+            "month": window_sums(steps, 1, start_day=0.0, width=days)[0]}
 
 
 def table(records: dict) -> str:
@@ -135,7 +141,7 @@ def table(records: dict) -> str:
     for basin, rec in records.items():
         for w in [rec["month"], *rec["windows"]]:
             g, a = w["damage_gain_fraction"], w["event_area_fraction"]
-            days = "0–28" if w is rec["month"] else f"{w['days'][0]}–{w['days'][1]}"
+            days = f"{w['days'][0]:g}–{w['days'][1]:g}"
             lines.append(f"| {basin} | {days} | {g['cutoff']:.2f} / {g['coulomb_tension']:.2f} / "
                          f"{g['coulomb_compression']:.2f} | {a['cutoff']:.2f} / {a['coulomb_tension']:.2f} / "
                          f"{a['coulomb_compression']:.2f} | {w['mean_compressed_area_fraction']:.2f} |")

@@ -512,7 +512,8 @@ def test_envelope_branch_classes_are_the_branches_dcrit_scales_onto():
     assert np.array_equal(classify(0.3 * sig), classify(sig))
     steps = [{"day": d, "area_m2": [1.0, 2.0, 3.0], "gain_m2": [0.0, 1.0, 3.0], "compressed_fraction": 0.5}
              for d in (0.5, 1.0, 2.9, 3.1)]
-    w = window_sums(steps, 2)
-    assert [x["steps"] for x in w] == [3, 1]
+    w = window_sums(steps, 2, start_day=0.0)  # (0, 3] and (3, 6]
+    assert [x["steps"] for x in w] == [3, 1] and w[1]["days"] == [3.0, 6.0]
+    assert [x["steps"] for x in window_sums(steps, 1)] == [2]  # the validation's first window, (1, 4]
     assert w[0]["event_area_fraction"] == dict(zip(CLASSES, [round(1 / 6, 4), round(2 / 6, 4), 0.5]))
     assert w[0]["damage_gain_fraction"]["coulomb_compression"] == 0.75 and w[0]["damage_gain_m2"] == 12.0
