@@ -291,9 +291,16 @@ class NextsimHealing:
         return rate
 
     def element_rate(self, state, t_s):
-        """H [s-1] per element of ``state`` at time ``t_s`` [s] (air temperature at the centroids)."""
-        c = state.mesh.centroids()
-        ta = self.air_temperature.evaluate(t_s, np.ascontiguousarray(c[:, 0]), np.ascontiguousarray(c[:, 1]))
+        """H [s-1] per element of ``state`` at time ``t_s`` [s] (air temperature at the centroids).
+
+        The air temperature comes through the field's shared centroid memo
+        (:func:`thermo.model_adapters.air_at_centroids`): the thermodynamics evaluated it at
+        the end of the previous step, at the same time and on the same node positions, so
+        this step's healing rate reuses that array (the same values bit for bit) unless a
+        remesh or a checkpoint load came between."""
+        from thermo.model_adapters import air_at_centroids
+
+        ta = air_at_centroids(self.air_temperature).values(state.mesh, t_s)
         return self.rate(ta, state.thickness, state.concentration, state.snow)
 
 

@@ -190,6 +190,26 @@ def test_thermodynamics_and_healing_share_one_air_temperature_evaluation():
     assert gone() is None
 
 
+def test_nextsim_healing_shares_the_air_temperature_with_the_thermodynamics():
+    # the flagship's healing law (neXtSIM's, lagice.strength) takes its air temperature through
+    # the same centroid memo: after the thermodynamics' evaluation at the same time on the same
+    # mesh it evaluates nothing, and its rate is the one a fresh evaluation gives, bit for bit
+    from lagice.strength import NextsimHealing, NextsimHealingComponent
+    from thermo.model_adapters import air_at_centroids
+
+    air = _CountingAir()
+    st = state()
+    thermo = ThermoComponent(air.field)
+    heal = NextsimHealingComponent(NextsimHealing(air.field))
+    thermo.step(st, 600.0, 600.0)
+    r = heal.rate(st, 600.0)
+    assert air.calls == 1 and air_at_centroids(air.field).n_reused == 1
+    c = st.mesh.centroids()
+    fresh = air.field.evaluate(600.0, np.ascontiguousarray(c[:, 0]), np.ascontiguousarray(c[:, 1]))
+    np.testing.assert_array_equal(r, heal.law.rate(fresh, st.thickness, st.concentration, st.snow))
+    assert np.all(r > 0)
+
+
 def test_first_non_finite_finds_the_first_bad_value_and_passes_huge_finite_ones():
     # the check sums each field first (a NaN or inf makes the sum non-finite); finite values
     # whose sum overflows must still pass, and a bad value is named with its index
