@@ -32,7 +32,19 @@ Stated before the month's runs (2026-11-27, 22:18 UTC; a one-day test run had gi
 under a compressive mean stress (more than half in both basins), and the cut-off carries less
 than a fifth.
 
+Two mechanism diagnostics (closed basin, from the shipped spin-up; not candidates). The drift runs
+8-26 deg to the left of the geostrophic wind (Thorndike and Colony: about 5 deg to the right), and
+the climatology's surface wind is turned 25 deg towards low pressure, so under a cyclone the ice
+is driven inwards and the pack is pressed. ``turn25``: neXtSIM's 25 deg ocean turning angle
+(``forcing.drag.turning_angle_deg=25``); ``isobar0``: the surface wind along the isobars
+(``forcing.wind.cross_isobar_angle_deg=0``; this changes the calibrated wind, so it only
+tests the mechanism). Stated before their runs (2026-11-27, 22:54 UTC): if the inflow presses the
+pack, isobar0's share of damage gain under pressure falls below 0.6 (shipped: 0.77) and its
+storm windows press less than 0.7 of the interior (shipped: 0.79-0.91); turn25, which turned the
+drift by about 10 deg only, moves the share by less than 0.1.
+
     python benchmarks/envelope_branches.py closed strait --jobs 2   # both basins, 28 days
+    python benchmarks/envelope_branches.py closed --set forcing.drag.turning_angle_deg=25 --label turn25
     python benchmarks/envelope_branches.py --table                   # the stored result
 """
 from __future__ import annotations
@@ -87,16 +99,19 @@ def window_sums(steps: list, n_windows: int, start_day: float = WINDOW_START_DAY
     return out
 
 
-def run(basin: str, days: float = 28.0) -> dict:
-    """One month of the scene of ``basin`` with the per-step callback; returns the record."""
+def run(basin: str, days: float = 28.0, sets: tuple = (), label: str | None = None) -> dict:
+    """One month of the scene of ``basin`` with the per-step callback; returns the record.
+    ``sets``: ``KEY=VALUE`` overrides (diagnostics: another configuration), recorded under
+    ``label`` (default: the basin's name)."""
     from lagice.diagnostics.faults import interior_triangles
     from lagice.scenes.builder import build_simulation
-    from lagice.scenes.config import load_scene
+    from lagice.scenes.config import load_scene, split_overrides
 
-    out_dir = OUT / f"branches-{basin}"
-    sets = {"run.duration": f"{days:g}d", "output.every": "1d", "output.plot": False, "run.progress": False,
-            "checkpoint.every": "7d"}
-    sim = build_simulation(load_scene(SCENES[basin], sets), out_dir)
+    name = label or basin
+    out_dir = OUT / f"branches-{name}"
+    ov = {"run.duration": f"{days:g}d", "output.every": "1d", "output.plot": False, "run.progress": False,
+          "checkpoint.every": "7d", **dict(split_overrides(list(sets)))}
+    sim = build_simulation(load_scene(SCENES[basin], ov), out_dir)
     model = sim.model
     memo = {"mesh": None, "triangles": None, "interior": None}
     prev = {"damage": model.state.damage.copy(), "triangles": model.state.mesh.triangles}
@@ -128,15 +143,16 @@ def run(basin: str, days: float = 28.0) -> dict:
     t0 = time.perf_counter()
     sim.run()
     n_win = int((days - WINDOW_START_DAY) // WINDOW_DAYS)
-    (OUT / f"branches-{basin}-steps.json").write_text(json.dumps(steps))
-    return {"basin": basin, "scene": SCENES[basin], "days": days, "buffer_m": BUFFER_M,
+    (OUT / f"branches-{name}-steps.json").write_text(json.dumps(steps))
+    return {"label": name, "basin": basin, "scene": SCENES[basin], "overrides": list(sets), "days": days,
+            "buffer_m": BUFFER_M,
             "steps_read": len(steps), "steps_skipped_remesh": skipped[0], "wall_s": round(time.perf_counter() - t0, 1),
             "classes": list(CLASSES), "windows": window_sums(steps, n_win),
             "month": window_sums(steps, 1, start_day=0.0, width=days)[0]}
 
 
 def table(records: dict) -> str:
-    lines = ["| basin | days | damage gain: cut-off / Coulomb, tensile mean / Coulomb, compressive mean "
+    lines = ["| run | days | damage gain: cut-off / Coulomb, tensile mean / Coulomb, compressive mean "
              "| event area, same order | interior area under compression (mean) |", "|---|---|---|---|---|"]
     for basin, rec in records.items():
         for w in [rec["month"], *rec["windows"]]:
@@ -154,18 +170,28 @@ def main(argv=None):
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--days", type=float, default=28.0)
     ap.add_argument("--table", action="store_true")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="an override for a diagnostic configuration (needs --label and one basin)")
+    ap.add_argument("--label", help="the record's name for a run with --set")
     a = ap.parse_args(argv)
     bad = [b for b in a.basins if b not in SCENES]
     if bad:
         ap.error(f"unknown basin(s) {bad}: expected any of {sorted(SCENES)}")
+    if (a.set or a.label) and not (a.set and a.label and len(a.basins) == 1):
+        ap.error("--set needs --label and exactly one basin (and --label needs --set)")
+    if a.label in SCENES:
+        ap.error(f"--label {a.label!r} is a basin's own record; choose another name")
     records = json.loads(PUBLISHED.read_text()) if PUBLISHED.exists() else {}
     if a.basins:
         with ProcessPoolExecutor(max_workers=a.jobs) as ex:
-            for rec in ex.map(run, a.basins, [a.days] * len(a.basins)):
-                records[rec["basin"]] = rec
-                print(f"branches: {rec['basin']} done in {rec['wall_s']} s ({rec['steps_read']} steps read, "
+            n = len(a.basins)
+            for rec in ex.map(run, a.basins, [a.days] * n, [tuple(a.set)] * n, [a.label] * n):
+                print(f"branches: {rec['label']} done in {rec['wall_s']} s ({rec['steps_read']} steps read, "
                       f"{rec['steps_skipped_remesh']} with a remesh skipped)", flush=True)
-        PUBLISHED.write_text(json.dumps(records, indent=1) + "\n")
+                # read again before writing: another invocation may have stored its record meanwhile
+                stored = json.loads(PUBLISHED.read_text()) if PUBLISHED.exists() else {}
+                records = {**stored, rec["label"]: rec}
+                PUBLISHED.write_text(json.dumps(records, indent=1) + "\n")
     if records:
         print(table(records))
     elif not a.basins:
