@@ -74,11 +74,10 @@ WINDOW_START_DAY = 1.0
 def classify(stress: np.ndarray) -> np.ndarray:
     """(m,) class index into :data:`CLASSES` of (m, 3) stresses [Pa]: 0 where the minor
     principal stress s2 ≥ 0, 1 where the mean m ≥ 0 > s2, 2 where m < 0."""
-    sxx, syy, sxy = stress[:, 0], stress[:, 1], stress[:, 2]
-    m = 0.5 * (sxx + syy)
-    r = np.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
-    s2 = m - r
-    return np.where(s2 >= 0.0, 0, np.where(m >= 0.0, 1, 2))
+    from lagice.rheology.maxwell_eb import principal_stresses
+
+    s1, s2 = principal_stresses(stress)
+    return np.where(s2 >= 0.0, 0, np.where(s1 + s2 >= 0.0, 1, 2))
 
 
 def window_sums(steps: list, n_windows: int, start_day: float = WINDOW_START_DAY, width: float = WINDOW_DAYS) -> list:
@@ -113,7 +112,8 @@ def run(basin: str, days: float = 28.0, sets: tuple = (), label: str | None = No
           "checkpoint.every": "7d", **dict(split_overrides(list(sets)))}
     sim = build_simulation(load_scene(SCENES[basin], ov), out_dir)
     model = sim.model
-    memo = {"mesh": None, "triangles": None, "interior": None}
+    # the interior mask of a mesh's first step (kept until the next remesh; nodes drift meanwhile)
+    memo = {"triangles": None, "interior": None}
     prev = {"damage": model.state.damage.copy(), "triangles": model.state.mesh.triangles}
     steps, skipped = [], [0]
 
