@@ -39,8 +39,8 @@ class MaxwellEBParams:
         stress_correction: path that brings a super-critical stress back to the envelope:
             ``"origin"`` (Dansereau et al. 2016, neXtSIM: the whole tensor scaled towards 0)
             or ``"mean_stress"`` (towards θ times the mean normal stress; θ = 1: only the
-            deviatoric part scaled, the mean kept; the implicit solver and the explicit CPU
-            stepper; docs/physics.md, compression test) or ``"associated"`` (along K n, n
+            deviatoric part scaled, the mean kept; the implicit solver and the explicit
+            stepper, CPU and CUDA; docs/physics.md, compression test) or ``"associated"`` (along K n, n
             the envelope's normal: the return of an associated plasticity; implicit solver
             only)
         stress_correction_mean_fraction: θ ∈ (0, 2] of ``"mean_stress"`` (None: 1) [-]; θ > 1
@@ -61,7 +61,7 @@ class MaxwellEBParams:
             the mean normal stress of damaged ice does not creep; with ``max_pressure_pa`` set the
             mean takes the compressive term's factor above (it creeps where it is tensile or
             compressive beyond P_max). The ice then converges elastically, at damage events or
-            above P_max. Explicit CPU stepper only
+            above P_max. Explicit stepper only (CPU and CUDA)
         dilatancy_angle_deg: ψ [degrees] ∈ [0, 45) of a dilatant Maxwell viscous flow (None or 0:
             off, the default; a diagnostic of lagice, 2026-11-27; docs/physics.md §4, "Broken ice
             that dilates as it shears"). The viscous (permanent) strain rate K⁻¹σ/(Eλ) of
@@ -69,7 +69,7 @@ class MaxwellEBParams:
             times its shear rate, as the Reynolds dilatancy of a granular material (Tremblay
             and Mysak 1997 for sea ice; ψ = 0 is their incompressible flow). Where the ice
             cannot open, the flow builds a pressure k_ψ r, k_ψ = sin ψ (1 + ν)/(1 − ν), r the
-            radius of Mohr's circle. Explicit CPU stepper only, with ``relax_mean_stress`` true
+            radius of Mohr's circle. Explicit stepper only (CPU and CUDA), with ``relax_mean_stress`` true
             and no ``max_pressure_pa``
     """
 

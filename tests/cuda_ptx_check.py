@@ -38,7 +38,9 @@ def signatures():
     B1, B2 = T.Array(T.int8, 1, "C"), T.Array(T.int8, 2, "C")
     C1 = T.Array(i8, 1, "C")
     node = (A2, A2, A2, I1, I1, A1, A1, A1, A2, A1, A2, f8, f8, A1, B2, A2, A2)
-    mat = (A1,) * 8 + (A1, i8)  # ... e_dt, gamma, then pmax and use_pmax (neXtSIM's compressive term)
+    # ... e_dt, gamma, then pmax and use_pmax (neXtSIM's compressive term), and the optional terms
+    # keep_mean (int), theta and dilat (float; 0: off)
+    mat = (A1,) * 8 + (A1, i8, i8, f8, f8)
     consts = (f8,) * 9
     return {
         "substeps_cooperative": (i8, f8, *node, I2, A2, A2, A1, *mat, *consts, B1, A2, A2, C1, A1),
@@ -76,9 +78,16 @@ def main():
 
     _dispatcher.get_current_device = lambda: _NoDevice()
     report = {"nvvm": True, "nvvm_version": list(nvvm.NVVM().get_version()), "cc": list(CC), "kernels": {}}
-    for name, sig in signatures().items():
+    sigs = signatures()
+    kernels = {name: getattr(K, name) for name in sigs}
+    # the copies with the optional rheology terms (a run with any of them launches these)
+    for name, kern in K.optional_kernels().items():
+        if name in sigs:
+            kernels[f"optional:{name}"] = kern
+    for name, kern in kernels.items():
+        sig = sigs[name.removeprefix("optional:")]
         try:
-            ptx, _ = cuda.compile_ptx(getattr(K, name).py_func, sig, cc=CC)
+            ptx, _ = cuda.compile_ptx(kern.py_func, sig, cc=CC)
         except Exception as exc:  # noqa: BLE001 - reported per kernel
             report["kernels"][name] = {"ok": False, "error": f"{type(exc).__name__}: {str(exc)[:400]}"}
             continue

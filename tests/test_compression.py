@@ -147,7 +147,8 @@ def test_outputs_readable(heal_run):
     ({"rheology.max_pressure_thickness_exponent": 4.0}, "max_pressure_thickness_exponent \\(k\\) = 4.0"),
     ({"rheology.relax_mean_stress": False},
      "rheology.relax_mean_stress = false: the implicit solver .* does not implement it \\(implemented in the "
-     "explicit CPU stepper \\(solver.name = 'explicit', solver.device = 'cpu'\\)\\)"),
+     "explicit CPU stepper \\(solver.name = 'explicit', solver.device = 'cpu'\\) and the CUDA explicit stepper "
+     "\\(solver.name = 'explicit', solver.device = 'cuda'\\)\\)"),
     ({"rheology.relax_mean_stress": "no"}, "relax_mean_stress"),
     ({"rheology.dilatancy_angle_deg": 20.0},
      "rheology.dilatancy_angle_deg = 20.0: the implicit solver .* does not implement it \\(implemented in the "

@@ -150,7 +150,10 @@ def test_every_kernel_compiles_for_sm90():
         pytest.skip(f"no NVVM to compile with: {rep['reason']}")
     kernels = {name for name, obj in vars(K).items()
                if isinstance(obj, CUDADispatcher) and not obj.targetoptions.get("device")}
-    assert set(rep["kernels"]) == kernels  # the check covers every kernel
+    # the check covers every kernel, and the copies with the optional rheology terms
+    assert {k for k in rep["kernels"] if not k.startswith("optional:")} == kernels
+    assert {k for k in rep["kernels"] if k.startswith("optional:")} == {
+        "optional:substeps_cooperative", "optional:element_substep_kernel"}
     for name, k in rep["kernels"].items():
         assert k["ok"], (name, k.get("error"))
         assert k.get("ptxas_ok", True), (name, k.get("ptxas_error"))
@@ -205,6 +208,13 @@ def test_cpu_serial_parallel_and_gpu_agree_on_a_damaging_run(sim_report):
     # neXtSIM's compressive term acted (elements below and above P_max) and changed the result
     below, above = r["pmax_elements_below_above"]
     assert below > 0 and above > 0 and r["pmax_vs_without"] > 1e-3
+    # the optional terms of the CPU kernel (the mean kept, alone and with the compressive term; the
+    # return towards 1.5 m I; the dilatant flow), both launch modes: each changed the result, and
+    # the device gives the CPU result
+    for variant in ("keep_mean", "keep_mean_pmax", "mean_stress", "dilatancy"):
+        _agree(f"{variant}_explicit_sync", r[f"{variant}_explicit_sync"])
+        _agree(f"{variant}_launches", r[f"{variant}_launches"])
+        assert r[f"{variant}_vs_without"] > 1e-3, (variant, r[f"{variant}_vs_without"])
     # a register cap on the cooperative kernel: same result bit for bit, bad caps refused
     cap = r["register_cap_64_vs_uncapped"]
     assert all(cap[f] == 0.0 for f in (*STATE, "transport", "strain", "nodes")), cap

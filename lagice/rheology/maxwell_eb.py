@@ -262,13 +262,14 @@ DAMAGE_UPDATE = (serial_copy(damage_update_kernel), damage_update_kernel)
 
 #: the stress-correction paths (``rheology.stress_correction``) each stepper implements
 #: (the prescribed-velocity stepper updates no damage: only the default is not an ignored setting)
-CORRECTION_PATHS = {"implicit": STRESS_CORRECTIONS, "explicit": ("origin", "mean_stress"), "explicit_cuda": ("origin",),
+CORRECTION_PATHS = {"implicit": STRESS_CORRECTIONS, "explicit": ("origin", "mean_stress"),
+                    "explicit_cuda": ("origin", "mean_stress"),
                     "prescribed": ("origin",)}
 #: the optional terms of :class:`lagice.params.MaxwellEBParams` that each stepper implements.
 #: A term set away from its default (:meth:`MaxwellEBParams.optional_terms`) is refused by a
 #: stepper that does not list it, so no stepper silently runs without it
 OPTIONAL_TERMS = {"implicit": (), "explicit": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg"),
-                  "explicit_cuda": ("max_pressure_pa",), "prescribed": ()}
+                  "explicit_cuda": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg"), "prescribed": ()}
 STEPPER_LABELS = {"implicit": "the implicit solver (solver.name = 'implicit')",
                   "prescribed": "the prescribed-velocity stepper (solver.name = 'prescribed', no damage update)",
                   "explicit": "the explicit CPU stepper (solver.name = 'explicit', solver.device = 'cpu')",

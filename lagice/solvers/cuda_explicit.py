@@ -621,8 +621,9 @@ class CudaExplicitSolver:
         return out
 
     # -- the step -----------------------------------------------------------------------------
-    def _choose_launch(self, args) -> str:
-        """Cooperative single-launch loop where requested and possible."""
+    def _choose_launch(self, args, optional: bool = False) -> str:
+        """Cooperative single-launch loop where requested and possible (``optional``: the
+        kernel with the optional rheology terms, which the rheology fixes for the stepper's life)."""
         from . import cuda_kernels as K
 
         if self.launch_used is not None:
@@ -631,7 +632,7 @@ class CudaExplicitSolver:
             self.launch_used = "launches"
             return self.launch_used
         try:
-            kern = K.cooperative_kernel(self.max_registers)
+            kern = K.cooperative_kernel(self.max_registers, optional)
             if simulator_enabled():
                 mx = kern.overloads[None].max_cooperative_grid_blocks(self.tpb)
             else:
@@ -738,21 +739,27 @@ class CudaExplicitSolver:
         node_args = (d["vel_w"], d["vel_sum"], d["sigma_w"], d["ptr"], d["elems"], d["wb"], d["wc"], d["m_dt"],
                      d["fext"], d["cda"], d["current"], self._cos_t, self._sin_t, d["half_mf"], d["fixed"],
                      d["pres0"], d["pres1"])
+        # the CPU kernel's optional terms; its None is 0 here (a CUDA launch cannot pass None)
+        keep_mean = 0 if p.relax_mean_stress else 1
+        theta = float(p.mean_fraction) if p.stress_correction == "mean_stress" else 0.0
+        dilat = float(p.dilatancy_factor or 0.0)
         mat = (d["conc_factor"], d["coh"], d["sig_c"], d["sig_t"], d["td"], d["heal"], d["e_dt"], d["gamma"],
-               d["pmax"], use_pmax)
+               d["pmax"], use_pmax, keep_mean, theta, dilat)
         consts = (kxx, kxy, kss, rh.q, rh._denom, float(p.max_damage), float(p.E0),
                   float(p.relaxation_time_s), float(p.alpha))
         coop_args = (n_sub, dt_sub, *node_args, d["tri"], d["b"], d["c"], d["damage_w"], *mat, *consts,
                      d["flag"], d["mean_vel"], d["strain"], d["counters"], d["scalars"])
-        if self._choose_launch(coop_args) == "cooperative":
+        optional = bool(keep_mean or theta or dilat)
+        if self._choose_launch(coop_args, optional) == "cooperative":
             blocks = min(self._coop_max, self._blocks(max(n, m)))
-            self._io.launch(K.cooperative_kernel(self.max_registers), blocks, self.tpb, coop_args)
+            self._io.launch(K.cooperative_kernel(self.max_registers, optional), blocks, self.tpb, coop_args)
         else:
             elem_args = (d["tri"], d["b"], d["c"], d["vel_w"], d["sigma_w"], d["damage_w"], *mat, *consts,
                          d["flag"], d["counters"])
+            element_kernel = K.optional_kernels()["element_substep_kernel"] if optional else K.element_substep_kernel
             for k in range(n_sub):
                 self._launch(K.node_substep_kernel, n, (k + 1) / n_sub, *node_args)
-                self._launch(K.element_substep_kernel, m, dt_sub, *elem_args)
+                self._launch(element_kernel, m, dt_sub, *elem_args)
             self._launch(K.finish_nodes_kernel, n, n_sub, d["vel_w"], d["vel_sum"], d["mean_vel"], d["counters"],
                          d["scalars"])
             self._launch(K.finish_elements_kernel, m, d["tri"], d["b"], d["c"], d["mean_vel"], d["strain"],

@@ -35,7 +35,7 @@ from numba import cuda
 from forcing.records import _bilinear
 
 from ..fem import element_strain_rate, solve_node_2x2
-from ..rheology.maxwell_eb import _principal
+from ..rheology.maxwell_eb import _dcrit_towards, _principal
 
 # counter slots (int64): C_NONFINITE counts nodes with a non-finite velocity,
 # C_NONFINITE_ELEM elements with a non-finite stress or damage (end of the step)
@@ -161,26 +161,54 @@ def node_update(i, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, cur
     vel_sum[i, 1] += vn
 
 
+#: False in the kernels of this module, which the default launch uses: numba freezes a module
+#: global when it compiles, so the optional terms' code (``element_update``'s ``keep_mean``,
+#: ``theta``, ``dilat``) is removed from them, and their PTX is the one compiled before those
+#: terms existed (``tests/cuda_ptx_check.py``; docs/gpu.md). True in the copies of
+#: :func:`optional_kernels`, which a run with any of the terms launches.
+_OPTIONAL_TERMS = False
+
+
 @cuda.jit(device=True)
 def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c, sigma_t, td,
-                   heal_rate, e_dt, gamma, pmax, use_pmax, dt_s, kxx, kxy, kss, q, denom, max_damage, E0,
-                   lambda0, alpha, damaged_flag):
+                   heal_rate, e_dt, gamma, pmax, use_pmax, keep_mean, theta, dilat, dt_s, kxx, kxy, kss, q, denom,
+                   max_damage, E0, lambda0, alpha, damaged_flag):
     """One element of :func:`lagice.solvers.explicit._element_stress_damage`
     (same expressions; ``use_pmax`` = 1: neXtSIM's compressive term with ``pmax``);
     returns 1 when the damage cap acted. The envelope test reads σc, σT per element (the
     CPU kernel scales the cohesion since 2026-11-26; both only shortcut ``_dcrit``, which
-    decides, so the results are the same)."""
+    decides, so the results are the same).
+
+    ``keep_mean`` (int, 1: the relaxation keeps the mean stress), ``theta`` (θ of the return
+    towards θ m I; 0: the origin path) and ``dilat`` (k_ψ of the dilatant viscous flow; 0: off)
+    are the CPU kernel's optional terms (its None is 0 here: numba's CUDA launch cannot pass
+    None), with its expressions in its order. Their code is compiled only into the copies of
+    :func:`optional_kernels` (:data:`_OPTIONAL_TERMS`); the default launch ignores them."""
     exx, eyy, exy = strain_rate_dev(tri, b, c, vel, e)
     ed = e_dt[e]
     g = gamma[e]
+    gp = g
     if use_pmax:
         sn = -0.5 * (sigma[e, 0] + sigma[e, 1])
         if sn > 0.0:
             pt = min2(1.0, pmax[e] / sn)
-            g = g / (g + (1.0 - g) * (1.0 - pt))
-    sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * g
-    syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * g
-    sxy = (sigma[e, 2] + ed * (kss * exy)) * g
+            gp = g / (g + (1.0 - g) * (1.0 - pt))
+    if not (_OPTIONAL_TERMS and keep_mean != 0):
+        sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * gp
+        syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * gp
+        sxy = (sigma[e, 2] + ed * (kss * exy)) * gp
+        if _OPTIONAL_TERMS and dilat != 0.0:  # only without pmax (MaxwellEBParams refuses both), so gp == g here
+            pd = (1.0 - g) * dilat * math.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
+            sxx -= pd
+            syy -= pd
+    else:
+        axx = sigma[e, 0] + ed * (kxx * exx + kxy * eyy)
+        ayy = sigma[e, 1] + ed * (kxy * exx + kxx * eyy)
+        am = 0.5 * (axx + ayy)
+        gm = gp if use_pmax else 1.0
+        sxx = (axx - am) * g + am * gm
+        syy = (ayy - am) * g + am * gm
+        sxy = (sigma[e, 2] + ed * (kss * exy)) * g
     mm = 0.5 * (sxx + syy)
     rr = math.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
     s1 = mm + rr
@@ -188,11 +216,24 @@ def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigm
         dc = 1.0
     else:
         dc = dcrit_dev(sxx, syy, sxy, cohesion[e], q, denom)
+    towards = False
+    pm = 0.0
+    if _OPTIONAL_TERMS and theta > 0.0:
+        if dc < 1.0:
+            fm = _dcrit_towards(sxx, syy, sxy, cohesion[e], q, denom, theta)
+            if fm >= 0.0:
+                dc = fm
+                pm = theta * mm
+                towards = True
     d0 = damage[e]
     d, f, capped = damage_step_dev(d0, dc, dt_s, td[e], heal_rate[e], max_damage)
     if dc < 1.0:
-        sxx *= f
-        syy *= f
+        if towards:  # False without the optional terms or with theta = 0
+            sxx = pm + f * (sxx - pm)
+            syy = pm + f * (syy - pm)
+        else:
+            sxx *= f
+            syy *= f
         sxy *= f
         damaged_flag[e] = 1
     sigma[e, 0] = sxx
@@ -248,9 +289,9 @@ def finish_element(e, tri, b, c, mean_vel, strain, damaged_flag, sigma, damage):
 @cuda.jit
 def substeps_cooperative(n_sub, dt_s, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, fext, cda, current,
                          cos_t, sin_t, half_mf, fixed, pres0, pres1, tri, b, c, damage, conc_factor,
-                         cohesion, sigma_c, sigma_t, td, heal_rate, e_dt, gamma, pmax, use_pmax, kxx, kxy, kss,
-                         q, denom, max_damage, E0, lambda0, alpha, damaged_flag, mean_vel, strain, counters,
-                         scalars):
+                         cohesion, sigma_c, sigma_t, td, heal_rate, e_dt, gamma, pmax, use_pmax, keep_mean, theta,
+                         dilat, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, damaged_flag, mean_vel,
+                         strain, counters, scalars):
     """All ``n_sub`` sub-steps, then the mean velocity and its strain rate, in one
     launch: the node and element phases are separated by a grid-wide barrier
     (cooperative groups), so the grid must be co-resident (launch with at most
@@ -269,8 +310,9 @@ def substeps_cooperative(n_sub, dt_s, vel, vel_sum, sigma, ptr, elems, wb, wc, m
         grid.sync()
         for e in range(start, m, stride):
             capped += element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c,
-                                     sigma_t, td, heal_rate, e_dt, gamma, pmax, use_pmax, dt_s, kxx, kxy,
-                                     kss, q, denom, max_damage, E0, lambda0, alpha, damaged_flag)
+                                     sigma_t, td, heal_rate, e_dt, gamma, pmax, use_pmax, keep_mean, theta,
+                                     dilat, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha,
+                                     damaged_flag)
         grid.sync()
     bad = 0
     s2max = 0.0
@@ -298,20 +340,48 @@ def substeps_cooperative(n_sub, dt_s, vel, vel_sum, sigma, ptr, elems, wb, wc, m
 
 
 _CAPPED = {}
+_OPTIONAL = {}
 
 
-def cooperative_kernel(max_registers=None):
-    """:func:`substeps_cooperative`, or the same function compiled with a register cap
-    per thread (``cuda.jit(max_registers=...)``; one dispatcher per cap, made once).
-    The cap changes register allocation only, not what is computed; numba's CUDA
-    simulator has no registers (and no such option), so there the kernel is uncapped."""
+def _copy(kernel, constants: dict, suffix: str, **jit_kw):
+    """``kernel``'s Python function compiled again with the module globals in ``constants``
+    replaced (frozen at compile time, as :func:`lagice._numba.specialised_copy` does on the CPU)."""
+    import types
+
+    py = kernel.py_func
+    f = types.FunctionType(py.__code__, {**py.__globals__, **constants}, py.__name__ + suffix, py.__defaults__,
+                           py.__closure__)
+    f.__qualname__ = py.__qualname__ + suffix
+    f.__doc__ = py.__doc__
+    return cuda.jit(**jit_kw)(f)
+
+
+def optional_kernels() -> dict:
+    """The sub-step kernels compiled with the optional rheology terms (:data:`_OPTIONAL_TERMS`
+    True): ``"substeps_cooperative"`` and ``"element_substep_kernel"``, made once."""
+    if not _OPTIONAL:
+        upd = _copy(element_update, {"_OPTIONAL_TERMS": True}, "_optional", device=True)
+        _OPTIONAL["element_update"] = upd
+        for k in (substeps_cooperative, element_substep_kernel):
+            _OPTIONAL[k.py_func.__name__] = _copy(k, {"element_update": upd}, "_optional")
+    return _OPTIONAL
+
+
+def cooperative_kernel(max_registers=None, optional: bool = False):
+    """:func:`substeps_cooperative` (``optional``: its copy with the optional rheology terms,
+    :func:`optional_kernels`), or the same function compiled with a register cap per thread
+    (``cuda.jit(max_registers=...)``; one dispatcher per cap, made once). The cap changes
+    register allocation only, not what is computed; numba's CUDA simulator has no registers
+    (and no such option), so there the kernel is uncapped."""
     from numba import config
 
+    base = optional_kernels()["substeps_cooperative"] if optional else substeps_cooperative
     if max_registers is None or config.ENABLE_CUDASIM:
-        return substeps_cooperative
-    if max_registers not in _CAPPED:
-        _CAPPED[max_registers] = cuda.jit(max_registers=int(max_registers))(substeps_cooperative.py_func)
-    return _CAPPED[max_registers]
+        return base
+    key = (int(max_registers), optional)
+    if key not in _CAPPED:
+        _CAPPED[key] = cuda.jit(max_registers=int(max_registers))(base.py_func)
+    return _CAPPED[key]
 
 
 # ----------------------------------------------------------------------------
@@ -328,13 +398,13 @@ def node_substep_kernel(w_time, vel, vel_sum, sigma, ptr, elems, wb, wc, m_dt, f
 
 @cuda.jit
 def element_substep_kernel(dt_s, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c, sigma_t,
-                           td, heal_rate, e_dt, gamma, pmax, use_pmax, kxx, kxy, kss, q, denom, max_damage, E0,
-                           lambda0, alpha, damaged_flag, counters):
+                           td, heal_rate, e_dt, gamma, pmax, use_pmax, keep_mean, theta, dilat, kxx, kxy, kss, q,
+                           denom, max_damage, E0, lambda0, alpha, damaged_flag, counters):
     capped = 0
     for e in range(cuda.grid(1), tri.shape[0], cuda.gridsize(1)):
         capped += element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigma_c, sigma_t,
-                                 td, heal_rate, e_dt, gamma, pmax, use_pmax, dt_s, kxx, kxy, kss, q, denom,
-                                 max_damage, E0, lambda0, alpha, damaged_flag)
+                                 td, heal_rate, e_dt, gamma, pmax, use_pmax, keep_mean, theta, dilat, dt_s, kxx,
+                                 kxy, kss, q, denom, max_damage, E0, lambda0, alpha, damaged_flag)
     if capped:
         cuda.atomic.add(counters, C_CAPPED, capped)
 
