@@ -43,7 +43,18 @@ pack, isobar0's share of damage gain under pressure falls below 0.6 (shipped: 0.
 storm windows press less than 0.7 of the interior (shipped: 0.79-0.91); turn25, which turned the
 drift by about 10 deg only, moves the share by less than 0.1.
 
+Is the weather wider than the basin? (2026-11-27/28, twenty-first session; mechanism
+diagnostics, not candidates): with ``--experiment NAME`` the script runs an experiment of
+``physics_experiments.py`` (its basin, resolution and overrides, in its own folder, so that
+``physics_experiments.py`` finds it finished) and stores that script's record as well, with the
+window statistics. The experiments and the rule stated before their runs (23:40 UTC) are in
+``physics_experiments.py`` ("storms as wide as the basin?"): ``F10x2-hthick`` (the basin twice as
+wide), ``F10-hthick-halfwx`` / ``F10s-hthick-halfwx`` (the climatology's lengths halved) and the
+control month ``F10-hthick-1125-w2027``. Result: rejected; the share under pressure is 0.80 in the
+wide basin and 0.72-0.73 under the half-scale weather (docs/physics.md §4).
+
     python benchmarks/envelope_branches.py closed strait --jobs 2   # both basins, 28 days
+    python benchmarks/envelope_branches.py --experiment F10-hthick-halfwx F10s-hthick-halfwx --jobs 2
     python benchmarks/envelope_branches.py closed --set forcing.drag.turning_angle_deg=25 --label turn25
     python benchmarks/envelope_branches.py --table                   # the stored result
 """
@@ -98,16 +109,18 @@ def window_sums(steps: list, n_windows: int, start_day: float = WINDOW_START_DAY
     return out
 
 
-def run(basin: str, days: float = 28.0, sets: tuple = (), label: str | None = None) -> dict:
+def run(basin: str, days: float = 28.0, sets: tuple = (), label: str | None = None,
+        out_dir: Path | None = None) -> dict:
     """One month of the scene of ``basin`` with the per-step callback; returns the record.
     ``sets``: ``KEY=VALUE`` overrides (diagnostics: another configuration), recorded under
-    ``label`` (default: the basin's name)."""
+    ``label`` (default: the basin's name); the run's folder is ``out_dir`` (default
+    ``branches-LABEL``)."""
     from lagice.diagnostics.faults import interior_triangles
-    from lagice.scenes.builder import build_simulation
+    from lagice.scenes.builder import build_simulation, finish
     from lagice.scenes.config import load_scene, split_overrides
 
     name = label or basin
-    out_dir = OUT / f"branches-{name}"
+    out_dir = out_dir or OUT / f"branches-{name}"
     ov = {"run.duration": f"{days:g}d", "output.every": "1d", "output.plot": False, "run.progress": False,
           "checkpoint.every": "7d", **dict(split_overrides(list(sets)))}
     sim = build_simulation(load_scene(SCENES[basin], ov), out_dir)
@@ -141,7 +154,7 @@ def run(basin: str, days: float = 28.0, sets: tuple = (), label: str | None = No
 
     sim.add_callback(after_step, "1 steps", name="envelope_branches")
     t0 = time.perf_counter()
-    sim.run()
+    finish(sim)  # as `lagice run` does: the run, then summary.json (which physics_experiments.py reads)
     n_win = int((days - WINDOW_START_DAY) // WINDOW_DAYS)
     (OUT / f"branches-{name}-steps.json").write_text(json.dumps(steps))
     return {"label": name, "basin": basin, "scene": SCENES[basin], "overrides": list(sets), "days": days,
@@ -151,16 +164,42 @@ def run(basin: str, days: float = 28.0, sets: tuple = (), label: str | None = No
             "month": window_sums(steps, 1, start_day=0.0, width=days)[0]}
 
 
+def run_experiment(name: str) -> dict:
+    """Experiment ``name`` of ``physics_experiments.py`` run here, in its own folder and with its
+    overrides (the same settings as its ``lagice run`` command), then analysed and stored by
+    that script; the envelope record gets the window statistics' medians and the drift."""
+    import physics_experiments as pe
+
+    scene, overrides, res, days, _what = pe.EXPERIMENTS[name]
+    sets = (f"domain.resolution_m={res:g}", *overrides)
+    rec = run(scene, days, sets, label=name, out_dir=pe.OUT / name)
+    stats = pe.run_experiment(name, run=False)
+    rec["statistics"] = {"median": stats["median"], "inside": stats["inside"], "drift": stats["drift"],
+                         "remesh_count": stats["remesh_count"]}
+    return rec
+
+
+def _summary(rec: dict) -> str:
+    """β and the rate of a record that has statistics, else a dash."""
+    st = rec.get("statistics")
+    if not st:
+        return "–"
+    med = st["median"]
+    return f"β {med['beta_space']:.3f}, {med['mean_total_deformation_rate_per_day']:.4f} d⁻¹"
+
+
 def table(records: dict) -> str:
     lines = ["| run | days | damage gain: cut-off / Coulomb, tensile mean / Coulomb, compressive mean "
-             "| event area, same order | interior area under compression (mean) |", "|---|---|---|---|---|"]
+             "| event area, same order | interior area under compression (mean) | month's medians |",
+             "|---|---|---|---|---|---|"]
     for basin, rec in records.items():
         for w in [rec["month"], *rec["windows"]]:
             g, a = w["damage_gain_fraction"], w["event_area_fraction"]
             days = f"{w['days'][0]:g}–{w['days'][1]:g}"
             lines.append(f"| {basin} | {days} | {g['cutoff']:.2f} / {g['coulomb_tension']:.2f} / "
                          f"{g['coulomb_compression']:.2f} | {a['cutoff']:.2f} / {a['coulomb_tension']:.2f} / "
-                         f"{a['coulomb_compression']:.2f} | {w['mean_compressed_area_fraction']:.2f} |")
+                         f"{a['coulomb_compression']:.2f} | {w['mean_compressed_area_fraction']:.2f} | "
+                         f"{_summary(rec) if w is rec['month'] else ''} |")
     return "\n".join(lines)
 
 
@@ -173,7 +212,15 @@ def main(argv=None):
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="an override for a diagnostic configuration (needs --label and one basin)")
     ap.add_argument("--label", help="the record's name for a run with --set")
+    ap.add_argument("--experiment", nargs="+", default=[], metavar="NAME",
+                    help="experiments of physics_experiments.py, run in their own folders and stored by both scripts")
     a = ap.parse_args(argv)
+    if a.experiment and (a.basins or a.set or a.label):
+        ap.error("--experiment takes no basin, --set or --label (the experiment defines them)")
+    if a.experiment:
+        import physics_experiments as pe
+
+        pe.check_names(a.experiment)
     bad = [b for b in a.basins if b not in SCENES]
     if bad:
         ap.error(f"unknown basin(s) {bad}: expected any of {sorted(SCENES)}")
@@ -182,10 +229,12 @@ def main(argv=None):
     if a.label in SCENES:
         ap.error(f"--label {a.label!r} is a basin's own record; choose another name")
     records = json.loads(PUBLISHED.read_text()) if PUBLISHED.exists() else {}
-    if a.basins:
+    if a.basins or a.experiment:
         with ProcessPoolExecutor(max_workers=a.jobs) as ex:
             n = len(a.basins)
-            for rec in ex.map(run, a.basins, [a.days] * n, [tuple(a.set)] * n, [a.label] * n):
+            jobs = (ex.map(run_experiment, a.experiment) if a.experiment else
+                    ex.map(run, a.basins, [a.days] * n, [tuple(a.set)] * n, [a.label] * n))
+            for rec in jobs:
                 print(f"branches: {rec['label']} done in {rec['wall_s']} s ({rec['steps_read']} steps read, "
                       f"{rec['steps_skipped_remesh']} with a remesh skipped)", flush=True)
                 # read again before writing: another invocation may have stored its record meanwhile

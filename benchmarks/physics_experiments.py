@@ -1128,6 +1128,67 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # The refrozen leads heal, the pack deforms more evenly (lighter tails, larger active area) and, in
 # the closed basin, more slowly; the interior closes as a whole as before.
 
+# --- 2026-11-27/28 (twenty-first session): storms as wide as the basin? (diagnostics) ------------
+# The twentieth session found that 72-77 % of the flagship's interior damage gain comes in shear
+# under a compressive mean stress, and ruled out the cyclones' inflow (docs/physics.md §4, "Where
+# the pack fails"). The reading it left untested: the climatology's weather is as wide as the
+# 1000 km basin (background wind e-folding over 1000 km, cyclone radii 300-900 km), so a storm pushes
+# the whole pack one way, against a coast. Two ways to make the weather narrower than the basin,
+# run by benchmarks/envelope_branches.py --experiment (the same runs as `run NAME`, with the
+# per-step classes; not candidates):
+# * F10x2-hthick: the validation month (wind seed 2026) in the basin twice as wide, from its own
+#   14-day spin-up (H10x2). Storm/basin width halved, and the fetch doubled.
+# * F10-hthick-halfwx / F10s-hthick-halfwx: the 1000 km basins under the weather of a basin twice
+#   as wide shrunk by 2: every length of the climatology halved (background e-folding 500 km,
+#   shortest wave 50 km on 6.25 km records, cyclone radii 150-450 km), cyclone depths halved (the
+#   same winds, which scale as depth/radius), four times the births per area (the same cover of
+#   the domain by storms) and the steering and cyclone speeds halved (the same time for a system
+#   to pass its own width). Storm/basin width halved, the fetch unchanged. It moves the wind's
+#   spatial e-folding out of its band (§1): a mechanism test only.
+# * control: the month of wind seed 2027 in the shipped closed basin (F10-hthick-1125-w2027, whose
+#   statistics are published), for the spread of the shares between two months.
+# Stated before the runs (2026-11-27, 23:40 UTC): the reading holds if, in both the wide basin and
+# the half-scale weather, the month's share of the damage gain under pressure falls below 0.6
+# (shipped 0.77 closed, 0.72 strait) and the storm windows (the three with the most damage gain)
+# press less than 0.7 of the interior on average (shipped 0.79-0.91), while the control month stays
+# within 0.1 of 0.77. Predicted: the shares fall in the wide basin and the half-scale weather (to
+# 0.5-0.65), and beta stays below 0.1 in every run (the wide basin's four earlier months had 0.019-
+# 0.047).
+HALF_SCALE_WEATHER = ["forcing.grid_spacing_m=6250", "forcing.wind.correlation_length_m=500e3",
+                      "forcing.wind.shortest_wavelength_m=50e3", "forcing.wind.cyclone_radius_median_m=225e3",
+                      "forcing.wind.cyclone_radius_range_m=[150e3, 450e3]", "forcing.wind.cyclone_depth_mean_hpa=10",
+                      "forcing.wind.cyclone_depth_max_hpa=25", "forcing.wind.cyclone_rate_per_mkm2_day=0.32",
+                      "forcing.wind.steering_m_s=[2.5, 0.0]", "forcing.wind.cyclone_speed_std_m_s=1.5"]
+EXPERIMENTS["F10x2-hthick"] = ("closed", [f"domain.file={BASIN_X2}"] + from_spinup("H10x2"), 10e3, 28,
+                               "F10-hthick-1125 (the validation month) in the basin twice as wide, own spin-up "
+                               "(diagnostic)")
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    EXPERIMENTS[f"{_p}-hthick-halfwx"] = (_basin, from_spinup("H1125") + HALF_SCALE_WEATHER, 10e3, 28,
+                                          f"{_p}-hthick-1125 under the weather of a basin twice as wide shrunk "
+                                          "by 2: every length of the climatology halved (diagnostic)")
+# Result of the first month (2026-11-27, 23:44 UTC): the half-scale weather does not move the share
+# under pressure (0.73 closed, 0.72 strait: the prediction failed), but the interior no longer closes
+# as a whole (net-divergence ratio -0.29 and -0.34 against -0.73 and -0.71; beta_components.py), while
+# beta stays (0.043, 0.040; its shear part 0.040, 0.038). So the weather's width sets the coherent
+# closing, and neither it nor the branch sets beta.
+# Two more months per basin (wind seeds 2027 and 2028), each beside the same month under the shipped
+# weather (F10[s]-hthick-1125-w2027/-w2028, published; rerun here for their folders, which the
+# component split and the classes read). Stated before the runs (2026-11-27, 23:46 UTC): in each of
+# the four month-basins the half-scale weather's net-divergence ratio (median over the windows) is
+# less negative than the shipped weather's by 0.2 or more, its beta is within 0.02 of the shipped
+# weather's, and its share of the damage gain under pressure within 0.1 of it.
+for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
+    for _seed in (2027, 2028):
+        EXPERIMENTS[f"{_p}-hthick-halfwx-w{_seed}"] = (
+            _basin, from_spinup("H1125") + HALF_SCALE_WEATHER + [f"forcing.wind.seed={_seed}"], 10e3, 28,
+            f"{_p}-hthick-halfwx, the weather of wind seed {_seed} (diagnostic)")
+# Result (2026-11-28, 00:45 UTC; docs/physics.md §4, "Is the weather too wide for the basin?"): the
+# net-divergence ratio rose by 0.2 or more in 3 of 4 month-basins (the strait of seed 2027 by 0.18),
+# beta stayed within 0.02 in 3 of 4 (the closed basin of seed 2027 moved 0.023), and the share under
+# pressure fell by 0.14-0.19 in all 4: the half-scale weather locks the pack in both months (0.0000-
+# 0.0005 per day), and a locked pack's damage gain comes more often with a tensile mean. The wide basin
+# (F10x2-hthick): share 0.80, rate 0.0102 per day (in the band), beta 0.056. The reading is rejected.
+
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
@@ -1576,6 +1637,10 @@ LEADS = (
     ("internal friction μ = 0.49 (−50 %)", "X10h-mu049", None, "The internal friction"),
     ("internal friction μ = 1.47 (+50 %)", "X10h-mu147", None, "The internal friction"),
     ("undamaged new ice (neXtSIM-DG)", "F10-hthick-1125-newice", "F10s-hthick-1125-newice", "Undamaged new ice"),
+    ("every length of the weather halved (a mechanism diagnostic)", "F10-hthick-halfwx", "F10s-hthick-halfwx",
+     "Is the weather too wide for the basin?"),
+    ("the basin twice as wide (own spin-up; a diagnostic)", "F10x2-hthick", None,
+     "Is the weather too wide for the basin?"),
 )
 
 

@@ -1,6 +1,7 @@
 """Benchmark helpers that change what a benchmark builds (benchmarks/scene_runs.py)."""
 from __future__ import annotations
 
+import dataclasses
 import re
 import sys
 from pathlib import Path
@@ -517,3 +518,35 @@ def test_envelope_branch_classes_are_the_branches_dcrit_scales_onto():
     assert [x["steps"] for x in window_sums(steps, 1)] == [2]  # the validation's first window, (1, 4]
     assert w[0]["event_area_fraction"] == dict(zip(CLASSES, [round(1 / 6, 4), round(2 / 6, 4), 0.5]))
     assert w[0]["damage_gain_fraction"]["coulomb_compression"] == 0.75 and w[0]["damage_gain_m2"] == 12.0
+
+
+def test_half_scale_weather_halves_every_length_and_keeps_the_winds():
+    """physics_experiments.HALF_SCALE_WEATHER (a mechanism diagnostic of docs/physics.md §4): the
+    weather of a basin twice as wide shrunk by 2. Every length of the climatology is halved, the
+    speeds that carry the weather too (the same time for a system to cross its own width), the
+    births per area are x4 (the same cover of the domain), and a cyclone's wind, which scales as
+    depth/radius, is unchanged: the median cyclone of each set has the same largest wind. The
+    records are fine enough for the shortest wave (the scene refuses fewer than 8 points per
+    wavelength)."""
+    import physics_experiments as pe
+
+    from forcing.climatology import ClimatologyParams, CycloneTrack
+    from lagice.scenes.config import _split
+
+    sets = dict(_split(s) for s in pe.HALF_SCALE_WEATHER)
+    wind = {k.removeprefix("forcing.wind."): v for k, v in sets.items() if k.startswith("forcing.wind.")}
+    half, full = ClimatologyParams(**{k: tuple(v) if isinstance(v, list) else v for k, v in wind.items()}), \
+        ClimatologyParams()
+    for name in ("correlation_length_m", "shortest_wavelength_m", "cyclone_radius_median_m",
+                 "cyclone_depth_mean_hpa", "cyclone_depth_max_hpa", "cyclone_speed_std_m_s"):
+        assert getattr(half, name) == 0.5 * getattr(full, name), name
+    for name in ("cyclone_radius_range_m", "steering_m_s"):
+        assert np.allclose(getattr(half, name), 0.5 * np.asarray(getattr(full, name))), name
+    assert half.cyclone_rate_per_mkm2_day == 4.0 * full.cyclone_rate_per_mkm2_day
+    assert half.decorrelation_time_s == full.decorrelation_time_s and half.background_wind_std_m_s == \
+        full.background_wind_std_m_s
+    median = [CycloneTrack(0, 0, 0, 0, 0, p.cyclone_depth_mean_hpa, p.cyclone_radius_median_m, 1.0)
+              for p in (half, full)]
+    assert median[0].max_surface_wind_m_s(half) == pytest.approx(median[1].max_surface_wind_m_s(full), rel=1e-12)
+    assert half.shortest_wavelength_m / sets["forcing.grid_spacing_m"] >= 8.0
+    assert set(wind) <= {f.name for f in dataclasses.fields(ClimatologyParams)}
