@@ -1188,6 +1188,13 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # pressure fell by 0.14-0.19 in all 4: the half-scale weather locks the pack in both months (0.0000-
 # 0.0005 per day), and a locked pack's damage gain comes more often with a tensile mean. The wide basin
 # (F10x2-hthick): share 0.80, rate 0.0102 per day (in the band), beta 0.056. The reading is rejected.
+# Is the shear's coherence Maxwell-EB's or shared with EVP? EVP's validation-month runs (E10h, E10hs,
+# published) are run again for their folders, and beta_components.py splits their beta. Stated
+# before the runs (2026-11-28, 00:47 UTC): EVP's shear part of beta is within 0.02 of Maxwell-EB's
+# in each basin (0.045 closed, 0.057 strait), i.e. what keeps the shear from cancelling is shared by
+# the two rheologies, not Maxwell-EB's damage.
+# Result (2026-11-28, 01:00 UTC): EVP's shear part 0.040 closed (holds), 0.035 strait (misses by 0.002);
+# EVP's interior does not close as a whole (net-divergence ratio -0.00, +0.06 against -0.73, -0.71).
 
 
 def command(scene, overrides, res, days, out) -> list:
