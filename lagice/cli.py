@@ -272,6 +272,9 @@ def _diagnose(args) -> int:
     if w["remesh_events"]:
         print(f"  {w['remesh_events']} remesh event(s) in the window: nodes followed by node_id, "
               f"{w['n_elements_lost']} remeshed elements left out")
+    if w["n_elements_folded"]:
+        print(f"  {w['n_elements_folded']} element(s) inverted in the mid-window geometry left out "
+              f"({w['n_interior_folded']} inside the buffer)")
     if args.coast_buffer_km > 0:
         print(f"  {w['n_elements']} of {tri.shape[0]} elements are >= {args.coast_buffer_km:g} km from the boundary")
     res = diagnose_arrays(xy0, xy1, tri[w["interior"]], dt, out)
@@ -328,6 +331,9 @@ def _diagnose_windows(args, snaps, out, window_statistics) -> int:
         print(f"  days {w['start_day']:g}-{w['end_day']:g}: skipped: {w['reason']}")
     for w in res["windows"]:
         lost = f", {w['n_elements_lost']} remeshed left out" if w["n_elements_lost"] else ""
+        if w["n_elements_folded"]:
+            lost += (f", {w['n_elements_folded']} inverted in the mid-window geometry left out "
+                     f"({w['n_interior_folded']} inside the buffer)")
         print(f"  days {w['start_day']:g}-{w['end_day']:g}: {w['n_elements']} elements{lost}, "
               f"beta {_num(w['interior']['beta_space'])}")
     for key, med in res["median"].items():

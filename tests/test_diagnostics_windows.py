@@ -163,3 +163,74 @@ def test_window_statistics_as_rgps_would_see_them(shear_run):
     # the model part is unchanged by asking for the operator
     plain = window_statistics(shear_run, window_days=3.0, coast_buffer_km=60.0, start_day=1.0)
     assert plain["median"] == res["median"]
+
+
+# -- an eddy that folds elements in the mid-window geometry ----------------------------------
+R_EDDY = 200e3  # m: the eddy's radius
+PHI_EDDY = 4.0  # rad: how far its centre turns in the 3-day window
+
+
+def eddy_turn(r):
+    """Angle [rad] a point at radius r [m] turns in the window, and s = r dφ/dr."""
+    x = np.clip(r * r / R_EDDY**2, 0.0, 1.0)
+    return PHI_EDDY * (1.0 - x) ** 2, -4.0 * PHI_EDDY * x * (1.0 - x)
+
+
+def eddy(t, x, y):
+    dx, dy = np.asarray(x) - 0.5 * L, np.asarray(y) - 0.5 * L
+    w = eddy_turn(np.hypot(dx, dy))[0] / (3 * DAY)
+    return -w * dy, w * dx
+
+
+@pytest.fixture(scope="module")
+def eddy_run(tmp_path_factory):
+    """3 days of a steady eddy (differential rotation, no divergence) on a free 400 km square:
+    the ring that turns by a little more than half a turn while it is sheared has every element
+    fine at both ends, but inverted in the mid-window geometry (x0 + x1)/2."""
+    out = tmp_path_factory.mktemp("eddy_run")
+    poly, _ = rectangle_domain(L, L)
+    mesh = generate_mesh(poly, 10e3, exterior_tag="free")
+    st = IceState.uniform(mesh, thickness_m=1.0, concentration=1.0, cohesion_pa=1e9)
+    model = Model(st, solver=PrescribedStepper(mesh=mesh, velocity=eddy), mover=MeshMotion())
+    sim = Simulation(model, dt="1h", stop="3d", progress=False)
+    sim.output(every="3d", path=out / "snapshots", crs=None)
+    sim.run()
+    return out
+
+
+def test_windows_leave_out_and_count_elements_folded_mid_window(eddy_run, shear_run):
+    from lagice.diagnostics.faults import interior_triangles
+    from lagice.diagnostics.strain import triangle_geometry
+    from lagice.io.snapshots import load_window
+
+    w = load_window(eddy_run, 0.0, 3 * DAY)
+    xy0, xy1, tri = w["xy0"], w["xy1"], w["triangles"]
+    assert (triangle_geometry(xy0, tri)[0] > 0).all() and (triangle_geometry(xy1, tri)[0] > 0).all()
+    folded = triangle_geometry(0.5 * (xy0 + xy1), tri)[0] <= 0
+    # the folds are where the continuum map A = R(φ) [[1, 0], [s, 1]] (local radial/tangential
+    # frame) has det(I + A) = 2 + 2 cos φ − s sin φ < 0: turned past half a turn while sheared
+    r = np.hypot(*(xy0[tri].mean(axis=1) - 0.5 * L).T)
+    phi, s = eddy_turn(r)
+    det_mid = 2.0 + 2.0 * np.cos(phi) - s * np.sin(phi)
+    assert not np.any(folded & (det_mid > 0.2)) and not np.any(~folded & (det_mid < -0.2))
+    assert 50 < folded.sum() < 0.2 * tri.shape[0]
+
+    res = window_statistics(eddy_run, window_days=3.0, coast_buffer_km=60.0, start_day=0.0)
+    (win,) = res["windows"]
+    assert win["n_elements_folded"] == res["n_elements_folded"] == int(folded.sum())
+    _, _, kept, _, info = window_arrays(eddy_run, 0.0, 3 * DAY, coast_buffer_m=60e3)
+    inside = info["interior"]
+    assert win["n_elements_all"] == kept.shape[0] == tri.shape[0] - folded.sum()
+    assert 0 < win["n_interior_folded"] == res["n_interior_folded"] <= win["n_elements_folded"]
+    n_inside = int(interior_triangles(*w["start_mesh"], 60e3).sum())  # no remesh: every element followed
+    assert win["n_elements"] == int(inside.sum()) == n_inside - win["n_interior_folded"]
+    # the statistics are those of the unfolded elements
+    s_all = summarise(xy0, xy1, tri[~folded], 3 * DAY)
+    for k in ("mean_shear_s", "mean_total_s", "beta_space", "shear_divergence_r2"):
+        assert win["all"][k] == pytest.approx(s_all[k], rel=1e-12)
+    # the whole window as one set would raise (the diagnostics refuse an inverted cell) ...
+    with pytest.raises(ConfigError, match="non-positive area"):
+        summarise(xy0, xy1, tri, 3 * DAY)
+    # ... and a run without folds counts none and keeps every element
+    calm = window_statistics(shear_run, window_days=3.0, coast_buffer_km=60.0, start_day=1.0)
+    assert calm["n_elements_folded"] == 0 and all(x["n_elements_folded"] == 0 for x in calm["windows"])

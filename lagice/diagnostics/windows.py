@@ -51,15 +51,28 @@ def window_arrays(run_dir, start_s: float, end_s: float, coast_buffer_m: float =
     elements kept for the statistics.
 
     Returns ``(xy0, xy1, triangles, dt_s, info)``: ``triangles`` are the elements
-    present over the whole window (remeshed patches left out), ``info`` the window of
-    :func:`lagice.io.snapshots.load_window` (without its arrays) plus ``interior``
+    present over the whole window (remeshed patches left out) whose mid-window geometry
+    is not inverted (see below), ``info`` the window of
+    :func:`lagice.io.snapshots.load_window` (without its arrays; ``kept_elements``
+    indexes ``triangles`` in the first mesh) plus ``interior``
     (mask of the triangles at least ``coast_buffer_m`` [m] from the boundary of the
-    window's first mesh), ``n_elements`` (their number) and ``n_elements_all``.
+    window's first mesh), ``n_elements`` (their number), ``n_elements_all`` and
+    ``n_elements_folded``.
+
+    The statistics take each element's gradient on its mid-window geometry
+    ``(x0 + x1)/2`` (:mod:`lagice.diagnostics.strain`). The model keeps every element
+    counter-clockwise at every step, but an element that turns by about half a turn
+    while it is sheared (in a fault or an eddy) can have a mid-window triangle with a
+    non-positive area although both ends are fine: its Lagrangian rate is then
+    undefined. Such an element is left out of ``triangles`` and counted in
+    ``n_elements_folded`` (and ``n_interior_folded`` for those inside the buffer), as RGPS
+    leaves out cells it cannot follow; nothing is left out silently.
     A run on a fixed mesh (no node moved) is a Eulerian run: its displacement over
     the window is taken as Δt × the mean of the velocities at both ends. Raises
     :class:`~lagice.errors.ConfigError` naming ``coast_buffer_km`` when fewer than
     ``min_elements`` elements are that far from the boundary."""
     from lagice.diagnostics.faults import interior_triangles
+    from lagice.diagnostics.strain import triangle_geometry
     from lagice.io.snapshots import load_window
 
     if not (math.isfinite(coast_buffer_m) and coast_buffer_m >= 0):
@@ -72,14 +85,22 @@ def window_arrays(run_dir, start_s: float, end_s: float, coast_buffer_m: float =
     if inside.sum() < min_elements:
         raise ConfigError(f"coast_buffer_km = {coast_buffer_m / 1e3:g}: only {int(inside.sum())} elements lie that "
                           f"far from the boundary (at least {min_elements} needed); use a smaller buffer")
-    keep = inside[w["kept_elements"]]
+    kept = np.asarray(w["kept_elements"])
+    keep = inside[kept]
+    unfolded = triangle_geometry(0.5 * (xy0 + xy1), tri)[0] > 0.0  # False for NaN too
+    n_folded = int(tri.shape[0] - unfolded.sum())
+    n_interior_folded = int(np.sum(keep & ~unfolded))
+    if n_folded:
+        tri, kept, keep = tri[unfolded], kept[unfolded], keep[unfolded]
     if keep.sum() < min_elements:
+        folded = f", {n_interior_folded} more inverted in the mid-window geometry" if n_interior_folded else ""
         raise WindowError(f"{run_dir}: window {w['start_s'] / DAY_S:g}-{w['end_s'] / DAY_S:g} days: only "
                           f"{int(keep.sum())} of the {int(inside.sum())} elements >= {coast_buffer_m / 1e3:g} km "
                           f"from the boundary can be followed through the window ({w['remesh_events']} remesh "
-                          f"event(s) replaced {w['n_elements_lost']} elements); choose other windows")
+                          f"event(s) replaced {w['n_elements_lost']} elements{folded}); choose other windows")
     info = {k: v for k, v in w.items() if k not in ("xy0", "xy1", "triangles", "datasets")}
-    info.update(n_elements=int(keep.sum()), n_elements_all=int(tri.shape[0]), interior=keep)
+    info.update(kept_elements=kept, n_elements=int(keep.sum()), n_elements_all=int(tri.shape[0]), interior=keep,
+                n_elements_folded=n_folded, n_interior_folded=n_interior_folded)
     return xy0, xy1, tri, dt, info
 
 
@@ -89,7 +110,9 @@ def window_summary(run_dir, start_s: float, window_s: float, coast_buffer_m: flo
     """Statistics of one Lagrangian window ``[start_s, start_s + window_s]`` [s].
 
     Returns ``{"start_day", "end_day", "n_elements" (kept), "n_elements_all",
-    "remesh_events", "n_elements_lost", "interior": {...}, "all": {...}}`` with the
+    "remesh_events", "n_elements_lost", "n_elements_folded", "n_interior_folded" (elements left out
+    because their mid-window geometry is inverted: :func:`window_arrays`), "interior": {...},
+    "all": {...}}`` with the
     :data:`WINDOW_KEYS` of :func:`lagice.diagnostics.summarise` on the elements
     ``coast_buffer_m`` [m] from the boundary (``interior``) and on all elements.
     ``keep_arrays``: ``interior`` also holds ``"_map"`` = (element-map node
@@ -104,7 +127,8 @@ def window_summary(run_dir, start_s: float, window_s: float, coast_buffer_m: flo
     xy0, xy1, tri, dt, info = window_arrays(run_dir, start_s, start_s + window_s, coast_buffer_m)
     out = {"start_day": info["start_s"] / DAY_S, "end_day": info["end_s"] / DAY_S,
            "n_elements": info["n_elements"], "n_elements_all": info["n_elements_all"],
-           "remesh_events": info["remesh_events"], "n_elements_lost": info["n_elements_lost"]}
+           "remesh_events": info["remesh_events"], "n_elements_lost": info["n_elements_lost"],
+           "n_elements_folded": info["n_elements_folded"], "n_interior_folded": info["n_interior_folded"]}
     for name, sub in (("interior", tri[info["interior"]]), ("all", tri)):
         s = summarise(xy0, xy1, sub, dt)
         arr = s.pop("_arrays")
@@ -161,6 +185,8 @@ def window_statistics(run_dir, window_days: float = 3.0, coast_buffer_km: float 
 
     Returns ``{"window_days", "coast_buffer_km", "start_day", "windows": [per-window
     dicts of :func:`window_summary`], "skipped": [{"start_day", "end_day", "reason"}],
+    "n_elements_folded", "n_interior_folded" (summed over the windows: elements left out because
+    their mid-window geometry is inverted, :func:`window_arrays`),
     "median", "min", "max": {metric: value over the windows, interior elements},
     "median_all_elements": {metric: median, all elements}}``. A window in which
     remeshing replaced (nearly) all the elements cannot be followed: it is listed
@@ -187,6 +213,8 @@ def window_statistics(run_dir, window_days: float = 3.0, coast_buffer_km: float 
 
     out = {"window_days": float(window_days), "coast_buffer_km": float(coast_buffer_km),
            "start_day": float(start_day), "windows": windows, "skipped": skipped,
+           "n_elements_folded": int(sum(w["n_elements_folded"] for w in windows)),
+           "n_interior_folded": int(sum(w["n_interior_folded"] for w in windows)),
            "median": over(np.median, "interior"), "min": over(np.min, "interior"),
            "max": over(np.max, "interior"), "median_all_elements": over(np.median, "all")}
     if rgps_tracking_error_m is not None:
