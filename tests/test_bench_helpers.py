@@ -550,3 +550,41 @@ def test_half_scale_weather_halves_every_length_and_keeps_the_winds():
     assert median[0].max_surface_wind_m_s(half) == pytest.approx(median[1].max_surface_wind_m_s(full), rel=1e-12)
     assert half.shortest_wavelength_m / sets["forcing.grid_spacing_m"] >= 8.0
     assert set(wind) <= {f.name for f in dataclasses.fields(ClimatologyParams)}
+
+
+def test_beta_vs_damage_reads_the_interiors_damage_at_the_window_start(tmp_path):
+    """``beta_vs_damage.py``: the area-weighted mean damage and broken share of the elements
+    >= 100 km from the boundary, read from a real run's snapshot, against the same numbers
+    computed here from the mesh with shapely."""
+    import shapely
+    from beta_vs_damage import start_damage
+
+    from lagice.errors import ConfigError
+    from lagice.mesh import generate_mesh, rectangle_domain
+    from lagice.model import Model
+    from lagice.simulation import Simulation
+    from lagice.solvers import PrescribedStepper
+    from lagice.state import IceState
+
+    side = 400e3
+    poly, _ = rectangle_domain(side, side)
+    mesh = generate_mesh(poly, 25e3, exterior_tag="free")
+    cen = mesh.nodes[mesh.triangles].mean(axis=1)
+    st = IceState.uniform(mesh, thickness_m=1.0, concentration=1.0, cohesion_pa=1e9)
+    st.damage = np.where(cen[:, 0] < 0.5 * side, 0.95, 0.2)  # broken west, sound east
+    model = Model(st, solver=PrescribedStepper(mesh=mesh, velocity=lambda t, x, y: (0 * x, 0 * y)))
+    sim = Simulation(model, dt="6h", stop="1d", progress=False)
+    sim.output(every="1d", path=tmp_path / "run" / "snapshots", crs=None)
+    sim.run()
+    res = start_damage(tmp_path / "run", 0.0)
+    inner = shapely.distance(shapely.points(cen), shapely.box(0, 0, side, side).exterior) >= 100e3
+    p = mesh.nodes[mesh.triangles]
+    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+                        - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
+    a, d = area[inner], st.damage[inner]
+    assert 0.3 < a[d > 0.9].sum() / a.sum() < 0.7  # the interior straddles the split
+    assert res["broken_area_share"] == pytest.approx(a[d > 0.9].sum() / a.sum(), rel=1e-12)
+    assert res["mean_damage"] == pytest.approx(np.sum(a * d) / a.sum(), rel=1e-12)
+    assert res["snapshot_day"] == 0.0
+    with pytest.raises(ConfigError, match="no snapshot within an hour of day 0.5"):
+        start_damage(tmp_path / "run", 0.5)
