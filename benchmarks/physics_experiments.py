@@ -1237,6 +1237,18 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # these 6 month-basins, and the medians over its four months put 4 bands or more inside in each
 # basin. Predicted: it holds in the windy month (2027) and not in the calm ones (2028, 2029), where
 # an intact pack stays locked: 2-3 of 6 month-basins gain, so the rule fails.
+# The basin twice as wide put the rate inside its band in the validation month (F10x2-hthick:
+# 0.0102 per day) and not in the calm month (F10x2-hthick-w2028: 0.0020). Its other two months of
+# the ensemble (ENSEMBLE_SEEDS 2027 and 2029), so that the wide basin has the four months the
+# shipped basin's ensemble started with. A diagnostic of the width, not a candidate (the shipped
+# scene keeps its 1000 km basin). Stated before the runs (2026-11-28, 01:56 UTC): the width
+# explains the rate's miss if the four months' median rate is inside the band (>= 0.01 per day).
+# Predicted: the windy month (2027; 0.0073 per day in the shipped basin) is inside (about 0.02),
+# the calm one (2029; 0.0003) is not (about 0.002), so the median is about 0.006 and the rule fails.
+for _seed in (2027, 2029):
+    EXPERIMENTS[f"F10x2-hthick-w{_seed}"] = (
+        "closed", [f"domain.file={BASIN_X2}", f"forcing.wind.seed={_seed}"] + from_spinup("H10x2"), 10e3, 28,
+        f"F10-hthick-1125-w{_seed} in the basin twice as wide (diagnostic)")
 for _seed in ENSEMBLE_SEEDS:
     for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
         EXPERIMENTS[f"{_p}-hthick-1125-intact-w{_seed}"] = (
