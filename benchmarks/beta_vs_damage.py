@@ -43,7 +43,8 @@ BROKEN = 0.9
 def start_damage(run_dir, day: float, buffer_m: float = BUFFER_M) -> dict:
     """The interior's damage in the snapshot nearest ``day`` [days]: ``mean_damage``
     (area-weighted over the elements whose centroid is >= ``buffer_m`` [m] from the mesh
-    boundary) and ``broken_area_share`` (their area with damage > :data:`BROKEN`).
+    boundary), ``broken_area_share`` (their area with damage > :data:`BROKEN`), and the sums
+    ``damage_area_m2`` (Σ d·A) and ``area_m2`` (Σ A) over those elements.
     Raises ConfigError when no snapshot lies within an hour of ``day``."""
     idx = read_index(run_dir)
     times = np.array([e["time_s"] for e in idx])
@@ -62,7 +63,8 @@ def start_damage(run_dir, day: float, buffer_m: float = BUFFER_M) -> dict:
     area = np.abs(triangle_geometry(xy, tri)[0])[inner]
     d = damage[inner]
     return {"snapshot_day": float(times[i] / DAY_S), "mean_damage": float(np.sum(area * d) / area.sum()),
-            "broken_area_share": float(area[d > BROKEN].sum() / area.sum())}
+            "broken_area_share": float(area[d > BROKEN].sum() / area.sum()),
+            "damage_area_m2": float(np.sum(area * d)), "area_m2": float(area.sum())}
 
 
 def rows_for(name: str, records: dict, runs: Path = RUNS) -> list:

@@ -57,6 +57,11 @@ wide basin and 0.72-0.73 under the half-scale weather (docs/physics.md §4).
     python benchmarks/envelope_branches.py --experiment F10-hthick-halfwx F10s-hthick-halfwx --jobs 2
     python benchmarks/envelope_branches.py closed --set forcing.drag.turning_angle_deg=25 --label turn25
     python benchmarks/envelope_branches.py --table                   # the stored result
+    python benchmarks/envelope_branches.py --budget closed F10-hthick-halfwx-w2028   # damage budgets
+
+``--budget RECORD ...`` (2026-11-28): per window, the interior's damage gain of the stored record
+against the net change of its Σ d·A between the run's snapshots at the window's ends; the
+difference is what healing took away (docs/physics.md §4, "The damage budget").
 """
 from __future__ import annotations
 
@@ -179,6 +184,39 @@ def run_experiment(name: str) -> dict:
     return rec
 
 
+def damage_budget(rec: dict, run_dir: Path) -> list:
+    """Per window of a record: the interior's damage gain (the per-step record: the steps whose
+    damage rose, net of their own healing), its net change between the snapshots at the window's
+    ends (Σ d·A over the elements >= 100 km from the boundary, each on its own mesh) and the
+    difference, ``healed_m2`` = gain − net: what healing took away, plus the steps with a remesh
+    (skipped by the record) and the remapping's change of the interior's Σ d·A."""
+    from beta_vs_damage import start_damage
+
+    rows = []
+    for w in rec["windows"]:
+        d0, d1 = w["days"]
+        a, b = start_damage(run_dir, d0, BUFFER_M), start_damage(run_dir, d1, BUFFER_M)
+        net = b["damage_area_m2"] - a["damage_area_m2"]
+        rows.append({"days": [d0, d1], "gain_m2": w["damage_gain_m2"], "net_m2": net,
+                     "healed_m2": w["damage_gain_m2"] - net, "interior_area_m2": a["area_m2"],
+                     "mean_damage_start": a["mean_damage"], "mean_damage_end": b["mean_damage"]})
+    return rows
+
+
+def budget_table(name: str, rows: list, rates: list | None = None) -> str:
+    """The damage budget of :func:`damage_budget` as a table [10⁹ m²], with the window's rate."""
+    lines = [f"| {name}: days | rate day⁻¹ | gain | net change | healed (gain − net) | mean damage, start → end |",
+             "|---|---|---|---|---|---|"]
+    for i, r in enumerate(rows):
+        rate = f"{rates[i]:.4f}" if rates else "–"
+        lines.append(f"| {r['days'][0]:g}–{r['days'][1]:g} | {rate} | {r['gain_m2'] / 1e9:.1f} | "
+                     f"{r['net_m2'] / 1e9:+.1f} | {r['healed_m2'] / 1e9:.1f} | "
+                     f"{r['mean_damage_start']:.3f} → {r['mean_damage_end']:.3f} |")
+    g, n = sum(r["gain_m2"] for r in rows), sum(r["net_m2"] for r in rows)
+    lines.append(f"| month | | {g / 1e9:.0f} | {n / 1e9:+.0f} | {(g - n) / 1e9:.0f} | |")
+    return "\n".join(lines)
+
+
 def _summary(rec: dict) -> str:
     """β and the rate of a record that has statistics, else a dash."""
     st = rec.get("statistics")
@@ -214,7 +252,12 @@ def main(argv=None):
     ap.add_argument("--label", help="the record's name for a run with --set")
     ap.add_argument("--experiment", nargs="+", default=[], metavar="NAME",
                     help="experiments of physics_experiments.py, run in their own folders and stored by both scripts")
+    ap.add_argument("--budget", nargs="+", default=[], metavar="RECORD",
+                    help="stored records: the interior's damage gain against its net change per window "
+                         "(from the run's snapshots), stored in the record as damage_budget")
     a = ap.parse_args(argv)
+    if a.budget:
+        return budget(a.budget)
     if a.experiment and (a.basins or a.set or a.label):
         ap.error("--experiment takes no basin, --set or --label (the experiment defines them)")
     if a.experiment:
@@ -245,6 +288,32 @@ def main(argv=None):
         print(table(records))
     elif not a.basins:
         sys.exit("no stored result: run the basins first")
+
+
+#: the run folders of the basins' own records (the run of ``physics_experiments.py`` with the same
+#: settings: the shipped spin-up, the validation month)
+BASIN_RUNS = {"closed": "F10-hthick-1125", "strait": "F10s-hthick-1125"}
+
+
+def budget(names: list) -> int:
+    """``--budget``: :func:`damage_budget` of stored records, printed and stored in each record."""
+    records = json.loads(PUBLISHED.read_text())
+    physics = json.loads((ROOT / "docs" / "figures" / "physics_experiments.json").read_text())
+    for name in names:
+        if name not in records:
+            sys.exit(f"branches: no stored record {name!r}; known: {sorted(records)}")
+        run_name = BASIN_RUNS.get(name, name)
+        run_dir = OUT / run_name if run_name != name or (OUT / name).exists() else OUT / f"branches-{name}"
+        if not (run_dir / "snapshots").exists():
+            sys.exit(f"branches: {name}: no snapshots in {run_dir}")
+        rows = damage_budget(records[name], run_dir)
+        rates = ([w["mean_total_s"] * DAY for w in physics[run_name]["per_window"]]
+                 if run_name in physics else None)
+        print(budget_table(name, rows, rates))
+        stored = json.loads(PUBLISHED.read_text())
+        stored[name]["damage_budget"] = rows
+        PUBLISHED.write_text(json.dumps(stored, indent=1) + "\n")
+    return 0
 
 
 if __name__ == "__main__":

@@ -588,3 +588,41 @@ def test_beta_vs_damage_reads_the_interiors_damage_at_the_window_start(tmp_path)
     assert res["snapshot_day"] == 0.0
     with pytest.raises(ConfigError, match="no snapshot within an hour of day 0.5"):
         start_damage(tmp_path / "run", 0.5)
+
+
+def test_damage_budget_takes_the_net_change_from_the_snapshots(tmp_path):
+    """``envelope_branches.py --budget``: per window, net = the change of the interior's Σ d·A
+    between the snapshots at the window's ends, and healed = gain − net. A real run whose damage
+    is set between its two days: the first window has no change (healed = gain), the second the
+    change made here."""
+    from envelope_branches import budget_table, damage_budget
+
+    from lagice.diagnostics.faults import interior_triangles
+    from lagice.mesh import generate_mesh, rectangle_domain
+    from lagice.model import Model
+    from lagice.simulation import Simulation
+    from lagice.solvers import PrescribedStepper
+    from lagice.state import IceState
+
+    side = 400e3
+    poly, _ = rectangle_domain(side, side)
+    mesh = generate_mesh(poly, 25e3, exterior_tag="free")
+    st = IceState.uniform(mesh, thickness_m=1.0, concentration=1.0, cohesion_pa=1e9)
+    st.damage = np.full(mesh.n_elements, 0.5)
+    model = Model(st, solver=PrescribedStepper(mesh=mesh, velocity=lambda t, x, y: (0 * x, 0 * y)))
+    sim = Simulation(model, dt="6h", stop="2d", progress=False)
+    sim.output(every="1d", path=tmp_path / "run" / "snapshots", crs=None)
+    sim.run(n_steps=4)  # day 1 written with d = 0.5
+    model.state.damage = np.full(mesh.n_elements, 0.8)
+    sim.run()
+    rec = {"windows": [{"days": [0.0, 1.0], "damage_gain_m2": 7.0e9}, {"days": [1.0, 2.0], "damage_gain_m2": 9.0e10}]}
+    rows = damage_budget(rec, tmp_path / "run")
+    p = mesh.nodes[mesh.triangles]
+    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+                        - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
+    a_in = area[interior_triangles(mesh.nodes, mesh.triangles, 100e3)].sum()
+    assert rows[0]["net_m2"] == pytest.approx(0.0, abs=1e-6 * a_in) and rows[0]["healed_m2"] == pytest.approx(7.0e9)
+    assert rows[1]["net_m2"] == pytest.approx(0.3 * a_in, rel=1e-12)
+    assert rows[1]["healed_m2"] == pytest.approx(9.0e10 - 0.3 * a_in, rel=1e-12)
+    assert rows[1]["mean_damage_start"] == pytest.approx(0.5) and rows[1]["mean_damage_end"] == pytest.approx(0.8)
+    assert "| 1–2 |" in budget_table("t", rows) and f"| {9.0e10 / 1e9 + 7.0:.0f} |" in budget_table("t", rows)
