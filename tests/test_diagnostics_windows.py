@@ -231,6 +231,13 @@ def test_windows_leave_out_and_count_elements_folded_mid_window(eddy_run, shear_
     # the whole window as one set would raise (the diagnostics refuse an inverted cell) ...
     with pytest.raises(ConfigError, match="non-positive area"):
         summarise(xy0, xy1, tri, 3 * DAY)
+    # the command line says so, in the window's line, and writes the counts
+    r = _cli("diagnose", str(eddy_run), "--window-days", "3", "--start-day", "0", "--coast-buffer-km", "60",
+             "--out", str(eddy_run / "win"))
+    assert (f"{win['n_elements_folded']} inverted in the mid-window geometry left out "
+            f"({win['n_interior_folded']} inside the buffer)") in r.stdout
+    got = json.loads((eddy_run / "win" / "window_statistics.json").read_text())
+    assert got["n_interior_folded"] == win["n_interior_folded"] and got["median"] == res["median"]
     # ... and a run without folds counts none and keeps every element
     calm = window_statistics(shear_run, window_days=3.0, coast_buffer_km=60.0, start_day=1.0)
     assert calm["n_elements_folded"] == 0 and all(x["n_elements_folded"] == 0 for x in calm["windows"])
