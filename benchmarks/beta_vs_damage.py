@@ -95,6 +95,7 @@ def correlations(rows: list) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("runs", nargs="+", help="run names in benchmarks/out/physics with published records")
+    ap.add_argument("--out", type=Path, default=OUT, help=f"the JSON written (default {OUT.relative_to(ROOT)})")
     args = ap.parse_args(argv)
     records = json.loads(RECORDS.read_text())
     rows = [r for n in args.runs for r in rows_for(n, records)]
@@ -106,9 +107,9 @@ def main(argv=None) -> int:
     for k in ("mean_damage", "broken_area_share", "rate_per_day"):
         print(f"Spearman beta vs {k} over {cor['n_windows']} windows: {cor[k]['spearman']:+.2f} "
               f"(p = {cor[k]['p_value']:.2g})")
-    OUT.write_text(json.dumps({"runs": args.runs, "buffer_m": BUFFER_M, "broken_damage": BROKEN,
-                               "windows": rows, "correlation": cor}, indent=1) + "\n")
-    print(f"beta_vs_damage: wrote {OUT.relative_to(ROOT)}")
+    args.out.write_text(json.dumps({"runs": args.runs, "buffer_m": BUFFER_M, "broken_damage": BROKEN,
+                                    "windows": rows, "correlation": cor}, indent=1) + "\n")
+    print(f"beta_vs_damage: wrote {args.out}")
     return 0
 
 

@@ -1237,6 +1237,9 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # these 6 month-basins, and the medians over its four months put 4 bands or more inside in each
 # basin. Predicted: it holds in the windy month (2027) and not in the calm ones (2028, 2029), where
 # an intact pack stays locked: 2-3 of 6 month-basins gain, so the rule fails.
+# Result (2026-11-28, 02:19 UTC): 3 of 6 gain (the calm months 2028 both basins and 2029 closed; none
+# in the windy month), the four months' medians 4 bands closed, 2 strait (spun-up: 3 and 2): the
+# rule fails; the count predicted held, its reason did not.
 # The basin twice as wide put the rate inside its band in the validation month (F10x2-hthick:
 # 0.0102 per day) and not in the calm month (F10x2-hthick-w2028: 0.0020). Its other two months of
 # the ensemble (ENSEMBLE_SEEDS 2027 and 2029), so that the wide basin has the four months the
