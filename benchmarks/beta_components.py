@@ -163,8 +163,10 @@ def with_patches(info: dict, dt_s: float, inside) -> dict:
     xy1, dt = info["start_nodes_at_end"], dt_s
     kept = np.zeros(len(tri), bool)
     kept[info["kept_elements"]] = True
+    folded = np.zeros(len(tri), bool)  # followed but left out (inverted mid-window): not a remeshed patch
+    folded[info["folded_elements"]] = True
     rates = lagrangian_velocity_gradients(xy0, np.where(np.isfinite(xy1), xy1, xy0), tri[kept & inside], dt)
-    g, a, c, used, dropped = patch_cells(xy0, xy1, tri[~kept & inside], dt)
+    g, a, c, used, dropped = patch_cells(xy0, xy1, tri[~kept & ~folded & inside], dt)
     out = {}
     for key, r in (("followed", rates), ("with_patches", ElementStrainRates(
             np.concatenate([rates.gradient_s, g]), np.concatenate([rates.area_m2, a]),
@@ -233,8 +235,9 @@ def run_components(run_dir: Path, window_days: float = 3.0, start_day: float = 1
         inside0 = interior_triangles(start_xy, start_tri, coast_buffer_m)
         lost0 = np.ones(len(start_tri), bool)
         lost0[info["kept_elements"]] = False
+        lost0[info["folded_elements"]] = False  # followed, but left out as folded: not remeshed
         row.update(followed_area_fraction=float(a0 / start_area.sum()), followed_area_change=float(a1 / a0 - 1.0),
-                   remeshed_elements=int(info["n_elements_lost"]),
+                   remeshed_elements=int(info["n_elements_lost"]), folded_elements=int(info["n_elements_folded"]),
                    interior_area_remeshed_fraction=float(start_area[inside0 & lost0].sum()
                                                          / start_area[inside0].sum()))
         if patches and info["n_elements_lost"]:

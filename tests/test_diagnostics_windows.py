@@ -6,6 +6,7 @@ its last window the same as the single-window ``lagice diagnose``)."""
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -241,3 +242,16 @@ def test_windows_leave_out_and_count_elements_folded_mid_window(eddy_run, shear_
     # ... and a run without folds counts none and keeps every element
     calm = window_statistics(shear_run, window_days=3.0, coast_buffer_km=60.0, start_day=1.0)
     assert calm["n_elements_folded"] == 0 and all(x["n_elements_folded"] == 0 for x in calm["windows"])
+
+
+def test_beta_components_count_folded_elements_apart_from_remeshed_ones(eddy_run):
+    """benchmarks/beta_components.py reads windows through window_arrays: the eddy's folded ring is
+    left out and counted as folded, not as remeshed area (it was 11 % of the interior before)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from beta_components import run_components
+
+    res = run_components(eddy_run, window_days=3.0, start_day=0.0, coast_buffer_m=60e3, patches=True)
+    (row,) = res["windows"]
+    ref = window_statistics(eddy_run, window_days=3.0, coast_buffer_km=60.0, start_day=0.0)
+    assert row["folded_elements"] == ref["n_elements_folded"] > 0
+    assert row["remeshed_elements"] == 0 and row["interior_area_remeshed_fraction"] == 0.0

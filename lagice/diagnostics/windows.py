@@ -56,8 +56,8 @@ def window_arrays(run_dir, start_s: float, end_s: float, coast_buffer_m: float =
     :func:`lagice.io.snapshots.load_window` (without its arrays; ``kept_elements``
     indexes ``triangles`` in the first mesh) plus ``interior``
     (mask of the triangles at least ``coast_buffer_m`` [m] from the boundary of the
-    window's first mesh), ``n_elements`` (their number), ``n_elements_all`` and
-    ``n_elements_folded``.
+    window's first mesh), ``n_elements`` (their number), ``n_elements_all``,
+    ``n_elements_folded`` and ``folded_elements`` (their indices in the first mesh).
 
     The statistics take each element's gradient on its mid-window geometry
     ``(x0 + x1)/2`` (:mod:`lagice.diagnostics.strain`). The model keeps every element
@@ -90,6 +90,7 @@ def window_arrays(run_dir, start_s: float, end_s: float, coast_buffer_m: float =
     unfolded = triangle_geometry(0.5 * (xy0 + xy1), tri)[0] > 0.0  # False for NaN too
     n_folded = int(tri.shape[0] - unfolded.sum())
     n_interior_folded = int(np.sum(keep & ~unfolded))
+    folded_elements = kept[~unfolded]
     if n_folded:
         tri, kept, keep = tri[unfolded], kept[unfolded], keep[unfolded]
     if keep.sum() < min_elements:
@@ -100,7 +101,7 @@ def window_arrays(run_dir, start_s: float, end_s: float, coast_buffer_m: float =
                           f"event(s) replaced {w['n_elements_lost']} elements{folded}); choose other windows")
     info = {k: v for k, v in w.items() if k not in ("xy0", "xy1", "triangles", "datasets")}
     info.update(kept_elements=kept, n_elements=int(keep.sum()), n_elements_all=int(tri.shape[0]), interior=keep,
-                n_elements_folded=n_folded, n_interior_folded=n_interior_folded)
+                n_elements_folded=n_folded, n_interior_folded=n_interior_folded, folded_elements=folded_elements)
     return xy0, xy1, tri, dt, info
 
 
