@@ -58,6 +58,7 @@ wide basin and 0.72-0.73 under the half-scale weather (docs/physics.md §4).
     python benchmarks/envelope_branches.py closed --set forcing.drag.turning_angle_deg=25 --label turn25
     python benchmarks/envelope_branches.py --table                   # the stored result
     python benchmarks/envelope_branches.py --budget closed F10-hthick-halfwx-w2028   # damage budgets
+    python benchmarks/envelope_branches.py --budget-figure closed F10-hthick-1125-w2028 F10-hthick-halfwx-w2028
 
 ``--budget RECORD ...`` (2026-11-28): per window, the interior's damage gain of the stored record
 against the net change of its Σ d·A between the run's snapshots at the window's ends; the
@@ -255,9 +256,14 @@ def main(argv=None):
     ap.add_argument("--budget", nargs="+", default=[], metavar="RECORD",
                     help="stored records: the interior's damage gain against its net change per window "
                          "(from the run's snapshots), stored in the record as damage_budget")
+    ap.add_argument("--budget-figure", nargs="+", default=[], metavar="RECORD",
+                    help=f"records with a stored damage_budget: one panel each in {BUDGET_FIGURE.name}")
     a = ap.parse_args(argv)
     if a.budget:
         return budget(a.budget)
+    if a.budget_figure:
+        print(f"branches: wrote {budget_figure(a.budget_figure)}")
+        return 0
     if a.experiment and (a.basins or a.set or a.label):
         ap.error("--experiment takes no basin, --set or --label (the experiment defines them)")
     if a.experiment:
@@ -293,6 +299,54 @@ def main(argv=None):
 #: the run folders of the basins' own records (the run of ``physics_experiments.py`` with the same
 #: settings: the shipped spin-up, the validation month)
 BASIN_RUNS = {"closed": "F10-hthick-1125", "strait": "F10s-hthick-1125"}
+
+
+#: the figure of ``--budget-figure``
+BUDGET_FIGURE = ROOT / "docs" / "figures" / "damage_budget.png"
+#: panel titles of known records (others are titled by their name)
+BUDGET_TITLES = {"closed": "closed basin, validation month (closed)",
+                 "strait": "strait, validation month (strait)",
+                 "F10-hthick-1125-w2028": "closed, calm month, seed 2028",
+                 "F10-hthick-halfwx-w2028": "closed, half-scale weather, seed 2028 (locked)",
+                 "F10-hthick-1125-intact": "closed, validation month, intact start"}
+
+
+def budget_figure(names: list, path: Path = BUDGET_FIGURE) -> Path:
+    """One panel per stored record with a ``damage_budget``: per window, the damage gain (up) and
+    what healing took away (down) [10⁹ m²], and the interior's mean damage at the windows' ends."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    records = json.loads(PUBLISHED.read_text())
+    missing = [n for n in names if "damage_budget" not in records.get(n, {})]
+    if missing:
+        sys.exit(f"branches: no damage_budget stored for {missing}; run --budget first")
+    fig, axes = plt.subplots(1, len(names), figsize=(4.2 * len(names), 3.6), sharey=True, squeeze=False)
+    for ax, name in zip(axes[0], names):
+        rows = records[name]["damage_budget"]
+        mid = [0.5 * (r["days"][0] + r["days"][1]) for r in rows]
+        ax.bar(mid, [r["gain_m2"] / 1e9 for r in rows], width=2.6, color="tab:red", label="damage gain")
+        ax.bar(mid, [-r["healed_m2"] / 1e9 for r in rows], width=2.6, color="tab:blue", label="healed (gain − net)")
+        ax.axhline(0.0, color="k", lw=0.6)
+        ax.set_title(BUDGET_TITLES.get(name, name), fontsize=9)
+        ax.set_xlabel("day")
+        twin = ax.twinx()
+        days = [rows[0]["days"][0]] + [r["days"][1] for r in rows]
+        twin.plot(days, [rows[0]["mean_damage_start"]] + [r["mean_damage_end"] for r in rows], "k.-",
+                  label="interior mean damage")
+        twin.set_ylim(0.0, 1.0)
+        if ax is axes[0][-1]:
+            twin.set_ylabel("interior mean damage")
+        else:
+            twin.set_yticklabels([])
+    axes[0][0].set_ylabel("damage-area per 3-day window (10⁹ m²)")
+    axes[0][0].legend(loc="lower left", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
 
 
 def budget(names: list) -> int:
