@@ -304,8 +304,8 @@ BASIN_RUNS = {"closed": "F10-hthick-1125", "strait": "F10s-hthick-1125"}
 #: the figure of ``--budget-figure``
 BUDGET_FIGURE = ROOT / "docs" / "figures" / "damage_budget.png"
 #: panel titles of known records (others are titled by their name)
-BUDGET_TITLES = {"closed": "closed basin, validation month (closed)",
-                 "strait": "strait, validation month (strait)",
+BUDGET_TITLES = {"closed": "closed, validation month, spun-up pack",
+                 "strait": "strait, validation month, spun-up pack",
                  "F10-hthick-1125-w2028": "closed, calm month, seed 2028",
                  "F10-hthick-halfwx-w2028": "closed, half-scale weather, seed 2028 (locked)",
                  "F10-hthick-1125-intact": "closed, validation month, intact start"}
@@ -342,8 +342,9 @@ def budget_figure(names: list, path: Path = BUDGET_FIGURE) -> Path:
         else:
             twin.set_yticklabels([])
     axes[0][0].set_ylabel("damage-area per 3-day window (10⁹ m²)")
-    axes[0][0].legend(loc="lower left", fontsize=8)
-    fig.tight_layout()
+    handles = axes[0][0].get_legend_handles_labels()[0] + twin.get_legend_handles_labels()[0]
+    fig.legend(handles, [h.get_label() for h in handles], loc="lower center", ncol=3, fontsize=8)
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
