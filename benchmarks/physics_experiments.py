@@ -1240,6 +1240,20 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # Result (2026-11-28, 02:19 UTC): 3 of 6 gain (the calm months 2028 both basins and 2029 closed; none
 # in the windy month), the four months' medians 4 bands closed, 2 strait (spun-up: 3 and 2): the
 # rule fails; the count predicted held, its reason did not.
+# Over-failure (docs/physics.md §4, "The damage budget"): one storm takes the interior's area with
+# damage above 0.5 from 17-62 % to 76-98 % while half the shear lies in 6-10 % of it. Is that the
+# load being far above the strength? The intact start (where the storm of days 7-10 meets a mostly
+# unbroken pack) with the strength +50 % and -50 % (C_lab 4.2 and 1.4 MPa, the sensitivity
+# values), closed basin. A mechanism diagnostic, not a candidate. Stated before the runs
+# (2026-11-28, 03:10 UTC): over-failure is the load-to-strength ratio if, with the strength +50 %,
+# the interior's area above damage 0.5 at day 10 is at least 0.2 lower than the shipped strength's
+# (0.98) while the storm window's half-shear area stays inside 4-8 %, and with -50 % it is not
+# lower. Predicted: the storm's stress exceeds even the +50 % strength over most of the pack, so
+# the area stays above 0.85 and the rule fails.
+for _key, _value in (("str+50", "rheology.strength_lab_pa=4.2e6"), ("str-50", "rheology.strength_lab_pa=1.4e6")):
+    EXPERIMENTS[f"F10-hthick-1125-intact-{_key}"] = (
+        "closed", from_spinup("H1125") + ["initial.damage=0.0", _value], 10e3, 28,
+        f"F10-hthick-1125-intact with the strength {_key[3:]} % (diagnostic)")
 # The basin twice as wide put the rate inside its band in the validation month (F10x2-hthick:
 # 0.0102 per day) and not in the calm month (F10x2-hthick-w2028: 0.0020). Its other two months of
 # the ensemble (ENSEMBLE_SEEDS 2027 and 2029), so that the wide basin has the four months the
