@@ -9,6 +9,7 @@ one row per window and Spearman's rank correlation of β with each (and with the
 the other thing β moves with), and writes ``docs/figures/beta_vs_damage.json``.
 
     python benchmarks/beta_vs_damage.py F10-hthick-1125 F10s-hthick-1125 F10-hthick-1125-intact F10s-hthick-1125-intact
+    python benchmarks/beta_vs_damage.py F10-hthick-1125-intact --at 7 10      # the damage at given days
 
 Runs are read from ``benchmarks/out/physics`` (made by ``physics_experiments.py run``); a run
 whose snapshots are missing stops the script with its name, so no window is left out silently.
@@ -38,12 +39,15 @@ DAY_S = 86400.0
 BUFFER_M = 100e3
 #: damage above which an element counts as broken in ``broken_area_share``
 BROKEN = 0.9
+#: damage above which an element counts in ``damaged_area_share`` (the over-failure's measure)
+DAMAGED = 0.5
 
 
 def start_damage(run_dir, day: float, buffer_m: float = BUFFER_M) -> dict:
     """The interior's damage in the snapshot nearest ``day`` [days]: ``mean_damage``
     (area-weighted over the elements whose centroid is >= ``buffer_m`` [m] from the mesh
-    boundary), ``broken_area_share`` (their area with damage > :data:`BROKEN`), and the sums
+    boundary), ``broken_area_share`` (their area with damage > :data:`BROKEN`),
+    ``damaged_area_share`` (with damage > :data:`DAMAGED`), and the sums
     ``damage_area_m2`` (Σ d·A) and ``area_m2`` (Σ A) over those elements.
     Raises ConfigError when no snapshot lies within an hour of ``day``."""
     idx = read_index(run_dir)
@@ -64,6 +68,7 @@ def start_damage(run_dir, day: float, buffer_m: float = BUFFER_M) -> dict:
     d = damage[inner]
     return {"snapshot_day": float(times[i] / DAY_S), "mean_damage": float(np.sum(area * d) / area.sum()),
             "broken_area_share": float(area[d > BROKEN].sum() / area.sum()),
+            "damaged_area_share": float(area[d > DAMAGED].sum() / area.sum()),
             "damage_area_m2": float(np.sum(area * d)), "area_m2": float(area.sum())}
 
 
@@ -96,7 +101,16 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("runs", nargs="+", help="run names in benchmarks/out/physics with published records")
     ap.add_argument("--out", type=Path, default=OUT, help=f"the JSON written (default {OUT.relative_to(ROOT)})")
+    ap.add_argument("--at", type=float, nargs="+", metavar="DAY",
+                    help="print the interior's damage of each run at these days instead (nothing written)")
     args = ap.parse_args(argv)
+    if args.at:
+        for name in args.runs:
+            for day in args.at:
+                r = start_damage(RUNS / name, day)
+                print(f"{name:34s} day {day:5.1f}: mean damage {r['mean_damage']:.3f}, area above "
+                      f"{DAMAGED:g}: {r['damaged_area_share']:.2f}, above {BROKEN:g}: {r['broken_area_share']:.2f}")
+        return 0
     records = json.loads(RECORDS.read_text())
     rows = [r for n in args.runs for r in rows_for(n, records)]
     print(f"{'run':30s} {'day':>4s} {'mean d':>7s} {'>0.9':>5s} {'beta':>7s} {'rate/day':>9s}")

@@ -584,6 +584,7 @@ def test_beta_vs_damage_reads_the_interiors_damage_at_the_window_start(tmp_path)
     a, d = area[inner], st.damage[inner]
     assert 0.3 < a[d > 0.9].sum() / a.sum() < 0.7  # the interior straddles the split
     assert res["broken_area_share"] == pytest.approx(a[d > 0.9].sum() / a.sum(), rel=1e-12)
+    assert res["damaged_area_share"] == pytest.approx(a[d > 0.5].sum() / a.sum(), rel=1e-12)
     assert res["mean_damage"] == pytest.approx(np.sum(a * d) / a.sum(), rel=1e-12)
     assert res["snapshot_day"] == 0.0
     with pytest.raises(ConfigError, match="no snapshot within an hour of day 0.5"):
