@@ -1250,6 +1250,8 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # (0.98) while the storm window's half-shear area stays inside 4-8 %, and with -50 % it is not
 # lower. Predicted: the storm's stress exceeds even the +50 % strength over most of the pack, so
 # the area stays above 0.85 and the rule fails.
+# Result (2026-11-28, 03:21 UTC): +50 %: 0.91 at day 10 (0.31 at day 7), 0.07 below the shipped
+# strength's 0.98; -50 %: 1.00. The rule fails, as predicted.
 for _key, _value in (("str+50", "rheology.strength_lab_pa=4.2e6"), ("str-50", "rheology.strength_lab_pa=1.4e6")):
     EXPERIMENTS[f"F10-hthick-1125-intact-{_key}"] = (
         "closed", from_spinup("H1125") + ["initial.damage=0.0", _value], 10e3, 28,
