@@ -193,10 +193,12 @@ def damage_budget(rec: dict, run_dir: Path) -> list:
     (skipped by the record) and the remapping's change of the interior's Σ d·A."""
     from beta_vs_damage import start_damage
 
+    days = sorted({d for w in rec["windows"] for d in w["days"]})  # each snapshot read once
+    at = {d: start_damage(run_dir, d, BUFFER_M) for d in days}
     rows = []
     for w in rec["windows"]:
         d0, d1 = w["days"]
-        a, b = start_damage(run_dir, d0, BUFFER_M), start_damage(run_dir, d1, BUFFER_M)
+        a, b = at[d0], at[d1]
         net = b["damage_area_m2"] - a["damage_area_m2"]
         rows.append({"days": [d0, d1], "gain_m2": w["damage_gain_m2"], "net_m2": net,
                      "healed_m2": w["damage_gain_m2"] - net, "interior_area_m2": a["area_m2"],
@@ -358,9 +360,10 @@ def budget(names: list) -> int:
         if name not in records:
             sys.exit(f"branches: no stored record {name!r}; known: {sorted(records)}")
         run_name = BASIN_RUNS.get(name, name)
-        run_dir = OUT / run_name if run_name != name or (OUT / name).exists() else OUT / f"branches-{name}"
-        if not (run_dir / "snapshots").exists():
-            sys.exit(f"branches: {name}: no snapshots in {run_dir}")
+        # the experiment's own folder, else the folder this script's basin runs write
+        run_dir = next((d for d in (OUT / run_name, OUT / f"branches-{name}") if (d / "snapshots").exists()), None)
+        if run_dir is None:
+            sys.exit(f"branches: {name}: no snapshots in {OUT / run_name} or {OUT / f'branches-{name}'}")
         rows = damage_budget(records[name], run_dir)
         rates = ([w["mean_total_s"] * DAY for w in physics[run_name]["per_window"]]
                  if run_name in physics else None)

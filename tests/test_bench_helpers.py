@@ -552,6 +552,28 @@ def test_half_scale_weather_halves_every_length_and_keeps_the_winds():
     assert set(wind) <= {f.name for f in dataclasses.fields(ClimatologyParams)}
 
 
+def _still_square(tmp_path, side=400e3):
+    """A free ``side`` square of 1 m ice that does not move (zero prescribed velocity), run through
+    Model/Simulation with daily snapshots in ``tmp_path/run/snapshots``. Returns (mesh, its
+    element areas [m2], the simulation); the caller sets the damage and runs it."""
+    from lagice.mesh import generate_mesh, rectangle_domain
+    from lagice.model import Model
+    from lagice.simulation import Simulation
+    from lagice.solvers import PrescribedStepper
+    from lagice.state import IceState
+
+    poly, _ = rectangle_domain(side, side)
+    mesh = generate_mesh(poly, 25e3, exterior_tag="free")
+    st = IceState.uniform(mesh, thickness_m=1.0, concentration=1.0, cohesion_pa=1e9)
+    model = Model(st, solver=PrescribedStepper(mesh=mesh, velocity=lambda t, x, y: (0 * x, 0 * y)))
+    sim = Simulation(model, dt="6h", stop="2d", progress=False)
+    sim.output(every="1d", path=tmp_path / "run" / "snapshots", crs=None)
+    p = mesh.nodes[mesh.triangles]
+    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+                        - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
+    return mesh, area, sim
+
+
 def test_beta_vs_damage_reads_the_interiors_damage_at_the_window_start(tmp_path):
     """``beta_vs_damage.py``: the area-weighted mean damage and broken share of the elements
     >= 100 km from the boundary, read from a real run's snapshot, against the same numbers
@@ -560,28 +582,16 @@ def test_beta_vs_damage_reads_the_interiors_damage_at_the_window_start(tmp_path)
     from beta_vs_damage import start_damage
 
     from lagice.errors import ConfigError
-    from lagice.mesh import generate_mesh, rectangle_domain
-    from lagice.model import Model
-    from lagice.simulation import Simulation
-    from lagice.solvers import PrescribedStepper
-    from lagice.state import IceState
 
     side = 400e3
-    poly, _ = rectangle_domain(side, side)
-    mesh = generate_mesh(poly, 25e3, exterior_tag="free")
+    mesh, area, sim = _still_square(tmp_path, side)
     cen = mesh.nodes[mesh.triangles].mean(axis=1)
-    st = IceState.uniform(mesh, thickness_m=1.0, concentration=1.0, cohesion_pa=1e9)
-    st.damage = np.where(cen[:, 0] < 0.5 * side, 0.95, 0.2)  # broken west, sound east
-    model = Model(st, solver=PrescribedStepper(mesh=mesh, velocity=lambda t, x, y: (0 * x, 0 * y)))
-    sim = Simulation(model, dt="6h", stop="1d", progress=False)
-    sim.output(every="1d", path=tmp_path / "run" / "snapshots", crs=None)
-    sim.run()
+    damage = np.where(cen[:, 0] < 0.5 * side, 0.95, 0.2)  # broken west, sound east
+    sim.model.state.damage = damage.copy()
+    sim.run(n_steps=4)
     res = start_damage(tmp_path / "run", 0.0)
     inner = shapely.distance(shapely.points(cen), shapely.box(0, 0, side, side).exterior) >= 100e3
-    p = mesh.nodes[mesh.triangles]
-    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
-                        - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
-    a, d = area[inner], st.damage[inner]
+    a, d = area[inner], damage[inner]
     assert 0.3 < a[d > 0.9].sum() / a.sum() < 0.7  # the interior straddles the split
     assert res["broken_area_share"] == pytest.approx(a[d > 0.9].sum() / a.sum(), rel=1e-12)
     assert res["damaged_area_share"] == pytest.approx(a[d > 0.5].sum() / a.sum(), rel=1e-12)
@@ -599,28 +609,14 @@ def test_damage_budget_takes_the_net_change_from_the_snapshots(tmp_path):
     from envelope_branches import budget_table, damage_budget
 
     from lagice.diagnostics.faults import interior_triangles
-    from lagice.mesh import generate_mesh, rectangle_domain
-    from lagice.model import Model
-    from lagice.simulation import Simulation
-    from lagice.solvers import PrescribedStepper
-    from lagice.state import IceState
 
-    side = 400e3
-    poly, _ = rectangle_domain(side, side)
-    mesh = generate_mesh(poly, 25e3, exterior_tag="free")
-    st = IceState.uniform(mesh, thickness_m=1.0, concentration=1.0, cohesion_pa=1e9)
-    st.damage = np.full(mesh.n_elements, 0.5)
-    model = Model(st, solver=PrescribedStepper(mesh=mesh, velocity=lambda t, x, y: (0 * x, 0 * y)))
-    sim = Simulation(model, dt="6h", stop="2d", progress=False)
-    sim.output(every="1d", path=tmp_path / "run" / "snapshots", crs=None)
+    mesh, area, sim = _still_square(tmp_path)
+    sim.model.state.damage = np.full(mesh.n_elements, 0.5)
     sim.run(n_steps=4)  # day 1 written with d = 0.5
-    model.state.damage = np.full(mesh.n_elements, 0.8)
+    sim.model.state.damage = np.full(mesh.n_elements, 0.8)
     sim.run()
     rec = {"windows": [{"days": [0.0, 1.0], "damage_gain_m2": 7.0e9}, {"days": [1.0, 2.0], "damage_gain_m2": 9.0e10}]}
     rows = damage_budget(rec, tmp_path / "run")
-    p = mesh.nodes[mesh.triangles]
-    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
-                        - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
     a_in = area[interior_triangles(mesh.nodes, mesh.triangles, 100e3)].sum()
     assert rows[0]["net_m2"] == pytest.approx(0.0, abs=1e-6 * a_in) and rows[0]["healed_m2"] == pytest.approx(7.0e9)
     assert rows[1]["net_m2"] == pytest.approx(0.3 * a_in, rel=1e-12)

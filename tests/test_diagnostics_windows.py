@@ -30,18 +30,23 @@ def shear(t, x, y):
     return GAMMA * (np.asarray(y) - 0.5 * L), np.zeros(np.shape(x))
 
 
+def prescribed_run(out, velocity, resolution_m, dt, stop, every):
+    """A free L × L square whose nodes move with ``velocity(t, x, y)`` (nothing fixed), run
+    through Model/Simulation with snapshots every ``every`` in ``out/snapshots``; returns ``out``."""
+    poly, _ = rectangle_domain(L, L)
+    mesh = generate_mesh(poly, resolution_m, exterior_tag="free")
+    st = IceState.uniform(mesh, thickness_m=1.0, concentration=1.0, cohesion_pa=1e9)
+    model = Model(st, solver=PrescribedStepper(mesh=mesh, velocity=velocity), mover=MeshMotion())
+    sim = Simulation(model, dt=dt, stop=stop, progress=False)
+    sim.output(every=every, path=out / "snapshots", crs=None)
+    sim.run()
+    return out
+
+
 @pytest.fixture(scope="module")
 def shear_run(tmp_path_factory):
     """7 days of simple shear of a free 400 km square, 6-h steps, daily snapshots."""
-    out = tmp_path_factory.mktemp("shear_run")
-    poly, _ = rectangle_domain(L, L)
-    mesh = generate_mesh(poly, 25e3, exterior_tag="free")  # nothing fixed: every node moves with the field
-    st = IceState.uniform(mesh, thickness_m=1.0, concentration=1.0, cohesion_pa=1e9)
-    model = Model(st, solver=PrescribedStepper(mesh=mesh, velocity=shear), mover=MeshMotion())
-    sim = Simulation(model, dt="6h", stop="7d", progress=False)
-    sim.output(every="1d", path=out / "snapshots", crs=None)
-    sim.run()
-    return out
+    return prescribed_run(tmp_path_factory.mktemp("shear_run"), shear, 25e3, "6h", "7d", "1d")
 
 
 def test_windows_of_an_analytic_shear(shear_run):
@@ -188,15 +193,7 @@ def eddy_run(tmp_path_factory):
     """3 days of a steady eddy (differential rotation, no divergence) on a free 400 km square:
     the ring that turns by a little more than half a turn while it is sheared has every element
     fine at both ends, but inverted in the mid-window geometry (x0 + x1)/2."""
-    out = tmp_path_factory.mktemp("eddy_run")
-    poly, _ = rectangle_domain(L, L)
-    mesh = generate_mesh(poly, 10e3, exterior_tag="free")
-    st = IceState.uniform(mesh, thickness_m=1.0, concentration=1.0, cohesion_pa=1e9)
-    model = Model(st, solver=PrescribedStepper(mesh=mesh, velocity=eddy), mover=MeshMotion())
-    sim = Simulation(model, dt="1h", stop="3d", progress=False)
-    sim.output(every="3d", path=out / "snapshots", crs=None)
-    sim.run()
-    return out
+    return prescribed_run(tmp_path_factory.mktemp("eddy_run"), eddy, 10e3, "1h", "3d", "3d")
 
 
 def test_windows_leave_out_and_count_elements_folded_mid_window(eddy_run, shear_run):
