@@ -71,6 +71,13 @@ class MaxwellEBParams:
             cannot open, the flow builds a pressure k_ψ r, k_ψ = sin ψ (1 + ν)/(1 − ν), r the
             radius of Mohr's circle. Explicit stepper only (CPU and CUDA), with ``relax_mean_stress`` true
             and no ``max_pressure_pa``
+        damage_nonlocal_radius_m: R [m] of the nonlocal damage (None or 0: off, the default, the
+            local scheme of Dansereau et al. 2016; issue 12 item 4, docs/physics.md §3): the load
+            ratio that drives damage is averaged over the element centroids within R with the
+            bell-shaped weight of Bažant and Jirásek (2002), so a crack is at least about R wide
+            whatever the mesh (:mod:`lagice.solvers.nonlocal_damage`). Explicit CPU stepper only,
+            with the default stress path (origin correction, whole stress relaxing, no
+            compressive term, no dilatancy)
     """
 
     poisson: float = 0.3
@@ -91,6 +98,7 @@ class MaxwellEBParams:
     max_pressure_thickness_exponent: float = 1.5
     relax_mean_stress: bool = True
     dilatancy_angle_deg: float | None = None
+    damage_nonlocal_radius_m: float | None = None
 
     def __post_init__(self):
         check_range("poisson (ν)", self.poisson, 0.0, 0.5, high_open=True)
@@ -120,6 +128,17 @@ class MaxwellEBParams:
                                   f"with the whole stress relaxing and no compressive term only; it is set with "
                                   f"relax_mean_stress = {str(self.relax_mean_stress).lower()}, max_pressure_pa = "
                                   f"{self.max_pressure_pa!r}")
+        if self.damage_nonlocal_radius_m:
+            check_range("damage_nonlocal_radius_m (R)", self.damage_nonlocal_radius_m, 0.0, 1.0e6, low_open=True,
+                        unit="m")
+            others = {"stress_correction": self.stress_correction, "relax_mean_stress": self.relax_mean_stress,
+                      "max_pressure_pa": self.max_pressure_pa, "dilatancy_angle_deg": self.dilatancy_angle_deg}
+            if (self.stress_correction != "origin" or not self.relax_mean_stress or self.max_pressure_pa
+                    or self.dilatancy_angle_deg):
+                raise ConfigError(f"rheology.damage_nonlocal_radius_m = {self.damage_nonlocal_radius_m!r} is "
+                                  f"implemented with the default stress path only (stress_correction = 'origin', "
+                                  f"relax_mean_stress = true, no max_pressure_pa, no dilatancy_angle_deg); it is "
+                                  f"set with {others}")
         if self.stress_correction not in STRESS_CORRECTIONS:
             raise ConfigError(f"rheology.stress_correction = {self.stress_correction!r}: expected one of "
                               f"{list(STRESS_CORRECTIONS)}")
@@ -148,6 +167,8 @@ class MaxwellEBParams:
             out["relax_mean_stress"] = self.relax_mean_stress
         if self.dilatancy_angle_deg:
             out["dilatancy_angle_deg"] = self.dilatancy_angle_deg
+        if self.damage_nonlocal_radius_m:
+            out["damage_nonlocal_radius_m"] = self.damage_nonlocal_radius_m
         return out
 
     @property

@@ -51,6 +51,7 @@ from ..rheology.maxwell_eb import _dcrit_towards
 from ..stability import effective_dx
 from ..state import IceState
 from .base import StepInfo
+from .nonlocal_damage import NonlocalWeights
 
 #: how the measured sub-step limit C Δx/sqrt(E/ρ) is applied (:mod:`lagice.stability`):
 #: "mesh" (default): the smallest element size with the stiffest modulus of the whole mesh;
@@ -317,6 +318,71 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     return n_capped
 
 
+def _element_trial_load(tri, b, c, vel, sigma, e_dt, gamma, cohesion, kxx, kxy, kss, q, denom, load):
+    """First pass of a sub-step with the nonlocal damage (rheology.damage_nonlocal_radius_m;
+    :mod:`lagice.solvers.nonlocal_damage`): the Maxwell stress update of
+    :func:`_element_stress_damage` (the default path: the whole stress relaxes, origin
+    correction, no compressive term) and the element's load ratio
+    L = max(0, s1/σT, (q s1 − s2)/σc) into ``load``; no damage yet."""
+    m = tri.shape[0]
+    for e in prange(m):
+        exx, eyy, exy = element_strain_rate(tri, b, c, vel, e)
+        ed = e_dt[e]
+        g = gamma[e]
+        sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * g
+        syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * g
+        sxy = (sigma[e, 2] + ed * (kss * exy)) * g
+        sigma[e, 0] = sxx
+        sigma[e, 1] = syy
+        sigma[e, 2] = sxy
+        mm = 0.5 * (sxx + syy)
+        r = math.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
+        s1 = mm + r
+        s2 = mm - r
+        sc = 2.0 * cohesion[e] / denom
+        st = sc / q
+        ld = 0.0
+        if s1 > 0.0:
+            ld = s1 / st
+        mc = q * s1 - s2
+        if mc > 0.0:
+            ld = max(ld, mc / sc)
+        load[e] = ld
+
+
+def _element_nonlocal_damage(nl_ptr, nl_idx, nl_w, load, sigma, damage, conc_factor, td, heal_rate, e_dt, gamma,
+                             dt_s, max_damage, E0, lambda0, alpha, damaged_flag):
+    """Second pass: d̄_crit = min(1, 1/L̄) from the neighbourhood's mean load ratio
+    L̄_e = Σ w_ej L_j, then :func:`lagice.rheology.damage_step` and the stress factor on
+    the element's own stress, as the local kernel does with its own d_crit. Returns the
+    number of elements whose damage hit the cap."""
+    m = damage.shape[0]
+    n_capped = 0
+    for e in prange(m):
+        lb = 0.0
+        for k in range(nl_ptr[e], nl_ptr[e + 1]):
+            lb += nl_w[k] * load[nl_idx[k]]
+        dc = 1.0 / lb if lb > 1.0 else 1.0
+        d0 = damage[e]
+        d, f, capped = damage_step(d0, dc, dt_s, td[e], heal_rate[e], max_damage)
+        if dc < 1.0:
+            sigma[e, 0] *= f
+            sigma[e, 1] *= f
+            sigma[e, 2] *= f
+            damaged_flag[e] = 1
+        n_capped += capped
+        if d != d0:
+            damage[e] = d
+            x = (1.0 - d) * conc_factor[e]
+            if alpha == 4.0:
+                lam = lambda0 * (x * x * x)
+            else:
+                lam = lambda0 * x ** (alpha - 1.0)
+            e_dt[e] = dt_s * (E0 * x)
+            gamma[e] = lam / (lam + dt_s)
+    return n_capped
+
+
 def _serial(func):
     """Serial numba variant of a prange kernel (see :mod:`lagice._numba`)."""
     return serial_copy(func, error_model="numpy", fastmath=KERNEL_FASTMATH)
@@ -366,6 +432,48 @@ def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_
 
 
 SUBSTEPS = (substeps_serial, substeps_parallel)
+
+element_trial_load_kernel = njit(cache=True, parallel=True, error_model="numpy", fastmath=KERNEL_FASTMATH)(
+    _element_trial_load)
+element_trial_load_kernel_serial = _serial(_element_trial_load)
+element_nonlocal_damage_kernel = njit(cache=True, parallel=True, error_model="numpy", fastmath=KERNEL_FASTMATH)(
+    _element_nonlocal_damage)
+element_nonlocal_damage_kernel_serial = _serial(_element_nonlocal_damage)
+
+
+@njit(cache=True, error_model="numpy")
+def substeps_nonlocal_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri,
+                             b, c, damage, conc_factor, coh, td, heal, e_dt, gamma, dt_s, kxx, kxy, kss, q, denom,
+                             max_damage, E0, lambda0, alpha, flag, nl_ptr, nl_idx, nl_w, load):
+    """The sub-step loop with the nonlocal damage (:mod:`lagice.solvers.nonlocal_damage`):
+    node kernel, then the two element passes (serial builds)."""
+    n_capped = 0
+    for k in range(n_sub):
+        node_velocity_kernel_serial(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
+                                    (k + 1) / n_sub)
+        element_trial_load_kernel_serial(tri, b, c, vel, sigma, e_dt, gamma, coh, kxx, kxy, kss, q, denom, load)
+        n_capped += element_nonlocal_damage_kernel_serial(nl_ptr, nl_idx, nl_w, load, sigma, damage, conc_factor, td,
+                                                          heal, e_dt, gamma, dt_s, max_damage, E0, lambda0, alpha,
+                                                          flag)
+    return n_capped
+
+
+@njit(cache=True, error_model="numpy")
+def substeps_nonlocal_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
+                               tri, b, c, damage, conc_factor, coh, td, heal, e_dt, gamma, dt_s, kxx, kxy, kss, q,
+                               denom, max_damage, E0, lambda0, alpha, flag, nl_ptr, nl_idx, nl_w, load):
+    """:func:`substeps_nonlocal_serial` with the parallel kernel builds."""
+    n_capped = 0
+    for k in range(n_sub):
+        node_velocity_kernel(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
+                             (k + 1) / n_sub)
+        element_trial_load_kernel(tri, b, c, vel, sigma, e_dt, gamma, coh, kxx, kxy, kss, q, denom, load)
+        n_capped += element_nonlocal_damage_kernel(nl_ptr, nl_idx, nl_w, load, sigma, damage, conc_factor, td, heal,
+                                                   e_dt, gamma, dt_s, max_damage, E0, lambda0, alpha, flag)
+    return n_capped
+
+
+SUBSTEPS_NONLOCAL = (substeps_nonlocal_serial, substeps_nonlocal_parallel)
 
 #: the α = 4 builds (Dansereau et al. 2016's value, the default): the element kernel with
 #: λ = λ0 x³ compiled in, and sub-step loops that call it
@@ -474,6 +582,12 @@ class ExplicitSolver:
         self.kernel_choice = None
         self._tuned_at = 0.0
         self._idx = (None, None)
+        radius = rheology.params.damage_nonlocal_radius_m
+        #: the nonlocal damage's averaging weights (rheology.damage_nonlocal_radius_m), or None
+        self.nonlocal_weights = NonlocalWeights(radius) if radius else None
+        if self.nonlocal_weights is not None and profile_kernels:
+            raise ConfigError("profile_kernels times the local element kernel; it is not implemented with "
+                              f"rheology.damage_nonlocal_radius_m = {radius!r}")
         self.nodes = NodeSystem(mesh, bcs, parallel, geometry_hook=self._geometry_extras)
 
     # -- geometry/topology (the node system owns the caches) ----------------------------
@@ -668,7 +782,14 @@ class ExplicitSolver:
             self._choose_kernels(args)
             par = ns.parallel
         ta = time.perf_counter()
-        if self.profile_kernels:
+        if self.nonlocal_weights is not None:
+            nl_ptr, nl_idx, nl_w = self.nonlocal_weights.update(tri, mesh.nodes, ns.area)
+            n_capped = SUBSTEPS_NONLOCAL[int(par)](
+                n_sub, vel, vel_sum, sigma, ptr32, elems32, su.w, nc, terms.cos_turn, terms.sin_turn, ns.fixed,
+                pres0, pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, self.td, heal, e_dt, gamma, dt_s, kxx,
+                kxy, kss, rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), flag, nl_ptr,
+                nl_idx, nl_w, np.empty(mesh.n_elements, np.float64))
+        elif self.profile_kernels:
             n_capped, tn, tm = self._profiled_substeps(par, n_sub, args)
             kt["node_velocity"] = tn
             kt["element_stress_damage"] = tm
