@@ -51,9 +51,11 @@ CANDIDATE_MARGIN = 0.25
 
 
 @njit(cache=True, parallel=True)
-def _weights(ptr, idx, cx, cy, area, radius2, w):
+def _weights(ptr, idx, cx, cy, area, radius2, w, count):
+    """Weights on the candidate rows (0 beyond R), normalised; count[e]: the nonzero ones."""
     for e in prange(len(ptr) - 1):
         s = 0.0
+        n = 0
         for k in range(ptr[e], ptr[e + 1]):
             j = idx[k]
             dx = cx[j] - cx[e]
@@ -62,12 +64,26 @@ def _weights(ptr, idx, cx, cy, area, radius2, w):
             if r2 < radius2:
                 t = 1.0 - r2 / radius2
                 v = area[j] * t * t
+                n += 1
             else:
                 v = 0.0
             w[k] = v
             s += v
         for k in range(ptr[e], ptr[e + 1]):
             w[k] /= s
+        count[e] = n
+
+
+@njit(cache=True, parallel=True)
+def _compact(ptr, idx, w, ptr_out, idx_out, w_out):
+    """The nonzero entries of each row, in the same (column) order."""
+    for e in prange(len(ptr) - 1):
+        o = ptr_out[e]
+        for k in range(ptr[e], ptr[e + 1]):
+            if w[k] > 0.0:
+                idx_out[o] = idx[k]
+                w_out[o] = w[k]
+                o += 1
 
 
 class NonlocalWeights:
@@ -82,6 +98,7 @@ class NonlocalWeights:
         self._tri = None
         self._ref = None
         self.ptr = self.idx = self.w = None
+        self._cptr = self._cidx = self._cw = None
         #: how many times the candidate pairs were searched (a k-d tree query)
         self.n_searches = 0
 
@@ -95,10 +112,10 @@ class NonlocalWeights:
         cols = np.concatenate([np.arange(n), pairs[:, 1], pairs[:, 0]])
         order = np.lexsort((cols, rows))
         rows, cols = rows[order], cols[order]
-        self.ptr = np.zeros(n + 1, np.int64)
-        np.cumsum(np.bincount(rows, minlength=n), out=self.ptr[1:])
-        self.idx = cols.astype(np.int32)
-        self.w = np.empty(len(cols), np.float64)
+        self._cptr = np.zeros(n + 1, np.int64)
+        np.cumsum(np.bincount(rows, minlength=n), out=self._cptr[1:])
+        self._cidx = cols.astype(np.int32)
+        self._cw = np.empty(len(cols), np.float64)
         self._ref = pts.copy()
         self.n_searches += 1
 
@@ -113,14 +130,23 @@ class NonlocalWeights:
                 > 0.5 * CANDIDATE_MARGIN * self.radius_m):
             self._search(cx, cy)
             self._tri = tri
-        _weights(self.ptr, self.idx, cx, cy, np.ascontiguousarray(area, np.float64), self.radius_m ** 2, self.w)
+        count = np.empty(len(cx), np.int64)
+        _weights(self._cptr, self._cidx, cx, cy, np.ascontiguousarray(area, np.float64), self.radius_m ** 2, self._cw,
+                 count)
+        # the kernels read the nonzero entries only (a third of the candidates lie beyond R):
+        # the same terms in the same order, so the same sums bit for bit
+        self.ptr = np.zeros(len(cx) + 1, np.int64)
+        np.cumsum(count, out=self.ptr[1:])
+        self.idx = np.empty(self.ptr[-1], np.int32)
+        self.w = np.empty(self.ptr[-1], np.float64)
+        _compact(self._cptr, self._cidx, self._cw, self.ptr, self.idx, self.w)
         return self.ptr, self.idx, self.w
 
     def mean_neighbours(self) -> float:
         """Mean number of elements with a nonzero weight per row (the element included)."""
         if self.w is None:
             return 0.0
-        return float(np.count_nonzero(self.w)) / (len(self.ptr) - 1)
+        return len(self.w) / (len(self.ptr) - 1)
 
 
 def nonlocal_average(ptr, idx, w, field) -> np.ndarray:
