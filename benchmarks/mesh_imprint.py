@@ -28,6 +28,8 @@ combine with ``+``, e.g. ``delaunay+meanstress``.
     python benchmarks/mesh_imprint.py cyclone --variants base jitter delaunay
     python benchmarks/mesh_imprint.py compression --n-across 40 80 --variants base jitter delaunay
     python benchmarks/mesh_imprint.py report          # figure + JSON from the runs in --out
+    python benchmarks/mesh_imprint.py cyclone --variants delaunay delaunay+nl16 --figure mesh_imprint_cyclone_nonlocal
+    python benchmarks/mesh_imprint.py zoom --variants delaunay delaunay+nl16 --figure nonlocal_damage_zoom
     python benchmarks/mesh_imprint.py final-faults --n-across 40 --variants delaunay+mean125
     python benchmarks/mesh_imprint.py final-faults --n-across 80 --variants delaunay+explicit+mean200 \
         --seed 0 1 --figure compression_explicit_dilatant    # + the stress and final damage, side by side
@@ -144,6 +146,15 @@ VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.me
             # four elements of 2.5 km): the faults stay within 3 deg of the explicit origin
             # path's (their angle is the fastest-growing band's, which the averaging of a uniform
             # load does not change), so item 7's 10 deg goal is not met.
+            # Result (2026-11-28, 04:47 UTC): the cyclone rule fails: damage's local index 0.16 /
+            # 0.16 / 0.22 (Delaunay again: 0.29 / 0.30 / 0.25), the shear rate's 0.06 / 0.04 / 0.05
+            # (0.30 / 0.30 / 0.31); the prediction was wrong in both fields. The maps show why the
+            # indices fall: damage in parallel stripes about R apart and the shear in blobs about R
+            # across, the averaging's own pattern (docs/figures/nonlocal_damage_zoom.png); the
+            # damaged fraction +0.02-0.06. Compression: faults (rate) 47.0, 42.4 deg against the
+            # local run's 19.3, 32.1 (final damage 42.0, 50.9 against 40.8, 31.0): the prediction
+            # fails, the faults are steeper (mean 44.7, the damage band's 44.5 deg); the plate
+            # ruptures on one fault pair (drop 17.3 kPa against 2.2); item 7 not met.
             "nl16": ["rheology.damage_nonlocal_radius_m=16e3"],
             "nl10": ["rheology.damage_nonlocal_radius_m=10e3"],
             **{f"mean{int(round(100 * t)):03d}": ["rheology.stress_correction=mean_stress",
@@ -378,6 +389,34 @@ def figure_final_damage(out: Path, runs: list, path: Path):
     print(f"wrote {path}")
 
 
+def figure_zoom(out: Path, variants, path: Path, box_km=(-250.0, -50.0, -150.0, 50.0)):
+    """Damage and the shear rate at day 3 (mesh not rotated) in a 200 km box of the disk's
+    western half, one row per variant: the element-scale pattern the whole-disk maps hide."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.tri as mtri
+
+    fig, ax = plt.subplots(len(variants), 2, figsize=(10, 5 * len(variants)), squeeze=False)
+    for i, v in enumerate(variants):
+        nodes, tri, d, sh = load_last(out / f"cyclone_{v}_r0")
+        t = mtri.Triangulation(nodes[:, 0] / 1e3, nodes[:, 1] / 1e3, tri)
+        im0 = ax[i, 0].tripcolor(t, d, vmin=0, vmax=1, cmap="magma_r")
+        im1 = ax[i, 1].tripcolor(t, np.log10(np.maximum(sh, 1e-10)), vmin=-9.0, vmax=-5.0, cmap="viridis")
+        ax[i, 0].set_title(f"{v}: damage, day 3", fontsize=10)
+        ax[i, 1].set_title(f"{v}: log10 shear rate [s-1], day 3", fontsize=10)
+        for a, im in ((ax[i, 0], im0), (ax[i, 1], im1)):
+            a.set_xlim(*box_km[:2])
+            a.set_ylim(*box_km[2:])
+            a.set_aspect("equal")
+            a.set_xlabel("x [km]")
+            fig.colorbar(im, ax=a, shrink=0.8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+
+
 def figure_cyclone(out: Path, variants, path: Path):
     import matplotlib
 
@@ -419,7 +458,7 @@ def figure_cyclone(out: Path, variants, path: Path):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("what", choices=("cyclone", "compression", "report", "final-faults"))
+    ap.add_argument("what", choices=("cyclone", "compression", "report", "final-faults", "zoom"))
     ap.add_argument("--variants", nargs="+", default=["base"])
     ap.add_argument("--n-across", type=int, nargs="+", default=[40])
     ap.add_argument("--max-strain", type=float, default=1e-3)
@@ -501,6 +540,9 @@ def main(argv=None):
             entry["final_damage_faults"] = r
         if args.figure:
             figure_final_damage(out, keys, args.fig_dir / f"{args.figure}.png")
+    elif args.what == "zoom":   # the cyclone runs already made, unrotated, in a 200 km box
+        figure_zoom(out, args.variants, args.fig_dir / f"{args.figure or 'mesh_imprint_zoom'}.png")
+        return
     else:
         figure_cyclone(out, [v for v in allres.get("cyclone", {})], args.fig_dir / "mesh_imprint_cyclone.png")
     js.write_text(json.dumps(allres, indent=1))

@@ -1293,6 +1293,11 @@ for _seed in ENSEMBLE_SEEDS:
 #  * over-failure (F10-hthick-1125-intact-nl20, the intact start): the averaging limits over-failure
 #    if the interior's area above damage 0.5 at day 10 is at least 0.2 below the local scheme's 0.98.
 #    Predicted: >= 0.9, for the same reason (the storm overloads regions far wider than R).
+# Result (2026-11-28, 05:13 UTC): the rule fails in the strait (1 band inside against 3; closed 3 against
+# 2, the rate 0.0134 per day inside its band); beta 0.317 and 0.323, so the prediction was wrong by x14:
+# the shear deforms in patches about R across (docs/figures/F10-hthick-1125-nl20.png), the averaging's
+# own pattern, not LKFs. Over-failure: 0.81 at day 10 (0.17 below 0.98): the rule fails narrowly and
+# the prediction (>= 0.9) was wrong. Not adopted.
 for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-1125-nl20"] = (
         _basin, from_spinup("H1125") + ["rheology.damage_nonlocal_radius_m=20e3"], 10e3, 28,
@@ -1762,6 +1767,8 @@ LEADS = (
      "F10s-hthick-1125-intact", "Is the weather too wide for the basin?"),
     ("a 7-day spin-up instead of 14 days (a diagnostic)", "F10-hthick-spin7d", "F10s-hthick-spin7d",
      "Is the weather too wide for the basin?"),
+    ("damage averaged over R = 20 km (nonlocal; patches of its own size)", "F10-hthick-1125-nl20",
+     "F10s-hthick-1125-nl20", "§3, Damage averaged over a physical length"),
 )
 
 
