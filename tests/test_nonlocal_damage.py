@@ -25,8 +25,8 @@ def plate():
     return generate_mesh(poly, 1e3, segments=segs, exterior_tag="free")
 
 
-def _area(mesh):
-    p = mesh.nodes[mesh.triangles]
+def _area(mesh, nodes=None):
+    p = (mesh.nodes if nodes is None else nodes)[mesh.triangles]
     return 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
                         - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
 
@@ -75,9 +75,7 @@ def test_weights_do_not_depend_on_when_the_candidates_were_found(plate):
     old.update(plate.triangles, plate.nodes, area0)
     field = rng.uniform(0, 2, plate.n_elements)
     tri = plate.triangles
-    p = moved[tri]
-    area1 = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
-                         - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
+    area1 = _area(plate, moved)
     a = nonlocal_average(*old.update(tri, moved, area1), field)
     assert old.n_searches == 1   # the candidates of the first geometry were reused
     fresh = NonlocalWeights(R)
