@@ -1297,7 +1297,8 @@ for _seed in ENSEMBLE_SEEDS:
 # 2, the rate 0.0134 per day inside its band); beta 0.317 and 0.323, so the prediction was wrong by x14:
 # the shear deforms in patches about R across (docs/figures/F10-hthick-1125-nl20.png), the averaging's
 # own pattern, not LKFs. Over-failure: 0.81 at day 10 (0.17 below 0.98): the rule fails narrowly and
-# the prediction (>= 0.9) was wrong. Not adopted.
+# the prediction (>= 0.9) was wrong. Not adopted. (05:46 UTC) The intact month's medians: beta 0.299, 1 band
+# inside (the rate, 0.0120 per day) against 4 with the local scheme.
 for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-1125-nl20"] = (
         _basin, from_spinup("H1125") + ["rheology.damage_nonlocal_radius_m=20e3"], 10e3, 28,
