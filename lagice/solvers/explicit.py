@@ -489,20 +489,12 @@ def substeps_nonlocal_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_
     return n_capped
 
 
-@njit(cache=True, error_model="numpy")
-def substeps_nonlocal_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
-                               tri, b, c, damage, conc_factor, coh, td, heal, e_dt, gamma, dt_s, kxx, kxy, kss, q,
-                               denom, max_damage, E0, lambda0, alpha, flag, nl_ptr, nl_idx, nl_w, load, mark):
-    """:func:`substeps_nonlocal_serial` with the parallel kernel builds."""
-    n_capped = 0
-    for k in range(n_sub):
-        node_velocity_kernel(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
-                             (k + 1) / n_sub)
-        element_trial_load_kernel(tri, b, c, vel, sigma, e_dt, gamma, coh, kxx, kxy, kss, q, denom, load)
-        mark_overloaded_neighbourhoods(nl_ptr, nl_idx, load, mark)
-        n_capped += element_nonlocal_damage_kernel(nl_ptr, nl_idx, nl_w, load, mark, sigma, damage, conc_factor, td,
-                                                   heal, e_dt, gamma, dt_s, max_damage, E0, lambda0, alpha, flag)
-    return n_capped
+#: :func:`substeps_nonlocal_serial` with the parallel kernel builds (the same loop, its kernels swapped)
+substeps_nonlocal_parallel = specialised_copy(
+    substeps_nonlocal_serial, "_parallel",
+    {"node_velocity_kernel_serial": node_velocity_kernel,
+     "element_trial_load_kernel_serial": element_trial_load_kernel,
+     "element_nonlocal_damage_kernel_serial": element_nonlocal_damage_kernel}, error_model="numpy")
 
 
 SUBSTEPS_NONLOCAL = (substeps_nonlocal_serial, substeps_nonlocal_parallel)
