@@ -1307,6 +1307,23 @@ EXPERIMENTS["F10-hthick-1125-intact-nl20"] = (
     "closed", from_spinup("H1125") + ["initial.damage=0.0", "rheology.damage_nonlocal_radius_m=20e3"], 10e3, 28,
     "F10-hthick-1125-intact with the damage averaged over R = 20 km (diagnostic of over-failure)")
 
+# The averaging length (twenty-fourth session): beta against R in the closed basin, validation
+# month, R = 14 km and 10 km (1.4 and 1.0 element sizes; R = 10 km reaches the three edge neighbours
+# at about 5.8 km with weight 0.44 and few others). A dose response of the one change that moved beta,
+# a diagnostic: R is a calibration, not a measured length of sea ice. Stated before the runs
+# (2026-11-28, 06:12 UTC):
+#  * beta falls monotonically with R: nl20 0.317 > nl14 > nl10 > the local scheme's 0.038.
+#  * Predicted: nl14 at 0.15-0.25 and nl10 at 0.06-0.15; the rate between the local scheme's 0.0024
+#    and nl20's 0.0134 per day, falling with R; remeshing between 180 and 846 events.
+#  * A lead for the strait and more months (next step, not this session) only if a radius puts
+#    beta inside 0.13-0.25 (the band widened by RGPS's tracking error, "The model as RGPS would see
+#    it") with at least 3 bands of 6 inside (shipped: 2), and its storm-window shear map shows lines
+#    narrower than nl20's patches about R across.
+for _r in (14, 10):
+    EXPERIMENTS[f"F10-hthick-1125-nl{_r}"] = (
+        "closed", from_spinup("H1125") + [f"rheology.damage_nonlocal_radius_m={_r}e3"], 10e3, 28,
+        f"F10-hthick-1125 with the damage averaged over R = {_r} km (diagnostic: beta against R)")
+
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
