@@ -1311,7 +1311,7 @@ EXPERIMENTS["F10-hthick-1125-intact-nl20"] = (
 # month, R = 14 km and 10 km (1.4 and 1.0 element sizes; R = 10 km reaches the three edge neighbours
 # at about 5.8 km with weight 0.44 and few others). A dose response of the one change that moved beta,
 # a diagnostic: R is a calibration, not a measured length of sea ice. Stated before the runs
-# (2026-11-28, 06:12 UTC):
+# (2026-11-28, 05:58 UTC):
 #  * beta falls monotonically with R: nl20 0.317 > nl14 > nl10 > the local scheme's 0.038.
 #  * Predicted: nl14 at 0.15-0.25 and nl10 at 0.06-0.15; the rate between the local scheme's 0.0024
 #    and nl20's 0.0134 per day, falling with R; remeshing between 180 and 846 events.
