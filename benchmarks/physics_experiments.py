@@ -1323,6 +1323,25 @@ for _r in (14, 10):
     EXPERIMENTS[f"F10-hthick-1125-nl{_r}"] = (
         "closed", from_spinup("H1125") + [f"rheology.damage_nonlocal_radius_m={_r}e3"], 10e3, 28,
         f"F10-hthick-1125 with the damage averaged over R = {_r} km (diagnostic: beta against R)")
+# Result (06:31 UTC): as predicted, beta rises with R: nl10 0.120 (3 bands inside: the shear tail,
+# the half-shear area, R^2; rate 0.0030 per day, 354 remeshes), nl14 0.1999 (4 inside: beta, the
+# |divergence| tail, the half-shear area, the rate 0.0103 per day; the shear tail 3.03 and R^2 0.727
+# outside; 665 remeshes). The storm window's shear (docs/figures/nonlocal_radius_shear_zoom.png):
+# nl14 a dense network of short zigzag segments one to two elements wide, narrower than nl20's
+# patches, so nl14 is a lead by the letter of the rule; nl10 keeps longer branching lines.
+# Stage 1 of nl14 as a lead, stated before its runs (2026-11-28, 06:36 UTC): the strait's validation
+# month (F10s-hthick-1125-nl14) and the calm month of wind seed 2028 in the closed basin
+# (F10-hthick-1125-nl14-w2028; shipped: 1 band inside, rate 0.0004 per day, the pack locked). nl14
+# stays a lead if the strait puts at least 3 bands inside (shipped 3) with beta in 0.13-0.25, and the
+# calm month at least 2 (shipped 1) with beta in 0.13-0.25. Predicted: the strait 3-4 bands, beta
+# 0.17-0.25; the calm month's rate x3 or more but below 0.01 per day, beta 0.10-0.20, so the calm
+# month decides. R = 14 km is then a calibration on beta (three radii), not a sourced value.
+EXPERIMENTS["F10s-hthick-1125-nl14"] = (
+    "strait", from_spinup("H1125") + ["rheology.damage_nonlocal_radius_m=14e3"], 10e3, 28,
+    "F10s-hthick-1125 with the damage averaged over R = 14 km (stage 1 of a lead)")
+EXPERIMENTS["F10-hthick-1125-nl14-w2028"] = (
+    "closed", from_spinup("H1125") + ["rheology.damage_nonlocal_radius_m=14e3", "forcing.wind.seed=2028"], 10e3, 28,
+    "F10-hthick-1125-w2028 (the calm month) with the damage averaged over R = 14 km (stage 1 of a lead)")
 
 
 def command(scene, overrides, res, days, out) -> list:
@@ -1716,6 +1735,45 @@ def figure_strength(name: str = "F10-hthick-cor50", ref: str = "F10-hthick-1125"
     return path
 
 
+def figure_shear(names: list, fig_name: str, days: float = 28, buffer_m: float = 100e3, box_km=None) -> Path:
+    """docs/figures/``fig_name``.png: the interior's shear rate in the storm window (the window
+    with the highest mean rate in the first run) of each run in ``names``, side by side, with
+    its β in that window: a dose response on one map scale. ``box_km`` (x0, x1, y0, y1): zoom
+    into that box, with the element edges drawn."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from validate import DAY, analyse_run
+
+    res = {n: analyse_run(OUT / n, days, buffer_m) for n in names}
+    k = int(np.argmax([w["interior"]["mean_total_s"] for w in res[names[0]]["windows"]]))
+    ncol = min(len(names), 2)
+    nrow = -(-len(names) // ncol)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(7.0 * ncol, 6.6 * nrow), squeeze=False)
+    for ax, n in zip(axes.ravel(), names):
+        w = res[n]["windows"][k]
+        mxy, mtri, shear = w["interior"]["_map"]
+        tp = ax.tripcolor(mxy[:, 0] / 1e3, mxy[:, 1] / 1e3, mtri, facecolors=np.log10(np.maximum(shear * DAY, 1e-4)),
+                          cmap="magma", vmin=-4, vmax=0)
+        beta = w["interior"].get("beta_space", float("nan"))
+        ax.set_title(f"{n}\nlog10 shear (day$^{{-1}}$), days {w['start_day']:.0f}–{w['end_day']:.0f}, "
+                     f"β {beta:.2f}", fontsize=8)
+        if box_km is not None:
+            ax.triplot(mxy[:, 0] / 1e3, mxy[:, 1] / 1e3, mtri, lw=0.15, color="0.6")
+            ax.set_xlim(box_km[0], box_km[1])
+            ax.set_ylim(box_km[2], box_km[3])
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (km)")
+    for ax in axes.ravel()[len(names):]:
+        ax.set_visible(False)
+    fig.colorbar(tp, ax=list(axes.ravel()), shrink=0.6)
+    path = ROOT / "docs" / "figures" / f"{fig_name}.png"
+    fig.savefig(path, dpi=75, bbox_inches="tight")
+    print(f"physics: wrote {path.relative_to(ROOT)}")
+    return path
+
+
 def spinup(name="shipped", days=14):
     """Spin-up state ``name`` (SPINUPS): ``examples/winter_basin_spinup.toml`` (pristine
     ice, seed 2025) with its overrides for ``days`` (the command takes them from
@@ -1821,9 +1879,11 @@ def leads_table(records: dict, fits: dict, leads=LEADS) -> str:
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("what", choices=("list", "run", "table", "spread", "spinup", "analyse", "figure", "screen",
-                                    "beta-by-rate", "leads"))
+                                    "beta-by-rate", "leads", "figure-shear"))
     ap.add_argument("names", nargs="*")
     ap.add_argument("--force", action="store_true", help="run again even if the run finished")
+    ap.add_argument("--box", type=float, nargs=4, default=None, metavar=("X0", "X1", "Y0", "Y1"),
+                    help="figure-shear: zoom into this box (km), element edges drawn")
     ap.add_argument("--jobs", type=int, default=1,
                     help="run: this many queues side by side (names dealt round-robin), one thread each")
     ap.add_argument("--beta-tolerance", type=float, default=0.0,
@@ -1871,6 +1931,8 @@ def main(argv=None):
                None if args.wind_factor_band is None else tuple(args.wind_factor_band))
     elif args.what == "figure":  # the cohesion and a storm window's shear: run NAME against run REF
         figure_strength(*args.names)
+    elif args.what == "figure-shear":  # FIG_NAME RUN [RUN ...]: the storm window's shear side by side
+        figure_shear(args.names[1:], args.names[0], box_km=args.box)
     else:
         print(table())
 
