@@ -1342,7 +1342,7 @@ EXPERIMENTS["F10s-hthick-1125-nl14"] = (
 EXPERIMENTS["F10-hthick-1125-nl14-w2028"] = (
     "closed", from_spinup("H1125") + ["rheology.damage_nonlocal_radius_m=14e3", "forcing.wind.seed=2028"], 10e3, 28,
     "F10-hthick-1125-w2028 (the calm month) with the damage averaged over R = 14 km (stage 1 of a lead)")
-# Stage 2, stated before stage 1's results (2026-11-28, 06:48 UTC), run only if stage 1 passes: the
+# Stage 2, stated before stage 1's results (2026-11-28, 06:47 UTC), run only if stage 1 passes: the
 # active month of wind seed 2027 in both basins (shipped: 2 bands inside in each, beta 0.028 and
 # 0.030, rate 0.0073 and 0.0069 per day). nl14 stays a lead if, in both basins, beta lies in
 # 0.13-0.25 and at least as many bands are inside as the shipped run's. Predicted: beta 0.15-0.25
