@@ -1347,6 +1347,23 @@ EXPERIMENTS["F10-hthick-1125-nl14-w2028"] = (
 # 0.030, rate 0.0073 and 0.0069 per day). nl14 stays a lead if, in both basins, beta lies in
 # 0.13-0.25 and at least as many bands are inside as the shipped run's. Predicted: beta 0.15-0.25
 # and 3 bands inside in each (the rate inside its band, the shear tail outside).
+# Result of stage 1 (2026-11-28, 06:58 UTC): the calm month fails it: beta 0.228, no band inside
+# (shipped: 1), both tails heavier than observed (1.59, 1.50), half of the shear in 1.7 % of the
+# area, the rate 0.0053 per day (x13, still below its band). So stage 2 is not run, and nl14 is not
+# a lead. Prediction: the rate as predicted, beta 0.03 above the predicted range.
+# Is beta a property of R or of R over the element size? (stated 2026-11-28, 07:00 UTC, before the
+# runs): the closed basin at 20 km from the same spin-up state (sampled at the nearest 10 km
+# centroid; the strength scaled with the 20 km elements), local (B20-hthick-1125), R = 14 km (0.7
+# elements) and R = 28 km (1.4 elements, the ratio of the 10 km nl14 run). beta follows R/dx (the
+# averaging's pattern is tied to the mesh) if R = 28 km raises beta over the 20 km local run by at
+# least half of the 10 km step (0.162, so >= 0.081) and R = 14 km by less than a third of it
+# (< 0.054); it follows R (a length of the ice) if R = 14 km raises it by >= 0.081. Predicted: it
+# follows R/dx.
+for _tag, _sets in (("", []), ("-nl14", ["rheology.damage_nonlocal_radius_m=14e3"]),
+                    ("-nl28", ["rheology.damage_nonlocal_radius_m=28e3"])):
+    EXPERIMENTS[f"B20-hthick-1125{_tag}"] = (
+        "closed", from_spinup("H1125") + _sets, 20e3, 28,
+        f"F10-hthick-1125{_tag} at 20 km (diagnostic: beta against R over the element size)")
 for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
     EXPERIMENTS[f"{_p}-hthick-1125-nl14-w2027"] = (
         _basin, from_spinup("H1125") + ["rheology.damage_nonlocal_radius_m=14e3", "forcing.wind.seed=2027"], 10e3,
