@@ -1359,6 +1359,15 @@ EXPERIMENTS["F10-hthick-1125-nl14-w2028"] = (
 # least half of the 10 km step (0.162, so >= 0.081) and R = 14 km by less than a third of it
 # (< 0.054); it follows R (a length of the ice) if R = 14 km raises it by >= 0.081. Predicted: it
 # follows R/dx.
+# Result (07:09 UTC): beta follows R/dx, as predicted: at 20 km, local 0.055, R = 14 km 0.090 (+0.035,
+# below 0.054), R = 28 km 0.226 (+0.172, above 0.081). So beta in the band at R = 14 km on the 10 km
+# mesh is a property of the averaging at 1.4 elements, not of a length of the ice.
+# Over-failure at R = 14 km (stated 2026-11-28, 07:10 UTC, before the run; the rule of
+# F10-hthick-1125-intact-nl20): limited if the interior's area above damage 0.5 at day 10 is at least
+# 0.2 below the local scheme's 0.98. Predicted: 0.85-0.95, between nl20's 0.81 and 0.98.
+EXPERIMENTS["F10-hthick-1125-intact-nl14"] = (
+    "closed", from_spinup("H1125") + ["initial.damage=0.0", "rheology.damage_nonlocal_radius_m=14e3"], 10e3, 28,
+    "F10-hthick-1125-intact with the damage averaged over R = 14 km (diagnostic of over-failure)")
 for _tag, _sets in (("", []), ("-nl14", ["rheology.damage_nonlocal_radius_m=14e3"]),
                     ("-nl28", ["rheology.damage_nonlocal_radius_m=28e3"])):
     EXPERIMENTS[f"B20-hthick-1125{_tag}"] = (
