@@ -1365,6 +1365,7 @@ EXPERIMENTS["F10-hthick-1125-nl14-w2028"] = (
 # Over-failure at R = 14 km (stated 2026-11-28, 07:10 UTC, before the run; the rule of
 # F10-hthick-1125-intact-nl20): limited if the interior's area above damage 0.5 at day 10 is at least
 # 0.2 below the local scheme's 0.98. Predicted: 0.85-0.95, between nl20's 0.81 and 0.98.
+# Result (07:39 UTC): 0.89 at day 10 (above 0.9: 0.65, local 0.58): the rule fails, as predicted.
 EXPERIMENTS["F10-hthick-1125-intact-nl14"] = (
     "closed", from_spinup("H1125") + ["initial.damage=0.0", "rheology.damage_nonlocal_radius_m=14e3"], 10e3, 28,
     "F10-hthick-1125-intact with the damage averaged over R = 14 km (diagnostic of over-failure)")
