@@ -511,12 +511,15 @@ def main(argv=None):
     allres = json.loads(js.read_text()) if js.exists() else {}
     if args.what == "cyclone":
         for v in args.variants:
+            made = False   # whether any rotation was run now (not only analysed again)
             for rot in ROTATIONS:
+                made |= not run_finished(out / f"cyclone_{v}_r{rot:g}")
                 run_cyclone(out, v, rot)
             res = analyse_cyclone(out, v)
             allres.setdefault("cyclone", {})[v] = _strip(res)
-            allres.setdefault("provenance", {})[f"cyclone/{v}"] = {"git_commit": git_commit(),
-                                                                  "date": time.strftime("%Y-%m-%d")}
+            prov = allres.setdefault("provenance", {})
+            if made or f"cyclone/{v}" not in prov:   # the commit whose code made the runs
+                prov[f"cyclone/{v}"] = {"git_commit": git_commit(), "date": time.strftime("%Y-%m-%d")}
             for field, per in res.items():
                 for rot, s in per.items():
                     sh = s.get("shift_vs_r0", {})
