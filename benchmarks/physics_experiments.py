@@ -18,6 +18,8 @@ largest displacement of the nodes that exist at the start and at the end).
     python benchmarks/physics_experiments.py spread               # their mean and [min, max]
     python benchmarks/physics_experiments.py spinup               # remake data_stubs/winter_basin_spinup.npz
     python benchmarks/physics_experiments.py spinup K50           # an experiment's own spin-up state (SPINUPS)
+    python benchmarks/physics_experiments.py figure-shear FIG A B C  # storm-window shear of A, B, C side by side
+    python benchmarks/physics_experiments.py figure-shear FIG A B --box 0 300 -300 0   # zoomed, edges drawn
 
 Runs go to ``benchmarks/out/physics/NAME`` (logs NAME.log); results accumulate in
 ``benchmarks/out/physics/experiments.json`` and ``docs/figures/physics_experiments.json``.
