@@ -1732,6 +1732,19 @@ def screen(candidate: str, reference: str, beta_tolerance: float, rate_tolerance
     return v
 
 
+def shear_panel(ax, window: dict, prefix: str = "", suffix: str = "", fontsize: int = 9):
+    """Draw a window's interior shear rate (log10, day⁻¹, -4 to 0) on ``ax``, titled with its
+    days; returns the mappable for a colour bar."""
+    from validate import DAY
+
+    mxy, mtri, shear = window["interior"]["_map"]
+    tp = ax.tripcolor(mxy[:, 0] / 1e3, mxy[:, 1] / 1e3, mtri, facecolors=np.log10(np.maximum(shear * DAY, 1e-4)),
+                      cmap="magma", vmin=-4, vmax=0)
+    ax.set_title(f"{prefix}log10 shear (day$^{{-1}}$), days {window['start_day']:.0f}–{window['end_day']:.0f}{suffix}",
+                 fontsize=fontsize)
+    return tp
+
+
 def figure_strength(name: str = "F10-hthick-cor50", ref: str = "F10-hthick-1125", days: float = 28,
                     buffer_m: float = 100e3) -> Path:
     """docs/figures/``name``.png: the cohesion at the start and the shear of the storm window
@@ -1741,7 +1754,7 @@ def figure_strength(name: str = "F10-hthick-cor50", ref: str = "F10-hthick-1125"
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import xarray as xr
-    from validate import DAY, analyse_run
+    from validate import analyse_run
 
     runs = [(ref, OUT / ref), (name, OUT / name)]
     res = {n: analyse_run(r, days, buffer_m) for n, r in runs}
@@ -1756,12 +1769,8 @@ def figure_strength(name: str = "F10-hthick-cor50", ref: str = "F10-hthick-1125"
         tp = ax.tripcolor(xy[:, 0], xy[:, 1], tri, facecolors=coh, cmap="viridis", vmin=5, vmax=40)
         ax.set_title(f"{n}: cohesion at day 0 (kPa)", fontsize=9)
         fig.colorbar(tp, ax=ax, shrink=0.8)
-        w = res[n]["windows"][k]
-        mxy, mtri, shear = w["interior"]["_map"]
         ax = axes[1, col]
-        tp = ax.tripcolor(mxy[:, 0] / 1e3, mxy[:, 1] / 1e3, mtri, facecolors=np.log10(np.maximum(shear * DAY, 1e-4)),
-                          cmap="magma", vmin=-4, vmax=0)
-        ax.set_title(f"{n}: log10 shear (day$^{{-1}}$), days {w['start_day']:.0f}–{w['end_day']:.0f}", fontsize=9)
+        tp = shear_panel(ax, res[n]["windows"][k], f"{n}: ")
         fig.colorbar(tp, ax=ax, shrink=0.8)
     for ax in axes.ravel():
         ax.set_aspect("equal")
@@ -1782,7 +1791,7 @@ def figure_shear(names: list, fig_name: str, days: float = 28, buffer_m: float =
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from validate import DAY, analyse_run
+    from validate import analyse_run
 
     res = {n: analyse_run(OUT / n, days, buffer_m) for n in names}
     k = int(np.argmax([w["interior"]["mean_total_s"] for w in res[names[0]]["windows"]]))
@@ -1791,13 +1800,9 @@ def figure_shear(names: list, fig_name: str, days: float = 28, buffer_m: float =
     fig, axes = plt.subplots(nrow, ncol, figsize=(7.0 * ncol, 6.6 * nrow), squeeze=False)
     for ax, n in zip(axes.ravel(), names):
         w = res[n]["windows"][k]
-        mxy, mtri, shear = w["interior"]["_map"]
-        tp = ax.tripcolor(mxy[:, 0] / 1e3, mxy[:, 1] / 1e3, mtri, facecolors=np.log10(np.maximum(shear * DAY, 1e-4)),
-                          cmap="magma", vmin=-4, vmax=0)
-        beta = w["interior"].get("beta_space", float("nan"))
-        ax.set_title(f"{n}\nlog10 shear (day$^{{-1}}$), days {w['start_day']:.0f}–{w['end_day']:.0f}, "
-                     f"β {beta:.2f}", fontsize=8)
+        tp = shear_panel(ax, w, f"{n}\n", f", β {w['interior'].get('beta_space', float('nan')):.2f}", fontsize=8)
         if box_km is not None:
+            mxy, mtri, _ = w["interior"]["_map"]
             ax.triplot(mxy[:, 0] / 1e3, mxy[:, 1] / 1e3, mtri, lw=0.15, color="0.6")
             ax.set_xlim(box_km[0], box_km[1])
             ax.set_ylim(box_km[2], box_km[3])
