@@ -413,7 +413,7 @@ def solver_options(cfg: dict) -> dict:
     accepted = set(inspect.signature(SOLVERS[sv["name"]].__init__).parameters)
     opts = {}
     for k in ("linear_solver", "tol", "max_iter", "substeps", "allow_unstable", "safety", "parallel",
-              "substep_limit"):
+              "substep_limit", "damage_iterations", "damage_tol"):
         if sv[k] is None or (k == "allow_unstable" and sv[k] is False):
             continue
         if k == "parallel" and isinstance(sv[k], str):

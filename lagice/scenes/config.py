@@ -83,6 +83,9 @@ SCHEMA = {
         "linear_solver": (str, None), "tol": (NUM, None), "max_iter": (int, None),
         "allow_unstable": (bool, False), "safety": (NUM, None), "parallel": ((bool, str), None),
         "substep_limit": (str, None),
+        # implicit solver: Dansereau et al. (2016)'s fixed point between the solve and the damage
+        # update (lagice.solvers.implicit, step 4); 1 pass (no fixed point) by default
+        "damage_iterations": (int, None), "damage_tol": (NUM, None),
         "velocity": (str, None), "velocity_params": (dict, {}),
         "device": (str, "cpu"),
     },

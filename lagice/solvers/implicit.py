@@ -14,6 +14,13 @@ Per step (Δt), with P1 velocity and P0 stress/damage:
    one iteration is exact (reported as 1 iteration, residual 0).
 3. Damage explicit (Dansereau et al. 2016 eq. 11): d_crit from the new stress, damage
    increment and stress correction, healing.
+4. Optional (``damage_iterations`` > 1): Dansereau et al. (2016, §4)'s fixed point between
+   steps 1-2 and step 3. Where step 3 damaged some element, steps 1-2 are solved again with
+   the moduli of the new damage (the old stress σ^n and velocity u^n unchanged), and the
+   damage is computed again from d^n with the new stress, until the damage changes by less
+   than ``damage_tol`` between two passes (or ``damage_iterations`` passes). The damage,
+   stress and velocity of the last pass are kept. Off by default: the published lagice
+   runs use one pass (the damage of step n+1 from the stress solved with d^n).
 
 Iterations, residual and timings (assembly, solve, damage) are reported in
 :class:`~lagice.solvers.base.StepInfo`.
@@ -45,6 +52,14 @@ class ImplicitSolver:
         tol: fixed-point tolerance on the relative constitutive residual.
         max_iter: fixed-point iteration limit (reaching it is reported, not an error).
         heal_rate: callable ``(state, t_s) -> (m,) [s-1]`` or None for the rheology's constant rate.
+        damage_iterations: passes of the damage fixed point (module doc, step 4); 1 (default):
+            one pass, no fixed point.
+        damage_tol: the fixed point stops when no element's damage moved by more than this
+            between two passes [-].
+
+    ``last_damage_passes`` is the number of passes of the last step; ``damage_passes_total``
+    and ``damage_unconverged_steps`` (steps that used every pass without meeting
+    ``damage_tol``) are counted over the run and reported, not hidden.
 
     The transport velocity is the end-of-step velocity u^{n+1} (backward Euler:
     x^{n+1} = x^n + Δt u^{n+1}); :attr:`last_strain_rate` is its strain rate.
@@ -53,7 +68,8 @@ class ImplicitSolver:
     name = "implicit"
 
     def __init__(self, rheology: MaxwellEB, mesh, bcs=(), forces=(), linear_solver: str = "cg",
-                 tol: float = 1e-8, max_iter: int = 30, linear_rtol: float = 1e-10, heal_rate=None):
+                 tol: float = 1e-8, max_iter: int = 30, linear_rtol: float = 1e-10, heal_rate=None,
+                 damage_iterations: int = 1, damage_tol: float = 1e-6):
         if not isinstance(rheology, MaxwellEB):
             raise ConfigError(f"the implicit stepper solves the Maxwell-EB rheology; got "
                               f"{type(rheology).__name__} (use solver 'evp' for viscous-plastic)")
@@ -62,6 +78,16 @@ class ImplicitSolver:
             raise ConfigError(f"tol = {tol!r} must be > 0")
         if int(max_iter) < 1:
             raise ConfigError(f"max_iter = {max_iter!r} must be >= 1")
+        if int(damage_iterations) != damage_iterations or int(damage_iterations) < 1:
+            raise ConfigError(f"solver.damage_iterations = {damage_iterations!r} must be an integer >= 1 "
+                              f"(1: one damage pass per step)")
+        if not 0.0 < damage_tol < 1.0:
+            raise ConfigError(f"solver.damage_tol = {damage_tol!r} must be in (0, 1)")
+        self.damage_iterations = int(damage_iterations)
+        self.damage_tol = float(damage_tol)
+        self.last_damage_passes = 0
+        self.damage_passes_total = 0
+        self.damage_unconverged_steps = 0
         self.rheology = rheology
         self.bcs = list(bcs)
         self.forces = list(forces)
@@ -103,6 +129,43 @@ class ImplicitSolver:
             raise ConfigError(f"dt = {dt!r} s must be > 0")
         info = StepInfo()
         tm = info.timings
+        mesh = self.mesh
+        with Timer(tm, "damage"):
+            heal = (self.heal_rate(state, t_s) if self.heal_rate is not None
+                    else self.rheology.constant_heal_rate(mesh.n_elements))
+        d_old = state.damage
+        d_use = d_old
+        n_capped_before = self.rheology.n_capped_total
+        passes = 0
+        for passes in range(1, self.damage_iterations + 1):  # noqa: B007 (reported after the loop)
+            vel, sigma, eps = self._solve(state, d_use, t_s, dt, info)
+            with Timer(tm, "damage"):
+                damage = d_old.copy()
+                self.rheology.n_capped_total = n_capped_before  # the kept pass's caps only
+                dc = self.rheology.damage_update(sigma, damage, state.cohesion, dt, self.td, heal)
+            if self.damage_iterations == 1 or not np.any(dc < 1.0):
+                break
+            change = float(np.max(np.abs(damage - d_use))) if passes > 1 else np.inf
+            if change < self.damage_tol:
+                break
+            d_use = damage
+        else:
+            self.damage_unconverged_steps += 1
+        self.last_damage_passes = passes
+        self.damage_passes_total += passes
+        info.n_damaged = int(np.sum(dc < 1.0))
+        info.n_capped = self.rheology.n_capped_total - n_capped_before
+        state.velocity = vel
+        state.stress = sigma
+        state.damage = damage
+        self._transport = vel
+        self.last_strain_rate = eps
+        return info
+
+    def _solve(self, state: IceState, damage, t_s: float, dt: float, info: StepInfo):
+        """Steps 1-2 of the module doc with the moduli of ``damage``, from the state's σ^n and
+        u^n: returns (u^{n+1}, σ^{n+1} before the damage update, ε̇(u^{n+1}))."""
+        tm = info.timings
         mesh, p = self.mesh, self.rheology.params
         t_new = t_s + dt
         ptr, elems, local = mesh.node_elements
@@ -112,7 +175,7 @@ class ImplicitSolver:
         nodal_force_from_stress = pick(NODAL_FORCE, n_el)
         strain_rate = pick(STRAIN_RATE, n_el)
         with Timer(tm, "assembly"):
-            E, lam = self.rheology.moduli(state.damage, state.concentration)
+            E, lam = self.rheology.moduli(damage, state.concentration)
             gamma = lam / (lam + dt)
             coef = self.area * h * gamma * dt * E
             data0 = assemble_elasticity(self.pattern.entry_map, self.b, self.c, coef, p.poisson,
@@ -169,18 +232,7 @@ class ImplicitSolver:
         info.residual = float(residual)
         if not np.all(np.isfinite(vel)):
             raise SolverError(f"non-finite velocity at t = {t_new:.6g} s")
-        with Timer(tm, "damage"):
-            heal = (self.heal_rate(state, t_s) if self.heal_rate is not None
-                    else self.rheology.constant_heal_rate(mesh.n_elements))
-            n_before = self.rheology.n_capped_total
-            dc = self.rheology.damage_update(sigma, state.damage, state.cohesion, dt, self.td, heal)
-            info.n_damaged = int(np.sum(dc < 1.0))
-            info.n_capped = self.rheology.n_capped_total - n_before
-        state.velocity = vel
-        state.stress = sigma
-        self._transport = vel
-        self.last_strain_rate = eps
-        return info
+        return vel, sigma, eps
 
     def _apply_dirichlet(self, data, rhs, up):
         """Symmetric elimination of prescribed dofs keeping the sparsity pattern."""

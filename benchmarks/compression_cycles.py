@@ -1,0 +1,156 @@
+"""Cycles after the macro-rupture in the uniaxial compression test (issue 12; a diagnostic).
+
+Dansereau et al. (2016, "A Maxwell elasto-brittle rheology for sea ice modelling", The
+Cryosphere 10, §5.1) write of their compression test: "At all spatial resolutions, the model
+simulates cycles of slow stress build ups (healing phase) and rapid stress relaxations
+(damaging phase)", and they measure β near each rupture. lagice's compression plate
+(`uniaxial_compression`, implicit solver, dt = td, constant healing t_h = 1e5 s) does not:
+
+* **Observation (2026-11-28, 08:10 UTC, before any rule):** N = 20, one damage pass per step
+  (lagice's scheme), run to a macroscopic strain of 3e-3 (6e5 s, six healing times). After
+  the macro-rupture the macroscopic stress stays at 117 kPa, 96 % of its 122 kPa peak, to
+  0.1 kPa for 5e5 s: no cycle. The fault's damage stays at 0.91. Damage balances healing
+  at the envelope in a fault that creeps steadily.
+
+Dansereau et al. (§4) solve each step by a fixed point between the momentum/constitutive
+solve and the damage update; lagice's implicit solver made one pass. `solver.damage_iterations`
+(lagice.solvers.implicit, step 4) now has the fixed point.
+
+**Rule and prediction (stated 2026-11-28, 08:16 UTC, before the fixed-point run's stress past
+its rupture was seen):**
+
+* A *relaxation event* is a drop of the block-end macroscopic stress between two consecutive
+  blocks (a block is N steps, the shear-wave crossing of the width, as in
+  `benchmarks/validate.py`) of at least 1 % of the peak stress. A *cycle* is an event that
+  follows a rise of at least 1 % of the peak since the previous event. Cycles are counted
+  from the first event to the end of the run.
+* The fixed point reproduces Dansereau et al.'s behaviour if it gives at least 3 cycles within
+  5 healing times after the first event at N = 20 and at N = 40, where one pass gives none.
+* Prediction: it does not (0-1 cycles). A fault that creeps with its damage balancing
+  healing at the envelope is a stationary state of both schemes; the fixed point only changes
+  how the damage of one step is shared between elements.
+
+    python benchmarks/compression_cycles.py run --n 20 40 [--strain 3e-3] [--variants one fixed]
+    python benchmarks/compression_cycles.py analyse [--figure docs/figures/compression_cycles.png]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+OUT = ROOT / "benchmarks" / "out" / "compression_cycles"
+#: the variants: scene overrides on top of `uniaxial_compression`
+VARIANTS = {
+    "one": {},  # lagice's scheme: one damage pass per step
+    "fixed": {"solver.damage_iterations": 30},  # Dansereau et al. (2016)'s fixed point
+}
+EVENT_FRACTION = 0.01  # of the peak stress, for a relaxation event and for the rise before a cycle
+HEALING_TIME_S = 1e5  # the scene's t_h (healing.law = "constant", rheology.healing_time_s)
+
+
+def run(ns, variants, strain):
+    from validate import run_compression
+
+    for n in ns:
+        for v in variants:
+            d = OUT / f"{v}_N{n}"
+            d.mkdir(parents=True, exist_ok=True)
+            print(f"compression N = {n}, {v}: {VARIANTS[v] or 'defaults'}", flush=True)
+            run_compression(d, n, strain, 0, VARIANTS[v] or None)
+
+
+def cycles(stress_block_end: np.ndarray, peak: float) -> dict:
+    """Relaxation events and cycles of a block-end stress series (module doc)."""
+    thr = EVENT_FRACTION * peak
+    drops = stress_block_end[:-1] - stress_block_end[1:]
+    events = np.flatnonzero(drops >= thr) + 1  # the block at the end of the drop
+    # a cycle: the stress rose by thr from its lowest value after one event before the next
+    n_cycles = 0
+    for a, b in zip(events[:-1], events[1:]):
+        if stress_block_end[b - 1] - stress_block_end[a:b].min() >= thr:
+            n_cycles += 1
+    return {"events": events.tolist(), "n_events": int(events.size), "n_cycles": int(n_cycles)}
+
+
+def analyse(figure: Path | None):
+    from validate import analyse_compression, load_npz
+
+    rows = {}
+    for d in sorted(OUT.glob("*_N*")):
+        f = d / f"compression_N{d.name.split('_N')[1]}.npz"
+        if not f.exists():
+            continue
+        z = load_npz(f)
+        block, dt = int(z["block_steps"]), float(z["dt_s"])
+        s = z["stress_pa"]
+        nb = s.size // block
+        se = s[: nb * block].reshape(nb, block)[:, -1]
+        peak = float(s.max())
+        cy = cycles(se, peak)
+        t_end = s.size * dt
+        first = cy["events"][0] if cy["events"] else None
+        span_h = None if first is None else (t_end - (first + 1) * block * dt) / HEALING_TIME_S
+        after = se[first:] if first is not None else se
+        a = analyse_compression(f)
+        rows[d.name] = {"n_across": int(z["n_across"]), "steps": int(s.size), "dt_s": dt, "block_steps": block,
+                        "peak_kpa": peak / 1e3, "n_events": cy["n_events"], "n_cycles": cy["n_cycles"],
+                        "healing_times_after_first_event": span_h,
+                        "stress_after_first_event_kpa": [float(after.min() / 1e3), float(after.max() / 1e3)],
+                        "max_damage_end": float(z["damage_block_end"][-1].max()),
+                        "beta_rupture_block": a["beta_rupture_block"], "beta_after_rupture": a["beta_after_rupture"],
+                        "wall_s": float(z["wall_s"])}
+        r = rows[d.name]
+        print(f"{d.name:10s} N={r['n_across']:3d} peak {r['peak_kpa']:.1f} kPa, events {r['n_events']}, cycles "
+              f"{r['n_cycles']} in {span_h if span_h is None else round(span_h, 2)} t_h after the first; stress "
+              f"after it {r['stress_after_first_event_kpa'][0]:.1f}-{r['stress_after_first_event_kpa'][1]:.1f} kPa; "
+              f"max damage {r['max_damage_end']:.3f}; beta rupture block {r['beta_rupture_block']:.3f}, next "
+              f"{r['beta_after_rupture']:.3f}; {r['wall_s']:.0f} s")
+        r["_series"] = (np.arange(1, nb + 1) * block * dt, se)
+    (OUT / "summary.json").write_text(json.dumps({k: {kk: vv for kk, vv in v.items() if not kk.startswith("_")}
+                                                  for k, v in rows.items()}, indent=1))
+    if figure is not None and rows:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(figsize=(9, 4.5))
+        for name, r in rows.items():
+            t, se = r["_series"]
+            ax.plot(t / HEALING_TIME_S, se / 1e3, lw=1,
+                    label=f"{name}: {r['n_cycles']} cycles, max damage {r['max_damage_end']:.2f}")
+        ax.set(xlabel="time / healing time t_h (1e5 s)", ylabel="macroscopic compressive stress (kPa), block ends",
+               title="Compression after the macro-rupture: one damage pass per step against the fixed point")
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(figure, dpi=110)
+        print("wrote", figure)
+    return rows
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("run")
+    r.add_argument("--n", type=int, nargs="+", default=[20, 40])
+    r.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
+    r.add_argument("--strain", type=float, default=3e-3)
+    a = sub.add_parser("analyse")
+    a.add_argument("--figure", type=Path, default=None)
+    args = ap.parse_args(argv)
+    if args.cmd == "run":
+        run(args.n, args.variants, args.strain)
+    else:
+        analyse(args.figure)
+
+
+if __name__ == "__main__":
+    main()
