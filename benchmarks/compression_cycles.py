@@ -16,8 +16,8 @@ Dansereau et al. (§4) solve each step by a fixed point between the momentum/con
 solve and the damage update; lagice's implicit solver made one pass. `solver.damage_iterations`
 (lagice.solvers.implicit, step 4) now has the fixed point.
 
-**Rule and prediction (stated 2026-11-28, 08:16 UTC, before the fixed-point run's stress past
-its rupture was seen):**
+**Rule and prediction (stated 2026-11-28, 08:16 UTC, while the first fixed-point run, N = 20,
+was at its step 7 400 of 60 000: one progress line past its rupture, 117.8 kPa, had been seen):**
 
 * A *relaxation event* is a drop of the block-end macroscopic stress between two consecutive
   blocks (a block is N steps, the shear-wave crossing of the width, as in
