@@ -105,7 +105,11 @@ def analyse(figure: Path | None):
                         "stress_after_first_event_kpa": [float(after.min() / 1e3), float(after.max() / 1e3)],
                         "max_damage_end": float(z["damage_block_end"][-1].max()),
                         "beta_rupture_block": a["beta_rupture_block"], "beta_after_rupture": a["beta_after_rupture"],
-                        "wall_s": float(z["wall_s"])}
+                        "wall_s": float(z["wall_s"]),
+                        "damage_passes_per_step": (float(z["damage_passes_total"]) / s.size
+                                                   if "damage_passes_total" in z else None),
+                        "damage_unconverged_steps": (int(z["damage_unconverged_steps"])
+                                                     if "damage_unconverged_steps" in z else None)}
         r = rows[d.name]
         print(f"{d.name:10s} N={r['n_across']:3d} peak {r['peak_kpa']:.1f} kPa, events {r['n_events']}, cycles "
               f"{r['n_cycles']} in {span_h if span_h is None else round(span_h, 2)} t_h after the first; stress "

@@ -373,7 +373,11 @@ def run_compression(out: Path, n_across: int, max_strain: float, seed: int = 0, 
                         dt_s=sim.dt, block_steps=block, n_across=n_across, length_m=length,
                         width_m=width, push_speed_m_s=push, friction=m.rheology.params.friction,
                         poisson=m.rheology.params.poisson,
-                        stress_correction=str(m.rheology.params.stress_correction), wall_s=wall, seed=seed)
+                        stress_correction=str(m.rheology.params.stress_correction), wall_s=wall, seed=seed,
+                        # the implicit solver's damage fixed point (solver.damage_iterations): passes over
+                        # the run and steps that used every pass without converging (-1: not that solver)
+                        damage_passes_total=getattr(m.stepper, "damage_passes_total", -1),
+                        damage_unconverged_steps=getattr(m.stepper, "damage_unconverged_steps", -1))
     return path
 
 
