@@ -105,3 +105,56 @@ def test_numba_pcg_matches_scipy_cg(plate_mesh):
     assert its > 0 and res <= 1e-12 * np.linalg.norm(b)
     ref = spla.spsolve(A.tocsc(), b)
     assert np.abs(x - ref).max() <= 1e-9 * np.abs(ref).max()
+
+
+def test_damage_fixed_point_is_consistent_and_default_is_one_pass(tmp_path):
+    """solver.damage_iterations (Dansereau et al. 2016's fixed point): on a step of the N = 10
+    compression where the plate damages, the fixed point's damage d* is the damage that the
+    stress solved with d* gives again (to 10 × damage_tol = 1e-9), in more than one pass; the
+    one-pass damage is not (it is computed from the stress solved with the old damage: here it
+    is off by about 1e-6), so the check can fail. Bad values fail before any work, naming the key."""
+    import copy
+
+    from helpers import compression_overrides, scene_sim
+    from lagice.solvers.base import StepInfo
+
+    sim = scene_sim("uniaxial_compression", tmp_path / "a", compression_overrides(
+        10, **{"healing.law": "none", "run.duration": 2600 * 20.0}))
+    m = sim.model
+    dt = sim.dt
+    while m.state.damage.max() == 0.0:  # to the onset of damage
+        sim.run(n_steps=50)
+    for _ in range(400):  # on to a step with many damaging elements
+        before = copy.deepcopy(m.state)
+        sim.run(n_steps=1)
+        if np.sum(m.state.damage > before.damage) >= 10:
+            break
+    t_s = m.clock.time_s - dt
+    st = m.stepper
+    rheo = st.rheology
+
+    def damage_from(state0, d_use):
+        vel, sigma, _ = st._solve(state0, d_use, t_s, dt, StepInfo())
+        d = state0.damage.copy()
+        rheo.damage_update(sigma, d, state0.cohesion, dt, st.td, rheo.constant_heal_rate(len(d)))
+        return d
+
+    one = copy.deepcopy(before)
+    st.damage_iterations = 1
+    st.step(one, t_s, dt)
+    assert np.array_equal(one.damage, m.state.damage)  # the run itself took one pass (the default)
+    st.damage_tol = tol = 1e-10  # one pass is already consistent to about 1e-6 here
+    gap_one = np.abs(damage_from(before, one.damage) - one.damage).max()
+    fixed = copy.deepcopy(before)
+    st.damage_iterations = 30
+    unconverged = st.damage_unconverged_steps
+    st.step(fixed, t_s, dt)
+    assert st.last_damage_passes > 1 and st.damage_unconverged_steps == unconverged
+    gap_fixed = np.abs(damage_from(before, fixed.damage) - fixed.damage).max()
+    assert gap_fixed < 10 * tol < gap_one
+    for bad in ({"solver.damage_iterations": 0}, {"solver.damage_tol": 0.0}):
+        with pytest.raises(ConfigError, match=list(bad)[0].split(".")[1]):
+            scene_sim("uniaxial_compression", tmp_path / "b", compression_overrides(10, **bad))
+    with pytest.raises(ConfigError, match="damage_iterations does not apply to solver 'explicit'"):
+        scene_sim("uniaxial_compression", tmp_path / "c",
+                  compression_overrides(10, **{"solver.name": "explicit", "solver.damage_iterations": 5}))
