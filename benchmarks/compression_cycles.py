@@ -79,6 +79,19 @@ def cycles(stress_block_end: np.ndarray, peak: float) -> dict:
     return {"events": events.tolist(), "n_events": int(events.size), "n_cycles": int(n_cycles)}
 
 
+def half_rate_area(nodes, tri, vel) -> float:
+    """Fraction of the plate's area that carries half of the total deformation rate ε̇tot · area
+    (the basin's half-shear area, on ε̇tot) of one block-mean velocity field."""
+    from lagice.diagnostics import velocity_gradients
+
+    e1, e2 = nodes[tri[:, 1]] - nodes[tri[:, 0]], nodes[tri[:, 2]] - nodes[tri[:, 0]]
+    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    w = velocity_gradients(nodes, tri, vel).total_s * area
+    order = np.argsort(w)[::-1]
+    k = int(np.searchsorted(np.cumsum(w[order]), 0.5 * w.sum())) + 1
+    return float(area[order[:k]].sum() / area.sum())
+
+
 def analyse(figure: Path | None):
     from validate import analyse_compression, load_npz
 
@@ -106,6 +119,13 @@ def analyse(figure: Path | None):
                         "max_damage_end": float(z["damage_block_end"][-1].max()),
                         "beta_rupture_block": a["beta_rupture_block"], "beta_after_rupture": a["beta_after_rupture"],
                         "wall_s": float(z["wall_s"]),
+                        # the fault's width: the area carrying half the deformation, at the rupture
+                        # block and at the last block (one element row across the plate is 1/N of it
+                        # for a fault along the short edge)
+                        "half_rate_area_rupture_block": half_rate_area(z["nodes"], z["triangles"],
+                                                                       z["velocity_block_mean"][a["rupture_block"]]),
+                        "half_rate_area_last_block": half_rate_area(z["nodes"], z["triangles"],
+                                                                    z["velocity_block_mean"][-1]),
                         "damage_passes_per_step": (float(z["damage_passes_total"]) / s.size
                                                    if "damage_passes_total" in z else None),
                         "damage_unconverged_steps": (int(z["damage_unconverged_steps"])
@@ -115,7 +135,9 @@ def analyse(figure: Path | None):
               f"{r['n_cycles']} in {span_h if span_h is None else round(span_h, 2)} t_h after the first; stress "
               f"after it {r['stress_after_first_event_kpa'][0]:.1f}-{r['stress_after_first_event_kpa'][1]:.1f} kPa; "
               f"max damage {r['max_damage_end']:.3f}; beta rupture block {r['beta_rupture_block']:.3f}, next "
-              f"{r['beta_after_rupture']:.3f}; {r['wall_s']:.0f} s")
+              f"{r['beta_after_rupture']:.3f}; half-rate area {r['half_rate_area_rupture_block']:.3f} at the rupture, "
+              f"{r['half_rate_area_last_block']:.3f} at the end; passes/step {r['damage_passes_per_step']}, "
+              f"unconverged {r['damage_unconverged_steps']}; {r['wall_s']:.0f} s")
         r["_series"] = (np.arange(1, nb + 1) * block * dt, se)
     (OUT / "summary.json").write_text(json.dumps({k: {kk: vv for kk, vv in v.items() if not kk.startswith("_")}
                                                   for k, v in rows.items()}, indent=1))
