@@ -41,6 +41,16 @@ the stress has to go each step to re-damage (about td/(t_h (1 − d)), 1 % at t_
 Prediction: no cycle at either t_h (rule as above: at least 3 cycles within 5 healing times
 after the first event would refute it), and a plateau within 2 % of the t_h = 1e5 s one.
 
+**Platens (stated 2026-11-28, 08:40 UTC).** Dansereau et al. (§4) prescribe "a constant velocity
+U on the upper short edge of the plate with the opposite edge maintained fixed in the direction of
+the forcing"; whether the edges also hold the across-plate velocity is not written. lagice's scene
+prescribes v only (the blocks beside a fault may slide along the edges). A scratch run at N = 20
+with the top edge also held (u = 0; 08:19 UTC, outside this script, before this rule) ended like the
+free one: plateau 116.2 against 116.8 kPa, the same largest damage 0.9125 and 169 elements above
+0.5. Variants `clamp_top`, `clamp_bottom` and `clamp_both` (N = 20, one pass) hold u = 0 on the top,
+the bottom and both edges. Prediction: no cycle in any; a fault system that can slide or extrude
+sideways (a wedge between conjugate faults can, with both edges held) keeps creeping.
+
     python benchmarks/compression_cycles.py run --n 20 40 [--strain 3e-3] [--variants one fixed]
     python benchmarks/compression_cycles.py analyse [--figure docs/figures/compression_cycles.png]
 """
@@ -63,6 +73,9 @@ VARIANTS = {
     "fixed": {"solver.damage_iterations": 30},  # Dansereau et al. (2016)'s fixed point
     "th3e4": {"rheology.healing_time_s": 3e4},  # healing 3.3x faster than Table 1's
     "th1e4": {"rheology.healing_time_s": 1e4},  # 10x faster
+    "clamp_top": {"boundary.top.u": 0.0},  # the pushed edge also holds the across-plate velocity
+    "clamp_bottom": {"boundary.bottom.u": 0.0},
+    "clamp_both": {"boundary.top.u": 0.0, "boundary.bottom.u": 0.0},
 }
 EVENT_FRACTION = 0.01  # of the peak stress, for a relaxation event and for the rise before a cycle
 HEALING_TIME_S = 1e5  # the scene's t_h (healing.law = "constant", rheology.healing_time_s)
@@ -122,7 +135,8 @@ def analyse(figure: Path | None):
         cy = cycles(se, peak)
         t_end = s.size * dt
         first = cy["events"][0] if cy["events"] else None
-        span_h = None if first is None else (t_end - (first + 1) * block * dt) / HEALING_TIME_S
+        t_h = VARIANTS.get(d.name.split("_N")[0], {}).get("rheology.healing_time_s", HEALING_TIME_S)
+        span_h = None if first is None else (t_end - (first + 1) * block * dt) / t_h  # in the run's own t_h
         after = se[first:] if first is not None else se
         a = analyse_compression(f)
         rows[d.name] = {"n_across": int(z["n_across"]), "steps": int(s.size), "dt_s": dt, "block_steps": block,
