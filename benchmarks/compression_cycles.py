@@ -41,7 +41,7 @@ the stress has to go each step to re-damage (about td/(t_h (1 − d)), 1 % at t_
 Prediction: no cycle at either t_h (rule as above: at least 3 cycles within 5 healing times
 after the first event would refute it), and a plateau within 2 % of the t_h = 1e5 s one.
 
-**Platens (stated 2026-11-28, 08:40 UTC).** Dansereau et al. (§4) prescribe "a constant velocity
+**Platens (stated 2026-11-28, 08:37 UTC).** Dansereau et al. (§4) prescribe "a constant velocity
 U on the upper short edge of the plate with the opposite edge maintained fixed in the direction of
 the forcing"; whether the edges also hold the across-plate velocity is not written. lagice's scene
 prescribes v only (the blocks beside a fault may slide along the edges). A scratch run at N = 20
