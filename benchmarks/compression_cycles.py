@@ -177,15 +177,23 @@ def analyse(figure: Path | None):
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        fig, ax = plt.subplots(figsize=(9, 4.5))
-        for name, r in rows.items():
-            t, se = r["_series"]
-            ax.plot(t / HEALING_TIME_S, se / 1e3, lw=1,
-                    label=f"{name}: {r['n_cycles']} cycles, max damage {r['max_damage_end']:.2f}")
-        ax.set(xlabel="time / healing time t_h (1e5 s)", ylabel="macroscopic compressive stress (kPa), block ends",
-               title="Compression after the macro-rupture: one damage pass per step against the fixed point")
-        ax.legend(fontsize=8)
-        ax.grid(alpha=0.3)
+        fig, axes = plt.subplots(1, 2, figsize=(14, 4.8), sharey=True)
+        panels = ([k for k in rows if k.split("_N")[0] in ("one", "fixed")],
+                  [k for k in rows if k.split("_N")[0] not in ("one", "fixed") or k == "one_N20"])
+        titles = ("one damage pass per step against the fixed point (Dansereau et al. 2016)",
+                  "N = 20: healing time and platens (one pass)")
+        for ax, names, title in zip(axes, panels, titles):
+            for name in names:
+                r = rows[name]
+                t, se = r["_series"]
+                ax.plot(t / HEALING_TIME_S, se / 1e3, lw=1.2 if name.startswith("fixed") else 0.9,
+                        ls="--" if name.startswith("fixed") else "-",
+                        label=f"{name}: {r['n_cycles']} cycles, max damage {r['max_damage_end']:.2f}")
+            ax.set(xlabel="time / 1e5 s (Table 1's healing time)", title=title)
+            ax.legend(fontsize=7, loc="lower right")
+            ax.grid(alpha=0.3)
+            ax.set_ylim(80, 130)
+        axes[0].set_ylabel("macroscopic compressive stress (kPa), block ends")
         fig.tight_layout()
         fig.savefig(figure, dpi=110)
         print("wrote", figure)

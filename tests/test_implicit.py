@@ -115,8 +115,9 @@ def test_damage_fixed_point_is_consistent_and_default_is_one_pass(tmp_path):
     is off by about 1e-6), so the check can fail. Bad values fail before any work, naming the key."""
     import copy
 
-    from helpers import compression_overrides, scene_sim
     from lagice.solvers.base import StepInfo
+
+    from helpers import compression_overrides, scene_sim
 
     sim = scene_sim("uniaxial_compression", tmp_path / "a", compression_overrides(
         10, **{"healing.law": "none", "run.duration": 2600 * 20.0}))
