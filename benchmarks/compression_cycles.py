@@ -51,7 +51,7 @@ free one: plateau 116.2 against 116.8 kPa, the same largest damage 0.9125 and 16
 the bottom and both edges. Prediction: no cycle in any; a fault system that can slide or extrude
 sideways (a wedge between conjugate faults can, with both edges held) keeps creeping.
 
-**After the platen runs at N = 20 (stated 2026-11-28, 08:53 UTC).** `clamp_bottom` has one event by
+**After the platen runs at N = 20 (stated 2026-11-28, 08:48 UTC).** `clamp_bottom` has one event by
 the rule's measure (a block-to-block drop of 1 % of the peak, at 5.9 t_h), so 0 cycles, yet its
 stress rises and falls by 2-8 kPa over 0.05-0.2 t_h through the whole run (the free plate's stays
 within 0.1 kPa). The drops are spread over more than one block (a block is 0.002 t_h at N = 20),
