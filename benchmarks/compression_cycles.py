@@ -62,6 +62,8 @@ within 0.05 t_h (1e5 s) from the highest value before it, relaxations at least 0
 value after the previous one. Variant `clamp_bottom` at N = 40 (run after this statement) tests
 whether the behaviour holds on the finer mesh. Prediction: at least 3 windowed cycles within 5 t_h
 after the first relaxation at N = 40 as at N = 20, and none in the free plate at either N.
+Added 08:56 UTC, after `clamp_both` at N = 20 (10 windowed cycles) and before its N = 40 run: the
+same prediction for `clamp_both` at N = 40.
 
     python benchmarks/compression_cycles.py run --n 20 40 [--strain 3e-3] [--variants one fixed]
     python benchmarks/compression_cycles.py analyse [--figure docs/figures/compression_cycles.png]
