@@ -64,7 +64,7 @@ whether the behaviour holds on the finer mesh. Prediction: at least 3 windowed c
 after the first relaxation at N = 40 as at N = 20, and none in the free plate at either N.
 Added 08:56 UTC, after `clamp_both` at N = 20 (10 windowed cycles) and before its N = 40 run: the
 same prediction for `clamp_both` at N = 40.
-Added 09:01 UTC, while `clamp_bottom` at N = 40 was at step 87 500 of 120 000 and its progress lines
+Added 09:00 UTC, while `clamp_bottom` at N = 40 was at step 87 500 of 120 000 and its progress lines
 (stress 110.3-110.7 kPa, mean damage 0.055) matched the free plate's: at N = 40 the first faults
 meet the *top* edge (`docs/figures/validation_compression.png`), so the bottom edge may not matter
 there. `clamp_top` at N = 40 (run after this statement): prediction, at least 3 windowed cycles
