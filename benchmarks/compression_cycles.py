@@ -220,6 +220,7 @@ def analyse(figure: Path | None):
               f"{r['half_rate_area_last_block']:.3f} at the end; passes/step {r['damage_passes_per_step']}, "
               f"unconverged {r['damage_unconverged_steps']}; {r['wall_s']:.0f} s")
         r["_series"] = (np.arange(1, nb + 1) * block * dt, se)
+        r["_map"] = (z["nodes"], z["triangles"], z["damage_block_end"][-1].astype(float))
     (OUT / "summary.json").write_text(json.dumps({k: {kk: vv for kk, vv in v.items() if not kk.startswith("_")}
                                                   for k, v in rows.items()}, indent=1))
     if figure is not None and rows:
@@ -228,18 +229,20 @@ def analyse(figure: Path | None):
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        fig, axes = plt.subplots(1, 2, figsize=(14, 4.8), sharey=True)
-        panels = ([k for k in rows if k.split("_N")[0] in ("one", "fixed")],
-                  [k for k in rows if k.split("_N")[0] not in ("one", "fixed") or k == "one_N20"])
+        fig, axes = plt.subplots(1, 3, figsize=(18, 4.8), sharey=True)
+        kind = {k: k.split("_N")[0] for k in rows}
+        panels = ([k for k in rows if kind[k] in ("one", "fixed")],
+                  [k for k in rows if k.endswith("_N20") and (kind[k] not in ("one", "fixed") or k == "one_N20")],
+                  [k for k in rows if k.endswith("_N40") and (kind[k] not in ("one", "fixed") or k == "one_N40")])
         titles = ("one damage pass per step against the fixed point (Dansereau et al. 2016)",
-                  "N = 20: healing time and platens (one pass)")
+                  "N = 20: healing time and held edges (one pass)", "N = 40: held edges (one pass)")
         for ax, names, title in zip(axes, panels, titles):
             for name in names:
                 r = rows[name]
                 t, se = r["_series"]
                 ax.plot(t / HEALING_TIME_S, se / 1e3, lw=1.2 if name.startswith("fixed") else 0.9,
                         ls="--" if name.startswith("fixed") else "-",
-                        label=f"{name}: {r['n_cycles']} cycles, max damage {r['max_damage_end']:.2f}")
+                        label=f"{name}: cycles {r['n_cycles']} (rule) / {r['n_windowed_cycles']} (windowed)")
             ax.set(xlabel="time / 1e5 s (Table 1's healing time)", title=title)
             ax.legend(fontsize=7, loc="lower right")
             ax.grid(alpha=0.3)
@@ -248,6 +251,21 @@ def analyse(figure: Path | None):
         fig.tight_layout()
         fig.savefig(figure, dpi=110)
         print("wrote", figure)
+        # the damage at the end of each run: where the fault system meets the edges
+        names = list(rows)
+        fig, axes = plt.subplots(1, len(names), figsize=(1.9 * len(names), 4.6))
+        for ax, name in zip(np.atleast_1d(axes), names):
+            nodes, tri, dmg = rows[name]["_map"]
+            ax.tripcolor(nodes[:, 0] / 1e3, nodes[:, 1] / 1e3, tri, facecolors=dmg, cmap="viridis", vmin=0, vmax=1)
+            ax.set_aspect("equal")
+            ax.set_title(name, fontsize=8)
+            ax.set_xticks([0, 50, 100])
+            ax.tick_params(labelsize=7)
+        fig.suptitle("damage at the end of each run (6 t_h); bottom edge fixed in y, top edge pushed down", fontsize=9)
+        fig.tight_layout()
+        maps = figure.with_name(figure.stem + "_damage.png")
+        fig.savefig(maps, dpi=110)
+        print("wrote", maps)
     return rows
 
 
