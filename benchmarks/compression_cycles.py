@@ -146,7 +146,8 @@ def windowed_cycles(t_s: np.ndarray, se: np.ndarray, peak: float) -> dict:
         lo = int(np.argmin(seg))
         if seg[lo:].max() - seg[lo] >= thr:
             n_cycles += 1
-    return {"relaxation_times_t_h": [round(float(t_s[k]) / HEALING_TIME_S, 3) for k in rel],
+    return {"relaxation_blocks": rel,
+            "relaxation_times_t_h": [round(float(t_s[k]) / HEALING_TIME_S, 3) for k in rel],
             "n_relaxations": len(rel), "n_windowed_cycles": n_cycles}
 
 
@@ -165,6 +166,8 @@ def half_rate_area(nodes, tri, vel) -> float:
 
 def analyse(figure: Path | None):
     from validate import analyse_compression, load_npz
+
+    from lagice.diagnostics import spatial_scaling, velocity_gradients
 
     rows = {}
     for d in sorted(OUT.glob("*_N*")):
@@ -185,6 +188,11 @@ def analyse(figure: Path | None):
         after = se[first:] if first is not None else None
         a = analyse_compression(f)
         wc = windowed_cycles(np.arange(1, nb + 1) * block * dt, se, peak)
+        # β of the block in which each windowed relaxation is seen ("β near the ruptures")
+        wc["beta_at_relaxations"] = [round(float(spatial_scaling(velocity_gradients(
+            z["nodes"], z["triangles"], z["velocity_block_mean"][k])).fit.exponent), 3)
+            for k in wc.pop("relaxation_blocks")]
+        wc["beta_at_relaxations_median"] = float(np.median(wc["beta_at_relaxations"]))
         rows[d.name] = {"n_across": int(z["n_across"]), "steps": int(s.size), "dt_s": dt, "block_steps": block,
                         "peak_kpa": peak / 1e3, "n_events": cy["n_events"], "n_cycles": cy["n_cycles"],
                         **wc,
@@ -213,7 +221,8 @@ def analyse(figure: Path | None):
         print(f"{d.name:10s} N={r['n_across']:3d} peak {r['peak_kpa']:.1f} kPa, events {r['n_events']}, cycles "
               f"{r['n_cycles']} in {span_h if span_h is None else round(span_h, 2)} t_h after the first (events at "
               f"{r['event_times_t_h']} t_h); windowed: {r['n_relaxations']} relaxations at {r['relaxation_times_t_h']} "
-              f"t_h, {r['n_windowed_cycles']} cycles; stress over the second half "
+              f"t_h (β {r['beta_at_relaxations']}, median {r['beta_at_relaxations_median']:.3f}), "
+              f"{r['n_windowed_cycles']} cycles; stress over the second half "
               f"{r['stress_second_half_kpa'][0]:.1f}-{r['stress_second_half_kpa'][1]:.1f} kPa; "
               f"max damage {r['max_damage_end']:.3f}; beta rupture block {r['beta_rupture_block']:.3f}, next "
               f"{r['beta_after_rupture']:.3f}; half-rate area {r['half_rate_area_rupture_block']:.3f} at the rupture, "
