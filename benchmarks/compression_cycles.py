@@ -262,15 +262,20 @@ def analyse(figure: Path | None):
         print("wrote", figure)
         # the damage at the end of each run: where the fault system meets the edges
         names = list(rows)
-        fig, axes = plt.subplots(1, len(names), figsize=(1.9 * len(names), 4.6))
-        for ax, name in zip(np.atleast_1d(axes), names):
+        ncol = min(6, len(names))
+        nrow = -(-len(names) // ncol)
+        fig, axes = plt.subplots(nrow, ncol, figsize=(2.1 * ncol, 4.4 * nrow), squeeze=False)
+        for ax in axes.flat[len(names):]:
+            ax.set_visible(False)
+        for ax, name in zip(axes.flat, names):
             nodes, tri, dmg = rows[name]["_map"]
             ax.tripcolor(nodes[:, 0] / 1e3, nodes[:, 1] / 1e3, tri, facecolors=dmg, cmap="viridis", vmin=0, vmax=1)
             ax.set_aspect("equal")
             ax.set_title(name, fontsize=8)
             ax.set_xticks([0, 50, 100])
             ax.tick_params(labelsize=7)
-        fig.suptitle("damage at the end of each run (6 t_h); bottom edge fixed in y, top edge pushed down", fontsize=9)
+        fig.suptitle("damage at the end of each run (6 x 1e5 s); the top edge is pushed down, the bottom edge "
+                     "holds v = 0; clamp_*: u = 0 on that edge too", fontsize=9)
         fig.tight_layout()
         maps = figure.with_name(figure.stem + "_damage.png")
         fig.savefig(maps, dpi=110)
