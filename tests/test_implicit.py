@@ -107,12 +107,13 @@ def test_numba_pcg_matches_scipy_cg(plate_mesh):
     assert np.abs(x - ref).max() <= 1e-9 * np.abs(ref).max()
 
 
-def test_damage_fixed_point_is_consistent_and_default_is_one_pass(tmp_path):
+def test_damage_fixed_point_is_consistent_and_default_is_one_pass(tmp_path, caplog):
     """solver.damage_iterations (Dansereau et al. 2016's fixed point): on a step of the N = 10
     compression where the plate damages, the fixed point's damage d* is the damage that the
     stress solved with d* gives again (to 10 × damage_tol = 1e-9), in more than one pass; the
     one-pass damage is not (it is computed from the stress solved with the old damage: here it
-    is off by about 1e-6), so the check can fail. Bad values fail before any work, naming the key."""
+    is off by about 1e-6), so the check can fail. A step that uses every pass without settling is
+    counted and logged. Bad values fail before any work, naming the key."""
     import copy
 
     from lagice.solvers.base import StepInfo
@@ -153,6 +154,12 @@ def test_damage_fixed_point_is_consistent_and_default_is_one_pass(tmp_path):
     assert st.last_damage_passes > 1 and st.damage_unconverged_steps == unconverged
     gap_fixed = np.abs(damage_from(before, fixed.damage) - fixed.damage).max()
     assert gap_fixed < 10 * tol < gap_one
+    # too few passes for the tolerance: counted and logged, the last pass kept
+    st.damage_iterations, st.damage_tol = 2, 1e-15
+    with caplog.at_level("WARNING", logger="lagice"):
+        st.step(copy.deepcopy(before), t_s, dt)
+    assert st.damage_unconverged_steps == unconverged + 1
+    assert "damage_iterations = 2 passes without the damage settling" in caplog.text
     for bad in ({"solver.damage_iterations": 0}, {"solver.damage_tol": 0.0}):
         with pytest.raises(ConfigError, match=list(bad)[0].split(".")[1]):
             scene_sim("uniaxial_compression", tmp_path / "b", compression_overrides(10, **bad))

@@ -27,6 +27,8 @@ Iterations, residual and timings (assembly, solve, damage) are reported in
 """
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 
 from .._numba import pick
@@ -59,7 +61,8 @@ class ImplicitSolver:
 
     ``last_damage_passes`` is the number of passes of the last step; ``damage_passes_total``
     and ``damage_unconverged_steps`` (steps that used every pass without meeting
-    ``damage_tol``) are counted over the run and reported, not hidden.
+    ``damage_tol``) are counted over the run; the first such step, and every 1000th, is
+    logged as a warning.
 
     The transport velocity is the end-of-step velocity u^{n+1} (backward Euler:
     x^{n+1} = x^n + Δt u^{n+1}); :attr:`last_strain_rate` is its strain rate.
@@ -151,6 +154,12 @@ class ImplicitSolver:
             d_use = damage
         else:
             self.damage_unconverged_steps += 1
+            n = self.damage_unconverged_steps
+            if n == 1 or n % 1000 == 0:  # reported, not hidden; not a line for every step
+                logging.getLogger("lagice").warning(
+                    f"implicit solver: the damage fixed point used all solver.damage_iterations = "
+                    f"{self.damage_iterations} passes without the damage settling to solver.damage_tol = "
+                    f"{self.damage_tol:g} on {n} step(s) so far (the last pass is kept)")
         self.last_damage_passes = passes
         self.damage_passes_total += passes
         info.n_damaged = int(np.sum(dc < 1.0))
