@@ -70,7 +70,7 @@ meet the *top* edge (`docs/figures/validation_compression.png`), so the bottom e
 there. `clamp_top` at N = 40 (run after this statement): prediction, at least 3 windowed cycles
 within 5 t_h after the first relaxation, if the faults meet the top edge as in that figure.
 
-**The basin's stepper (stated 2026-11-28, 09:35 UTC, after every run above and before these).**
+**The basin's stepper (stated 2026-11-28, 09:34 UTC, after every run above and before these).**
 The flagship runs the explicit stepper (elastic sub-steps, damage over td), not the implicit one.
 Variants `explicit` (free edges) and `explicit_clamp_both` (u = 0 on both edges), N = 20 and 40,
 the scene's mesh and Δt = td with automatic sub-steps, as `mesh_imprint.py`'s explicit variant.
