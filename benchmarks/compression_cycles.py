@@ -249,13 +249,19 @@ def analyse(figure: Path | None):
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        fig, axes = plt.subplots(1, 3, figsize=(18, 4.8), sharey=True)
+        fig, axes = plt.subplots(1, 4, figsize=(23, 4.8), sharey=True)
         kind = {k: k.split("_N")[0] for k in rows}
+
+        def implicit_variant(k, n):
+            return k.endswith(n) and not k.startswith("explicit") and (kind[k] not in ("one", "fixed")
+                                                                      or k == "one" + n)
+
         panels = ([k for k in rows if kind[k] in ("one", "fixed")],
-                  [k for k in rows if k.endswith("_N20") and (kind[k] not in ("one", "fixed") or k == "one_N20")],
-                  [k for k in rows if k.endswith("_N40") and (kind[k] not in ("one", "fixed") or k == "one_N40")])
+                  [k for k in rows if implicit_variant(k, "_N20")], [k for k in rows if implicit_variant(k, "_N40")],
+                  [k for k in rows if k.startswith("explicit")])
         titles = ("one damage pass per step against the fixed point (Dansereau et al. 2016)",
-                  "N = 20: healing time and held edges (one pass)", "N = 40: held edges (one pass)")
+                  "N = 20: healing time and held edges (one pass)", "N = 40: held edges (one pass)",
+                  "explicit stepper (the basin's): its elastic ringing")
         for ax, names, title in zip(axes, panels, titles):
             for name in names:
                 r = rows[name]
