@@ -623,3 +623,32 @@ def test_damage_budget_takes_the_net_change_from_the_snapshots(tmp_path):
     assert rows[1]["healed_m2"] == pytest.approx(9.0e10 - 0.3 * a_in, rel=1e-12)
     assert rows[1]["mean_damage_start"] == pytest.approx(0.5) and rows[1]["mean_damage_end"] == pytest.approx(0.8)
     assert "| 1–2 |" in budget_table("t", rows) and f"| {9.0e10 / 1e9 + 7.0:.0f} |" in budget_table("t", rows)
+
+
+def test_compression_cycle_measures_on_known_series():
+    """benchmarks/compression_cycles.py: on a flat plateau after one drop, neither measure finds a
+    cycle; on a sawtooth of slow 3 % rises and falls spread over 5 blocks (0.01 t_h), the
+    block-to-block measure finds none (each block falls 0.6 % of the peak, under its 1 %) and the
+    windowed measure finds every fall after the first (rise of 3 % between them), 0.5 t_h apart."""
+    from compression_cycles import HEALING_TIME_S, cycles, windowed_cycles
+
+    dt_block = 0.002 * HEALING_TIME_S
+    t = np.arange(1, 3001) * dt_block  # 6 t_h
+    peak = 100.0
+    flat = np.full(t.size, 96.0)
+    flat[:200] = np.linspace(0.0, peak, 200)
+    flat[200] = 90.0  # one drop of 10 % right after the peak, then a plateau
+    assert cycles(flat, peak)["n_cycles"] == 0
+    w = windowed_cycles(t, flat, peak)
+    assert (w["n_relaxations"], w["n_windowed_cycles"]) == (1, 0)
+    saw = np.empty(t.size)
+    period = 250  # blocks: 0.5 t_h
+    for k in range(t.size):
+        j = k % period
+        saw[k] = 97.0 + 3.0 * j / (period - 5) if j < period - 5 else 100.0 - 3.0 * (j - period + 6) / 5
+    assert cycles(saw, peak)["n_events"] == 0
+    w = windowed_cycles(t, saw, peak)
+    assert w["n_relaxations"] == t.size // period
+    assert w["n_windowed_cycles"] == w["n_relaxations"] - 1
+    gaps = np.diff(w["relaxation_times_t_h"])
+    assert np.allclose(gaps, 0.5)
