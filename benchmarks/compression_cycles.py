@@ -166,13 +166,11 @@ def half_rate_area(nodes, tri, vel) -> float:
     """Fraction of the plate's area that carries half of the total deformation rate ε̇tot · area
     (the basin's half-shear area, on ε̇tot) of one block-mean velocity field."""
     from lagice.diagnostics import velocity_gradients
+    from lagice.diagnostics.statistics import localisation_area_fraction
+    from lagice.mesh.core import signed_areas
 
-    e1, e2 = nodes[tri[:, 1]] - nodes[tri[:, 0]], nodes[tri[:, 2]] - nodes[tri[:, 0]]
-    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
-    w = velocity_gradients(nodes, tri, vel).total_s * area
-    order = np.argsort(w)[::-1]
-    k = int(np.searchsorted(np.cumsum(w[order]), 0.5 * w.sum())) + 1
-    return float(area[order[:k]].sum() / area.sum())
+    rate = velocity_gradients(nodes, tri, vel).total_s
+    return float(localisation_area_fraction(rate, np.abs(signed_areas(nodes, tri))))
 
 
 def analyse(figure: Path | None):
