@@ -1382,6 +1382,46 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
         28, f"{_p}-hthick-1125-w2027 with the damage averaged over R = 14 km (stage 2 of a lead)")
 
 
+# Broken ice that keeps no cohesion (2026-11-28, twenty-sixth session; docs/physics.md §4):
+# rheology.failure_stress = "effective", the Mohr-Coulomb envelope judges the effective stress
+# sigma/(1 - d) of continuum damage mechanics (Kachanov 1958; Lemaitre 1985): an element's
+# cohesion is C (1 - d), its friction kept. Why (measured first, from the validation month's
+# snapshots, F10-hthick-1125, days 8-10): in the storm window the interior's damage is 0.91
+# (median) between the most active 5 % of the elements and 0.96 in them, so with the nominal
+# criterion a fault is hardly weaker than the pack around it.
+# A prototype screen (an uncommitted worktree with the same one-line change; its rule, stated
+# 10:17 UTC before its month's statistics: beta +0.04, the interior's area above damage 0.5 at
+# day 10 down by 0.2, half-shear area <= 8 %), 20 km closed basin, each from its own 14-day
+# spin-up (H20 below): nominal beta 0.046, tails 2.23 / 2.49, half-shear area 7.7 %, R2 0.78,
+# rate 0.0033 per day (4 bands inside); effective beta 0.192, tails 4.29 / 4.25, half-shear area
+# 12.8 %, R2 0.61, rate 0.0238 per day (2 bands inside); area above damage 0.5 at day 10: 1.00 ->
+# 0.59. It failed its rule on the half-shear area (predicted: on beta, +0.02 only).
+# The 10 km runs, stated 2026-11-28 10:25 UTC before any of them (committed code, both basins,
+# the validation month, each from its own 14-day spin-up with the change):
+#  (a) beta belongs to the ice, not to the mesh, if the closed basin's beta at 10 km lies within
+#      0.05 of the 20 km screen's 0.192, and above 0.13;
+#  (b) it limits over-failure if the interior's area above damage 0.5 at day 10 is at least 0.2
+#      below the shipped set's (0.99 closed, 1.00 strait) in both basins;
+#  (c) a lead for the flagship only if it puts at least as many bands inside as the shipped set
+#      (2 closed, 3 strait) in both basins.
+# Predicted: (a) and (b) hold (beta 0.15-0.22, area 0.55-0.75); (c) fails: the half-shear area
+# above 8 % and both tails lighter than observed, 2 bands inside or fewer in each basin.
+EFFECTIVE = ["rheology.failure_stress=effective"]
+SPINUPS["H1125-eff"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE, OUT / "spinup-H1125-eff.npz", 10e3)
+EXPERIMENTS["F10-hthick-eff"] = ("closed", EFFECTIVE + from_spinup("H1125-eff"), 10e3, 28,
+                                 "the envelope judges the effective stress sigma/(1 - d), own spin-up")
+EXPERIMENTS["F10s-hthick-eff"] = ("strait", EFFECTIVE + from_spinup("H1125-eff"), 10e3, 28,
+                                  "strait: the envelope judges the effective stress sigma/(1 - d), own spin-up")
+# the 20 km screen again through the committed code (its own 20 km spin-ups; the prototype's
+# numbers above must come back)
+SPINUPS["H20"] = ([f"initial.thickness_m={HETERO_THICKNESS}"], OUT / "spinup-H20.npz", 20e3)
+SPINUPS["H20-eff"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE, OUT / "spinup-H20-eff.npz", 20e3)
+EXPERIMENTS["B20-hthick-own"] = ("closed", from_spinup("H20"), 20e3, 28,
+                                 "thick-and-thin pack at 20 km from its own 20 km spin-up (nominal criterion)")
+EXPERIMENTS["B20-hthick-eff"] = ("closed", EFFECTIVE + from_spinup("H20-eff"), 20e3, 28,
+                                 "20 km: the envelope judges the effective stress sigma/(1 - d), own spin-up")
+
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]

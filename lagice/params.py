@@ -18,6 +18,8 @@ OMEGA_EARTH = 7.2921e-5  # rad s-1
 
 #: stress-correction paths of :class:`MaxwellEBParams` (``rheology.stress_correction``)
 STRESS_CORRECTIONS = ("origin", "mean_stress", "associated")
+#: the stress the failure envelope judges (:attr:`MaxwellEBParams.failure_stress`)
+FAILURE_STRESSES = ("nominal", "effective")
 
 
 @dataclass(frozen=True)
@@ -78,6 +80,14 @@ class MaxwellEBParams:
             whatever the mesh (:mod:`lagice.solvers.nonlocal_damage`). Explicit CPU stepper only,
             with the default stress path (origin correction, whole stress relaxing, no
             compressive term, no dilatancy)
+        failure_stress: the stress the Mohr-Coulomb envelope judges. ``"nominal"`` (Dansereau et
+            al. 2016, neXtSIM; the default): σ itself, so damaged ice fails at the strength of
+            intact ice. ``"effective"`` (a diagnostic of lagice, 2026-11-28; docs/physics.md §4,
+            "Broken ice that keeps no cohesion"): the effective stress σ/(1 − d) of continuum
+            damage mechanics (Kachanov 1958; Lemaitre 1985), so the cohesion and the tensile
+            strength of an element are C (1 − d) and the friction μ is kept: broken ice holds by
+            friction alone, as a fault does. Explicit CPU stepper only, with the local damage
+            (no ``damage_nonlocal_radius_m``)
     """
 
     poisson: float = 0.3
@@ -99,6 +109,7 @@ class MaxwellEBParams:
     relax_mean_stress: bool = True
     dilatancy_angle_deg: float | None = None
     damage_nonlocal_radius_m: float | None = None
+    failure_stress: str = "nominal"
 
     def __post_init__(self):
         check_range("poisson (ν)", self.poisson, 0.0, 0.5, high_open=True)
@@ -139,6 +150,13 @@ class MaxwellEBParams:
                                   f"implemented with the default stress path only (stress_correction = 'origin', "
                                   f"relax_mean_stress = true, no max_pressure_pa, no dilatancy_angle_deg); it is "
                                   f"set with {others}")
+        if self.failure_stress not in FAILURE_STRESSES:
+            raise ConfigError(f"rheology.failure_stress = {self.failure_stress!r}: expected one of "
+                              f"{list(FAILURE_STRESSES)}")
+        if self.failure_stress != "nominal" and self.damage_nonlocal_radius_m:
+            raise ConfigError(f"rheology.failure_stress = {self.failure_stress!r} is implemented with the local "
+                              f"damage only; it is set with damage_nonlocal_radius_m = "
+                              f"{self.damage_nonlocal_radius_m!r} m")
         if self.stress_correction not in STRESS_CORRECTIONS:
             raise ConfigError(f"rheology.stress_correction = {self.stress_correction!r}: expected one of "
                               f"{list(STRESS_CORRECTIONS)}")
@@ -169,6 +187,8 @@ class MaxwellEBParams:
             out["dilatancy_angle_deg"] = self.dilatancy_angle_deg
         if self.damage_nonlocal_radius_m:
             out["damage_nonlocal_radius_m"] = self.damage_nonlocal_radius_m
+        if self.failure_stress != "nominal":
+            out["failure_stress"] = self.failure_stress
         return out
 
     @property

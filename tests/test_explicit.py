@@ -64,7 +64,7 @@ def test_element_kernel_damage_matches_rheology(kernel, theta):
     kc, kt = envelope_factors(rheo)
     e_dt, gam = np.zeros(m), np.ones(m)
     kernel(tri, zeros3, zeros3, np.zeros((1, 2)), s2, d2, conc_factor, coh, kc, kt, td, heal, e_dt, gam, None,
-           None, theta, None, 7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, p.alpha,
+           None, theta, None, None, 7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, p.alpha,
            flag)
     assert (dc < 1).sum() > 100
     if theta is not None:  # the path differs from the origin's where the correction acted
@@ -112,7 +112,7 @@ def test_element_kernel_stress_update_uses_rheology_moduli(kernel):
         kc, kt = envelope_factors(rheo)
         E, lam = rheo.moduli(damage, conc)
         kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, conc_factor, np.full(m, 1e15), kc, kt,
-               np.full(m, 20.0), np.zeros(m), dt_s * E, lam / (lam + dt_s), None, None, None, None, dt_s,
+               np.full(m, 20.0), np.zeros(m), dt_s * E, lam / (lam + dt_s), None, None, None, None, None, dt_s,
                *rheo.K[0, :2],
                rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, float(alpha),
                np.zeros(m, np.int8))
@@ -149,7 +149,7 @@ def test_alpha4_builds_equal_general_builds():
         sigma, d, flag = sigma0.copy(), damage0.copy(), np.zeros(m, np.int8)
         e_dt, gam = dt_s * E, lam / (lam + dt_s)
         capped = kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, np.full(m, 0.9),
-                        coh, kc, kt, np.full(m, 30.0), np.full(m, 1e-6), e_dt, gam, None, None, None, None, dt_s,
+                        coh, kc, kt, np.full(m, 30.0), np.full(m, 1e-6), e_dt, gam, None, None, None, None, None, dt_s,
                         *rheo.K[0, :2],
                         rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
         out.append((sigma, d, flag, capped, e_dt, gam))

@@ -69,6 +69,9 @@ SCHEMA = {
         # nonlocal damage: the load ratio averaged over centroids within this radius [m]
         # (MaxwellEBParams.damage_nonlocal_radius_m; 0/None off)
         "damage_nonlocal_radius_m": (NUM, None),
+        # the stress the failure envelope judges: "nominal" (Dansereau et al. 2016) or "effective",
+        # σ/(1 − d): cohesion C (1 − d), friction kept (MaxwellEBParams.failure_stress)
+        "failure_stress": (str, "nominal"),
         "p_star": (NUM, 27.5e3), "c_star": (NUM, 20.0), "ellipse": (NUM, 2.0), "delta_min": (NUM, 2e-9),
         "replacement_pressure": (bool, False),
         # strength law (lagice.strength; issue 12): "uniform" = cohesion_min/max_pa,
@@ -122,7 +125,7 @@ RHEOLOGY_KEYS = {
                    "alpha", "cohesion_min_pa", "cohesion_max_pa", "healing_time_s", "concentration_c",
                    "max_damage", "stress_correction", "stress_correction_mean_fraction", "max_pressure_pa",
                    "max_pressure_thickness_exponent", "relax_mean_stress",
-                   "dilatancy_angle_deg", "damage_nonlocal_radius_m"),
+                   "dilatancy_angle_deg", "damage_nonlocal_radius_m", "failure_stress"),
     "viscous_plastic": ("p_star", "c_star", "ellipse", "delta_min", "replacement_pressure", "rho_ice"),
 }
 
@@ -157,6 +160,7 @@ LEGACY_VALUES = {
     "rheology.relax_mean_stress": (True,),            # 2026-11-27: the whole stress relaxes
     "rheology.dilatancy_angle_deg": (None, 0, 0.0),   # 2026-11-27: the viscous flow does not dilate
     "rheology.damage_nonlocal_radius_m": (None, 0, 0.0),  # 2026-11-28: local damage
+    "rheology.failure_stress": ("nominal",),         # 2026-11-28: the envelope judges the nominal stress
     "thermo.new_ice_undamaged": (False,),            # 2026-11-27: new ice takes the element's damage
     "initial.state_file": (None, ""),                # 2026-11-24: no spin-up state
     "solver.substep_limit": (None, "mesh"),          # 2026-11-25: the whole-mesh limit

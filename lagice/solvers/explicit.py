@@ -201,8 +201,8 @@ _ALPHA_IS_4 = False
 
 
 def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion, kc, kt,
-                           td, heal_rate, e_dt, gamma, pmax, keep_mean, theta, dilat, dt_s, kxx, kxy, kss, q, denom,
-                           max_damage, E0, lambda0, alpha, damaged_flag):
+                           td, heal_rate, e_dt, gamma, pmax, keep_mean, theta, dilat, eff, dt_s, kxx, kxy, kss, q,
+                           denom, max_damage, E0, lambda0, alpha, damaged_flag):
     """Maxwell stress update and damage/healing of one sub-step, in place (module doc, step 2).
 
     e_dt = Δt_s E [Pa s], gamma = λ/(λ+Δt_s) per element, refreshed here where damage
@@ -235,6 +235,10 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     relaxation: σ ← γ σ* − (1 − γ) k_ψ r I, r that of the relaxed stress γ σ* (exact, since
     the isotropic term leaves r unchanged). Only with the whole stress relaxing and no
     compressive term (params refuse the rest).
+    eff: None (rheology.failure_stress = "nominal", the default; pruned as pmax is): the envelope
+    judges σ with the element's cohesion C. True (``"effective"``): it judges the effective
+    stress σ/(1 − d), i.e. σ against the envelope of cohesion C (1 − d) (the friction is
+    kept), d the damage at the start of the sub-step.
     Returns the number of elements whose damage hit the cap.
     """
     m = tri.shape[0]
@@ -274,6 +278,8 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
         mm = 0.5 * (sxx + syy)
         r2 = 0.25 * (sxx - syy) ** 2 + sxy * sxy
         ce = cohesion[e]
+        if eff is not None:
+            ce = ce * (1.0 - damage[e])
         at = ce * kt - mm
         ac = ce * kc - (q - 1.0) * mm
         if at > 0.0 and ac > 0.0 and r2 < at * at and (q + 1.0) * (q + 1.0) * r2 < ac * ac:
@@ -431,7 +437,7 @@ PARALLEL_MIN_ELEMENTS = PARALLEL_MIN_SIZE
 @njit(cache=True, error_model="numpy")
 def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
                       c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat,
-                      dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+                      eff, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
     """All ``n_sub`` sub-steps of one outer step in compiled code (one call per outer
     step, no Python per sub-step): the node kernel then the element kernel, serial
     builds; the same calls as a Python loop over the kernels, bit-identical results."""
@@ -441,14 +447,14 @@ def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t,
                                     (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel_serial(
             tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta,
-            dilat, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            dilat, eff, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
 
 @njit(cache=True, error_model="numpy")
 def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
                       c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat,
-                      dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+                      eff, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
     """:func:`substeps_serial` with the parallel kernel builds (one fork/join per
     kernel and sub-step, launched from compiled code)."""
     n_capped = 0
@@ -457,7 +463,7 @@ def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_
                              (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel(
             tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta,
-            dilat, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            dilat, eff, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
 
@@ -724,8 +730,8 @@ class ExplicitSolver:
     def _profiled_substeps(self, par, n_sub, args):
         """The sub-step loop in Python with each kernel timed (``profile_kernels``)."""
         (vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b, c, damage, conc_factor,
-         coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat, dt_s, kxx, kxy, kss, q, denom, max_damage,
-         E0, lambda0, alpha, flag) = args
+         coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat, eff, dt_s, kxx, kxy, kss, q, denom,
+         max_damage, E0, lambda0, alpha, flag) = args
         node_k = node_velocity_kernel if par else node_velocity_kernel_serial
         elem_k = element_kernels(alpha)[int(par)]
         n_capped = 0
@@ -735,7 +741,7 @@ class ExplicitSolver:
             node_k(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, (k + 1) / n_sub)
             tb = time.perf_counter()
             n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma,
-                               pmax, keep_mean, theta, dilat, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0,
+                               pmax, keep_mean, theta, dilat, eff, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0,
                                alpha,
                                flag)
             tc = time.perf_counter()
@@ -777,6 +783,7 @@ class ExplicitSolver:
         keep_mean = None if p.relax_mean_stress else True
         theta = None if p.stress_correction == "origin" else float(p.mean_fraction)
         dilat = p.dilatancy_factor  # None: off
+        eff = None if p.failure_stress == "nominal" else True
         heal = (self.heal_rate(state, t_s) if self.heal_rate is not None
                 else self.rheology.constant_heal_rate(mesh.n_elements))
         heal = np.ascontiguousarray(heal, np.float64)
@@ -796,7 +803,7 @@ class ExplicitSolver:
         ptr32, elems32, tri32 = self._indices(mesh)
         args = (vel, vel_sum, sigma, ptr32, elems32, su.w, nc, terms.cos_turn, terms.sin_turn, ns.fixed, pres0,
                 pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, k_c, k_t, self.td, heal, e_dt, gamma, pmax,
-                keep_mean, theta, dilat, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s,
+                keep_mean, theta, dilat, eff, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s,
                 float(p.alpha), flag)
         if self.kernel_choice is None or (
                 self.parallel_setting is None
