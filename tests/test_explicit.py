@@ -64,8 +64,8 @@ def test_element_kernel_damage_matches_rheology(kernel, theta):
     kc, kt = envelope_factors(rheo)
     e_dt, gam = np.zeros(m), np.ones(m)
     kernel(tri, zeros3, zeros3, np.zeros((1, 2)), s2, d2, conc_factor, coh, kc, kt, td, heal, e_dt, gam, None,
-           None, theta, None, None, 7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, p.alpha,
-           flag)
+           None, theta, None, None, 7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0,
+           p.relaxation_time_s, p.alpha, flag)
     assert (dc < 1).sum() > 100
     if theta is not None:  # the path differs from the origin's where the correction acted
         s0, d0 = sigma.copy(), damage.copy()
@@ -121,6 +121,61 @@ def test_element_kernel_stress_update_uses_rheology_moduli(kernel):
         assert np.array_equal(d, damage)
         assert np.allclose(sigma, ref, rtol=1e-13, atol=1e-13 * np.abs(ref).max())
         assert not np.allclose(sigma, sigma0, rtol=1e-3)  # the strain rate acted
+
+
+@pytest.mark.parametrize("kernel", [element_stress_damage_kernel_serial, element_stress_damage_kernel_a4])
+def test_effective_failure_stress(kernel):
+    """``rheology.failure_stress = "effective"``: the envelope judges σ/(1 − d). (1) On the
+    uniaxial-compression ray, σ = −s σc ŷŷ (σc the intact uniaxial strength of the element's
+    cohesion C), an element of damage d damages when s > 1 − d and not when s < 1 − d (by a
+    margin of 1e-3), while the nominal criterion damages none with s < 1. (2) Everywhere it is
+    the nominal kernel run with the cohesion C (1 − d): stress, damage and flags bit for bit
+    (the friction is kept, only the cohesion scales). (3) Other steppers and the nonlocal damage
+    refuse it, naming the key."""
+    from lagice.rheology.maxwell_eb import envelope
+
+    rheo = MaxwellEB(failure_stress="effective", friction=0.7)
+    p = rheo.params
+    kc, kt = envelope_factors(rheo)
+    rng = np.random.default_rng(11)
+    m = 400
+    d = rng.uniform(0.0, 0.95, m)
+    coh = rng.uniform(1e4, 3e4, m)
+    sigma_c = envelope(coh, p.friction)[1]
+    s = (1.0 - d) * np.where(np.arange(m) % 2 == 0, 1.001, 0.999)  # just outside / inside the shrunk envelope
+    sig0 = np.zeros((m, 3))
+    sig0[:, 1] = -s * sigma_c
+    tri, zeros3 = np.zeros((m, 3), np.int32), np.zeros((m, 3))
+
+    def run(eff, cohesion, sigma, damage):
+        sg, dm, flag = sigma.copy(), damage.copy(), np.zeros(m, np.int8)
+        kernel(tri, zeros3, zeros3, np.zeros((1, 2)), sg, dm, np.ones(m), cohesion, kc, kt, np.full(m, 20.0),
+               np.zeros(m), np.zeros(m), np.ones(m), None, None, None, None, eff, 7.0, *rheo.K[0, :2], rheo.K[2, 2],
+               rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
+        return sg, dm, flag
+
+    _, d_eff, f_eff = run(True, coh, sig0, d)
+    assert np.array_equal(f_eff.astype(bool), np.arange(m) % 2 == 0)
+    assert np.all(d_eff[::2] > d[::2]) and np.array_equal(d_eff[1::2], d[1::2])
+    _, d_nom, f_nom = run(None, coh, sig0, d)
+    assert not f_nom.any() and np.array_equal(d_nom, d)
+    # (2) random stresses, some tensile, some confined: the same as the nominal kernel with C (1 − d)
+    sig = rng.normal(0, 2e4, (m, 3))
+    sig[:, :2] -= rng.uniform(0, 3e4, (m, 1))
+    a = run(True, coh, sig, d)
+    b = run(None, coh * (1.0 - d), sig, d)
+    assert 50 < a[2].sum() < m - 50
+    for x, y in zip(a, b):
+        assert np.array_equal(x, y)
+    # (3) refused where it is not implemented
+    for stepper in ("implicit", "explicit_cuda"):
+        with pytest.raises(ConfigError, match="failure_stress = 'effective'"):
+            rheo.require_stepper(stepper)
+    rheo.require_stepper("explicit")
+    with pytest.raises(ConfigError, match="failure_stress = 'effective' is implemented with the local damage"):
+        MaxwellEB(failure_stress="effective", damage_nonlocal_radius_m=2e4)
+    with pytest.raises(ConfigError, match="rheology.failure_stress = 'plastic': expected one of"):
+        MaxwellEB(failure_stress="plastic")
 
 
 def test_alpha4_builds_equal_general_builds():

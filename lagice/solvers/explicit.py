@@ -741,9 +741,8 @@ class ExplicitSolver:
             node_k(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, (k + 1) / n_sub)
             tb = time.perf_counter()
             n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma,
-                               pmax, keep_mean, theta, dilat, eff, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0,
-                               alpha,
-                               flag)
+                               pmax, keep_mean, theta, dilat, eff, dt_s, kxx, kxy, kss, q, denom, max_damage, E0,
+                               lambda0, alpha, flag)
             tc = time.perf_counter()
             tn += tb - ta
             tm += tc - tb
@@ -803,8 +802,8 @@ class ExplicitSolver:
         ptr32, elems32, tri32 = self._indices(mesh)
         args = (vel, vel_sum, sigma, ptr32, elems32, su.w, nc, terms.cos_turn, terms.sin_turn, ns.fixed, pres0,
                 pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, k_c, k_t, self.td, heal, e_dt, gamma, pmax,
-                keep_mean, theta, dilat, eff, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s,
-                float(p.alpha), flag)
+                keep_mean, theta, dilat, eff, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0,
+                p.relaxation_time_s, float(p.alpha), flag)
         if self.kernel_choice is None or (
                 self.parallel_setting is None
                 and time.perf_counter() - self._tuned_at > (
