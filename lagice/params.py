@@ -86,8 +86,8 @@ class MaxwellEBParams:
             "Broken ice that keeps no cohesion"): the effective stress σ/(1 − d) of continuum
             damage mechanics (Kachanov 1958; Lemaitre 1985), so the cohesion and the tensile
             strength of an element are C (1 − d) and the friction μ is kept: broken ice holds by
-            friction alone, as a fault does. Explicit CPU stepper only, with the local damage
-            (no ``damage_nonlocal_radius_m``)
+            friction alone, as a fault does. Explicit CPU stepper and implicit solver, with the
+            local damage (no ``damage_nonlocal_radius_m``)
     """
 
     poisson: float = 0.3

@@ -131,7 +131,7 @@ def test_effective_failure_stress(kernel):
     margin of 1e-3), while the nominal criterion damages none with s < 1. (2) Everywhere it is
     the nominal kernel run with the cohesion C (1 − d): stress, damage and flags bit for bit
     (the friction is kept, only the cohesion scales). (3) Other steppers and the nonlocal damage
-    refuse it, naming the key."""
+    refuse it, naming the key; the implicit solver's damage update agrees with the kernel."""
     from lagice.rheology.maxwell_eb import envelope
 
     rheo = MaxwellEB(failure_stress="effective", friction=0.7)
@@ -167,11 +167,18 @@ def test_effective_failure_stress(kernel):
     assert 50 < a[2].sum() < m - 50
     for x, y in zip(a, b):
         assert np.array_equal(x, y)
+    # the implicit solver's damage update (the rheology's) takes the same envelope: the same
+    # elements damage, to round-off (zero strain rate, γ = 1)
+    si, di = sig.copy(), d.copy()
+    dc = rheo.damage_update(si, di, coh, 7.0, np.full(m, 20.0), np.zeros(m))
+    assert np.array_equal(dc < 1.0, a[2].astype(bool))
+    assert np.allclose(si, a[0], rtol=1e-13, atol=1e-13 * np.abs(si).max())
+    assert np.allclose(di, a[1], rtol=1e-13, atol=1e-15)
     # (3) refused where it is not implemented
-    for stepper in ("implicit", "explicit_cuda"):
-        with pytest.raises(ConfigError, match="failure_stress = 'effective'"):
-            rheo.require_stepper(stepper)
+    with pytest.raises(ConfigError, match="failure_stress = 'effective'"):
+        rheo.require_stepper("explicit_cuda")
     rheo.require_stepper("explicit")
+    rheo.require_stepper("implicit")
     with pytest.raises(ConfigError, match="failure_stress = 'effective' is implemented with the local damage"):
         MaxwellEB(failure_stress="effective", damage_nonlocal_radius_m=2e4)
     with pytest.raises(ConfigError, match="rheology.failure_stress = 'plastic': expected one of"):

@@ -268,7 +268,7 @@ CORRECTION_PATHS = {"implicit": STRESS_CORRECTIONS, "explicit": ("origin", "mean
 #: the optional terms of :class:`lagice.params.MaxwellEBParams` that each stepper implements.
 #: A term set away from its default (:meth:`MaxwellEBParams.optional_terms`) is refused by a
 #: stepper that does not list it, so no stepper silently runs without it
-OPTIONAL_TERMS = {"implicit": (), "explicit": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg",
+OPTIONAL_TERMS = {"implicit": ("failure_stress",), "explicit": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg",
                                                "damage_nonlocal_radius_m", "failure_stress"),
                   "explicit_cuda": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg"), "prescribed": ()}
 STEPPER_LABELS = {"implicit": "the implicit solver (solver.name = 'implicit')",
@@ -354,7 +354,11 @@ class MaxwellEB:
                 * np.exp(-p.concentration_c * (1.0 - np.asarray(concentration, np.float64))))
 
     def damage_update(self, sigma, damage, cohesion, dt, td, heal_rate):
-        """Apply the damage/healing update in place; returns d_crit per element."""
+        """Apply the damage/healing update in place; returns d_crit per element. With
+        ``failure_stress = "effective"`` the envelope is that of the cohesion C (1 − d), d the
+        damage passed in (the step's starting damage), as the explicit kernel takes it."""
+        if self.params.failure_stress != "nominal":
+            cohesion = np.asarray(cohesion, np.float64) * (1.0 - np.asarray(damage, np.float64))
         out = np.empty(len(damage))
         kernel = pick(DAMAGE_UPDATE, len(damage))
         n = kernel(sigma, damage, cohesion, float(dt), np.ascontiguousarray(td),
