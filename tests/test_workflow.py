@@ -120,6 +120,60 @@ def test_output_folder_reuse_is_refused(tmp_path):
     assert (other / "thesis.tex").read_text() == "precious"
 
 
+def test_resume_starts_a_run_killed_before_its_first_checkpoint_and_refuses_other_folders(tmp_path):
+    """A batch queue requeues ``lagice run SCENE --out DIR --resume``: a run killed (SIGKILL)
+    before its first checkpoint is started afresh in its folder; a folder of another run, or
+    with files a run does not write, is refused and left as it is."""
+    hook = tmp_path / "killhook.py"
+    hook.write_text(textwrap.dedent("""
+        import os, pathlib, time
+        from lagice.io.timeseries import diagnostic
+
+        @diagnostic("1", "pause (slows the run so the test can kill it mid-run)")
+        def pause(model):
+            if model.clock.iteration >= 3:
+                pathlib.Path(os.environ["SENTINEL"]).touch()
+                time.sleep(0.2)
+            return 0.0
+    """))
+    out = tmp_path / "run"
+    sentinel = tmp_path / "sentinel"
+    env = {"PYTHONPATH": f"{tmp_path}{os.pathsep}{os.environ.get('PYTHONPATH', '')}", "SENTINEL": str(sentinel)}
+    sets = [*QUICK, 'output.timeseries.every="1 steps"', 'output.timeseries.diagnostics=["killhook:pause"]']
+    cmd = [sys.executable, "-m", "lagice.cli", "run", "shear_box", "--out", str(out), "--resume"]
+    for s in sets:
+        cmd += ["--set", s]
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**os.environ, **env})
+    t0 = time.time()
+    while not sentinel.exists():
+        assert p.poll() is None, p.communicate()
+        assert time.time() - t0 < 120
+        time.sleep(0.02)
+    p.kill()
+    p.communicate(timeout=60)
+    assert (out / "lagice_run.json").exists() and (out / "snapshots").is_dir()
+    assert not list(out.glob("checkpoints/checkpoint_*.npz")), "killed before its first checkpoint"
+    one_line_error(run_cli("resume", out), f"no checkpoint in {out}", "lagice run", f"--out {out} --resume")
+    before = sorted(p.name for p in out.rglob("*"))
+    # another run (other physics) in the folder: refused, nothing touched
+    r = run_cli("run", "shear_box", "--out", out, "--resume", sets=[*sets, "run.seed=5"], env=env)
+    one_line_error(r, str(out), "other physics settings", "--overwrite")
+    (out / "notes.txt").write_text("mine")
+    r = run_cli("run", "shear_box", "--out", out, "--resume", sets=sets, env=env)
+    one_line_error(r, str(out), "notes.txt", "a run does not write")
+    assert sorted(p.name for p in out.rglob("*")) == sorted([*before, "notes.txt"])
+    (out / "notes.txt").unlink()
+    # the same run: started afresh, its partial outputs replaced, one line says so
+    env["SENTINEL"] = str(tmp_path / "s2")
+    r = run_cli("run", "shear_box", "--out", out, "--resume", sets=sets, env=env)
+    assert r.returncode == 0, r.stderr[-3000:]
+    assert sum("starting it afresh" in ln for ln in r.stdout.splitlines()) == 1, r.stdout
+    assert json.loads((out / "summary.json").read_text())["finished"]
+    assert last_snapshot(out)[1][-1]["step"] == 20 and list(out.glob("checkpoints/checkpoint_*.npz"))
+    ts = xr.load_dataset(out / "timeseries.nc", decode_times=False)
+    assert np.array_equal(ts["time"].values, np.arange(0.0, 801.0, 40.0)), "one row per step, no killed rows left"
+
+
 @pytest.mark.slow
 def test_default_folders_never_collide_and_latest_follows(tmp_path):
     a = run_cli("run", "shear_box", sets=QUICK, cwd=tmp_path)
