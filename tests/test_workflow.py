@@ -334,6 +334,24 @@ def test_bad_setting_is_one_line_before_any_work(setting, fragments, tmp_path):
     assert time.time() - t0 < 60
 
 
+@pytest.mark.parametrize("shift_km", [4500.0, 150.0])
+def test_spinup_state_that_does_not_cover_the_domain_is_refused_before_meshing(shift_km, tmp_path):
+    """The bundled winter-basin spin-up state moved east: its nearest-centroid lookup would
+    fill the domain (all of it, or its western part) from ice far away."""
+    z = dict(np.load(ROOT / "data_stubs" / "winter_basin_spinup.npz"))
+    z["centroid_x_m"] = (z["centroid_x_m"] + shift_km * 1e3).astype(np.float32)
+    state = tmp_path / "moved.npz"
+    np.savez(state, **z)
+    out = tmp_path / "run"
+    r = run_cli("run", "winter_basin_pack", "--out", out,
+                sets=["run.duration=1h", "domain.resolution_m=80e3", f'initial.state_file="{state}"'])
+    line = one_line_error(r, "initial.state_file", str(state), "outside the spin-up state's footprint",
+                          "tolerance 20.", "km from the nearest state centroid")
+    far = float(line.split(" km from the nearest")[0].rsplit(" ", 1)[1])
+    assert far > 100.0 and (shift_km < 1000 or far > 3000.0), line
+    assert not out.exists(), "refused before the output folder and the mesh"
+
+
 def test_info_on_a_file_that_is_not_netcdf(tmp_path):
     bad = tmp_path / "notes.nc"
     bad.write_text("not netCDF at all")

@@ -24,7 +24,7 @@ from ..rheology import MaxwellEB, ViscousPlastic, ViscousPlasticParams, draw_coh
 from ..schedule import parse_duration, parse_schedule
 from ..simulation import Simulation
 from ..solvers import SOLVER_RHEOLOGY, SOLVERS, VelocityBC
-from ..spinup import field_from_spinup, load_state_file
+from ..spinup import check_footprint, field_from_spinup, load_state_file
 from ..state import IceState
 from . import components
 from .components import time_step_s  # noqa: F401 - part of the builder API
@@ -198,6 +198,19 @@ def _domain_points(poly, n: int = 30) -> np.ndarray:
     return np.vstack([v, np.column_stack([gx.ravel(), gy.ravel()])])
 
 
+def _footprint_points(poly, state_file) -> np.ndarray:
+    """Points covering a polygon, to check a spin-up state's footprint before meshing: its
+    boundary every state centroid spacing, and a 60 x 60 grid over its bounding box (inside)."""
+    from ..spinup import FOOTPRINT_SPACINGS, footprint_tolerance_m
+
+    step = footprint_tolerance_m(state_file) / FOOTPRINT_SPACINGS
+    rings = (poly.exterior, *poly.interiors)
+    bnd = [np.asarray((r.segmentize(step) if math.isfinite(step) and step > 0 else r).coords) for r in rings]
+    g = _domain_points(poly, 60)
+    inside = g[shapely.contains_xy(poly, g[:, 0], g[:, 1])]
+    return np.vstack([*bnd, inside])
+
+
 def build_mesh(cfg: dict, with_order: bool = False):
     """The scene's mesh (gmsh), renumbered and rotated as asked; also returns the polygon.
 
@@ -345,6 +358,9 @@ def validate_config(cfg: dict) -> None:
     poly = domain_polygon(cfg)  # no mesh yet: the polygon only
     if not poly.is_valid or poly.area <= 0:
         raise ConfigError(f"domain: the polygon is not valid ({shapely.validation.explain_validity(poly)})")
+    if state_fields:  # the spin-up state must cover the domain (its boundary and inside)
+        check_footprint(cfg["initial"]["state_file"], *_footprint_points(poly, cfg["initial"]["state_file"]).T,
+                        "initial.state_file", "the domain")
     if dr["positions_m"]:
         for k, p in enumerate(dr["positions_m"]):
             if not poly.contains(shapely.Point(p)):
@@ -519,6 +535,8 @@ def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
             return field_from_spinup(ini["state_file"], FROM_STATE[key], x, y)
         return spatial_values(ini[key], x, y, f"initial.{key}")
 
+    if any(ini[k] == "from_state" for k in FROM_STATE):
+        check_footprint(ini["state_file"], x, y, "initial.state_file", "the mesh")
     state = IceState.uniform(mesh, thickness_m=field("thickness_m"), concentration=field("concentration"),
                              damage=field("damage"), cohesion_pa=cohesion)
     if coh == "random" and law is not None and law.correlated:  # a law only for Maxwell-EB (strength_law)
