@@ -324,6 +324,7 @@ def test_sigterm_writes_a_checkpoint_and_the_run_resumes_bit_identically(base_ru
     ("output.crs_epsg=3031", ["output.crs_epsg", "[domain] crs"]),
     ('forcing.ocean.colour="blue"', ["forcing.ocean.colour", "takes no keys"]),
     ('forcing.wind={kind="file", path="no/such/era5.nc"}', ["no/such/era5.nc", "file not found"]),
+    ("domain.resolution_m=2000e3", ["domain.resolution_m = 2e+06 m", "larger than the domain", "942.7 km"]),
 ])
 def test_bad_setting_is_one_line_before_any_work(setting, fragments, tmp_path):
     out = tmp_path / "run"
@@ -350,6 +351,20 @@ def test_spinup_state_that_does_not_cover_the_domain_is_refused_before_meshing(s
     far = float(line.split(" km from the nearest")[0].rsplit(" ", 1)[1])
     assert far > 100.0 and (shift_km < 1000 or far > 3000.0), line
     assert not out.exists(), "refused before the output folder and the mesh"
+
+
+def test_resolution_larger_than_the_domain_is_refused_before_meshing(tmp_path):
+    from lagice.errors import ConfigError
+    from lagice.scenes.builder import validate_config
+    from lagice.scenes.config import load_scene
+
+    out = tmp_path / "run"
+    r = run_cli("run", "shear_box", "--out", out, sets=[*QUICK, "domain.resolution_m=500e3"])
+    one_line_error(r, "domain.resolution_m = 500000 m", "larger than the domain", "smallest extent is 200.0 km")
+    assert not out.exists()
+    validate_config(load_scene("shear_box", {"domain.resolution_m": 200e3}))  # one element across: allowed
+    with pytest.raises(ConfigError, match="smallest extent is 200.0 km"):
+        validate_config(load_scene("shear_box", {"domain.resolution_m": 200.001e3}))
 
 
 def test_info_on_a_file_that_is_not_netcdf(tmp_path):

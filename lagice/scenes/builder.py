@@ -198,6 +198,27 @@ def _domain_points(poly, n: int = 30) -> np.ndarray:
     return np.vstack([v, np.column_stack([gx.ravel(), gy.ravel()])])
 
 
+def smallest_extent_m(poly) -> float:
+    """The domain's smallest extent [m]: the shorter side of its minimum rotated rectangle
+    (a rectangle's width or height, whichever is smaller)."""
+    r = np.asarray(poly.minimum_rotated_rectangle.exterior.coords)
+    sides = np.hypot(*np.diff(r[:3], axis=0).T)
+    return float(sides.min())
+
+
+def check_resolution(res, poly) -> None:
+    """A numeric ``domain.resolution_m`` (the target element size) must not exceed the
+    domain's smallest extent (:func:`smallest_extent_m`): a mesh needs at least one element
+    across the domain. ConfigError naming the key, the value and the extent in km."""
+    if isinstance(res, str):
+        return
+    ext = smallest_extent_m(poly)
+    if res > ext:
+        raise ConfigError(f"domain.resolution_m = {res:g} m is larger than the domain: its smallest extent is "
+                          f"{ext / 1e3:.1f} km; expected an element size of at most {ext:g} m (at least one "
+                          f"element across the domain)")
+
+
 def _footprint_points(poly, state_file) -> np.ndarray:
     """Points covering a polygon, to check a spin-up state's footprint before meshing: its
     boundary every state centroid spacing, and a 60 x 60 grid over its bounding box (inside)."""
@@ -358,6 +379,7 @@ def validate_config(cfg: dict) -> None:
     poly = domain_polygon(cfg)  # no mesh yet: the polygon only
     if not poly.is_valid or poly.area <= 0:
         raise ConfigError(f"domain: the polygon is not valid ({shapely.validation.explain_validity(poly)})")
+    check_resolution(d["resolution_m"], poly)
     if state_fields:  # the spin-up state must cover the domain (its boundary and inside)
         check_footprint(cfg["initial"]["state_file"], *_footprint_points(poly, cfg["initial"]["state_file"]).T,
                         "initial.state_file", "the domain")
