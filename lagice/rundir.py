@@ -208,6 +208,20 @@ def prepare(out, config: dict | None = None) -> list[Path]:
     return removed
 
 
+def discard(out, remove_folder: bool) -> None:
+    """Undo :func:`prepare` for a new run that failed before it started (a check that
+    needed the mesh): remove what was written in ``out`` (it was empty), and ``out``
+    itself when ``remove_folder`` (it did not exist), so that the corrected command can
+    use the same folder. Failures to remove are reported, not raised (the first error matters)."""
+    out = Path(out)
+    try:
+        clear_folder(out, why="removing the folder of the failed run")
+        if remove_folder:
+            out.rmdir()
+    except (OSError, OutputError) as exc:
+        log.warning(f"could not remove {out} after the failed start: {exc}")
+
+
 def clean_stale(out) -> list[Path]:
     """Remove the temporary files killed writes left in the run folder ``out``."""
     from .io.checkpoint import clean_stale_temporaries

@@ -367,6 +367,33 @@ def test_resolution_larger_than_the_domain_is_refused_before_meshing(tmp_path):
         validate_config(load_scene("shear_box", {"domain.resolution_m": 200.001e3}))
 
 
+@pytest.mark.parametrize("setting,fragments", [
+    ("initial.thickness_m=-1", ["initial.thickness_m = -1 m", "out of range", "[0, inf] m"]),
+    ("initial.concentration=1.5", ["initial.concentration = 1.5", "out of range", "[0, 1]"]),
+    ("initial.damage=1.5", ["initial.damage = 1.5", "out of range", "[0, 1)"]),
+    ("initial.damage=1.0", ["initial.damage = 1.0", "out of range", "[0, 1)"]),
+    ("initial.thickness_m=nan", ["initial.thickness_m = nan", "out of range"]),
+])
+def test_initial_constant_out_of_range_is_refused_before_meshing(setting, fragments, tmp_path):
+    out = tmp_path / "run"
+    one_line_error(run_cli("run", "shear_box", "--out", out, sets=[*QUICK, setting]), *fragments)
+    assert not out.exists(), "refused before the output folder (and the mesh)"
+
+
+def test_initial_expression_out_of_range_names_the_key_and_leaves_no_folder(tmp_path):
+    """An expression is checked on the mesh (its values at the element centroids); the
+    failed start leaves no folder, so the corrected command may use the same --out."""
+    out = tmp_path / "run"
+    r = run_cli("run", "shear_box", "--out", out, sets=[*QUICK, 'initial.concentration="0.5 + x / 2e5"'])
+    one_line_error(r, "initial.concentration = '0.5 + x / 2e5' gives values in [", "elements outside",
+                   "expected values in [0, 1]")
+    assert not out.exists(), "the failed start left its folder behind"
+    r = run_cli("run", "shear_box", "--out", out, sets=[*QUICK, 'initial.concentration="0.5 + x / 4e5"'])
+    assert r.returncode == 0, r.stderr[-3000:]
+    ds, _ = last_snapshot(out)
+    assert 0.5 < float(ds["concentration"].min()) and float(ds["concentration"].max()) < 1.0
+
+
 def test_info_on_a_file_that_is_not_netcdf(tmp_path):
     bad = tmp_path / "notes.nc"
     bad.write_text("not netCDF at all")

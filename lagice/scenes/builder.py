@@ -16,7 +16,7 @@ import numpy as np
 import shapely
 from shapely.geometry import LineString, Polygon, shape
 
-from ..errors import ConfigError, check_range
+from ..errors import ConfigError, LagiceError, check_range
 from ..mesh import generate_mesh, rectangle_domain, renumber_for_locality, rotate_mesh
 from ..model import Model
 from ..params import MaxwellEBParams
@@ -371,6 +371,8 @@ def validate_config(cfg: dict) -> None:
     for key, val in cfg["initial"].items():
         if val is None or (key == "cohesion_pa" and val == "random") or key == "state_file" or key in state_fields:
             continue
+        if isinstance(val, (int, float)) and not isinstance(val, bool):  # a constant: its range now
+            check_initial_range(key, val)
         if key == "stress_pa" and isinstance(val, str) and ":" in val:
             resolve_hook(val, "initial.stress_pa")
             continue
@@ -532,6 +534,45 @@ def check_state_file_strength(cfg: dict, law) -> None:
                           f"carries a factor made with {ell:g} m and {a:g}; use the state file's values")
 
 
+#: valid range of each ``[initial]`` field, as the state checks it (:func:`lagice.fields.validate_state`):
+#: (low, high, high_open, unit)
+INITIAL_RANGES = {"thickness_m": (0.0, None, False, "m"), "concentration": (0.0, 1.0, False, ""),
+                  "damage": (0.0, 1.0, True, ""), "cohesion_pa": (0.0, None, False, "Pa"),
+                  "snow_m": (0.0, None, False, "m"), "stress_pa": (None, None, False, "Pa")}
+
+
+def check_initial_range(key: str, value) -> None:
+    """ConfigError naming ``initial.KEY``, the value and the expected range, unless the
+    constant ``value`` lies in :data:`INITIAL_RANGES` (and is finite)."""
+    if key not in INITIAL_RANGES:
+        return
+    lo, hi, hi_open, unit = INITIAL_RANGES[key]
+    check_range(f"initial.{key}", value, lo, hi, high_open=hi_open, unit=unit)
+    if not math.isfinite(float(value)):
+        raise ConfigError(f"initial.{key} = {value!r}: expected a finite number{' in ' + unit if unit else ''}")
+
+
+def check_initial_values(key: str, spec, values) -> None:
+    """The values of ``initial.KEY`` (= ``spec``, an expression or a hook) over the mesh's
+    elements in :data:`INITIAL_RANGES`; ConfigError naming the key, the range found and the one expected."""
+    if key not in INITIAL_RANGES or not np.size(values):
+        return
+    lo, hi, hi_open, unit = INITIAL_RANGES[key]
+    v = np.asarray(values, np.float64)
+    bad = ~np.isfinite(v)
+    if lo is not None:
+        bad |= v < lo
+    if hi is not None:
+        bad |= (v >= hi) if hi_open else (v > hi)
+    if bad.any():
+        rng = (f"[{lo:g}, " if lo is not None else "(-inf, ") + (
+            "inf)" if hi is None else f"{hi:g})" if hi_open else f"{hi:g}]")
+        u = f" {unit}" if unit else ""
+        raise ConfigError(f"initial.{key} = {spec!r} gives values in [{np.nanmin(v):.6g}, {np.nanmax(v):.6g}]{u} "
+                          f"over the mesh ({int(bad.sum())} of {v.size} elements outside); expected values in "
+                          f"{rng}{u}")
+
+
 def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
     """The scene's initial state on ``mesh``; ``order`` (see :func:`build_mesh`): random
     cohesion is drawn in the mesh generator's element order, then permuted, so the
@@ -552,10 +593,14 @@ def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
                 cohesion = cohesion[order]
     else:
         cohesion = spatial_values(coh, x, y, "initial.cohesion_pa")
+        check_initial_values("cohesion_pa", coh, cohesion)
+
     def field(key):
         if ini[key] == "from_state":
             return field_from_spinup(ini["state_file"], FROM_STATE[key], x, y)
-        return spatial_values(ini[key], x, y, f"initial.{key}")
+        v = spatial_values(ini[key], x, y, f"initial.{key}")
+        check_initial_values(key, ini[key], v)
+        return v
 
     if any(ini[k] == "from_state" for k in FROM_STATE):
         check_footprint(ini["state_file"], x, y, "initial.state_file", "the mesh")
@@ -571,6 +616,7 @@ def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
         state.cohesion = state.cohesion * state.strength_factor
     if ini["snow_m"] is not None:
         state.snow = spatial_values(ini["snow_m"], x, y, "initial.snow_m")
+        check_initial_values("snow_m", ini["snow_m"], state.snow)
     sp = ini["stress_pa"]
     if isinstance(sp, str) and ":" in sp:
         stress = np.asarray(resolve_hook(sp, "initial.stress_pa")(x, y), np.float64)
@@ -665,13 +711,23 @@ def build_simulation(cfg: dict, out_dir=None, progress: bool | None = None, over
     # checks that they do what that version did)
     cfg = override_config(cfg, overrides or {})
     validate_config(cfg)
+    out = rundir.new_run_dir(cfg["scene"]["name"]) if out_dir is None else Path(out_dir)
+    existed, fresh = out.exists(), rundir.is_empty(out)
+    rundir.prepare(out, cfg)
+    try:
+        sim = _simulation(cfg, out, progress)
+    except LagiceError:
+        if fresh:  # a new run failed its checks on the mesh: leave no folder that blocks the corrected rerun
+            rundir.discard(out, remove_folder=not existed)
+        raise
     if out_dir is None:
-        out = rundir.new_run_dir(cfg["scene"]["name"])
-        rundir.prepare(out, cfg)
         rundir.update_latest(out, cfg["scene"]["name"])
-    else:
-        out = Path(out_dir)
-        rundir.prepare(out, cfg)
+    return sim
+
+
+def _simulation(cfg: dict, out: Path, progress) -> Simulation:
+    """The model (mesh, initial state: the checks that need the mesh) and its
+    :class:`Simulation` writing into the prepared folder ``out``."""
     model = build_model(cfg, validated=True)
     prog = cfg["run"]["progress"] if progress is None else progress
     sim = Simulation(model, dt=time_step_s(cfg), stop=cfg["run"]["duration"], progress=prog, builder=BUILDER,
