@@ -394,6 +394,21 @@ def test_initial_expression_out_of_range_names_the_key_and_leaves_no_folder(tmp_
     assert 0.5 < float(ds["concentration"].min()) and float(ds["concentration"].max()) < 1.0
 
 
+@pytest.mark.parametrize("setting,fragments", [
+    ('output.every="50s"', ["output.every = '50s' (50 s)", "solver.dt = 40 s", "40 s or 80 s", "'1 steps'"]),
+    ("checkpoint.every=100.0", ["checkpoint.every = 100.0 (100 s)", "solver.dt = 40 s", "80 s or 120 s"]),
+    ("output.every=10.0", ["output.every = 10.0 (10 s)", "whole number (>= 1) of steps", "40 s"]),
+    ('output.timeseries={every="1min", diagnostics=["mean_damage"]}',
+     ["output.timeseries.every = '1min' (60 s)", "solver.dt = 40 s"]),
+])
+def test_output_and_checkpoint_intervals_must_be_whole_steps(setting, fragments, tmp_path):
+    """As run.duration: an interval that is not a whole number of steps would fall due at
+    irregular steps (every 40 or 80 s for 50 s)."""
+    out = tmp_path / "run"
+    one_line_error(run_cli("run", "shear_box", "--out", out, sets=[*QUICK, setting]), *fragments)
+    assert not out.exists()
+
+
 def test_info_on_a_file_that_is_not_netcdf(tmp_path):
     bad = tmp_path / "notes.nc"
     bad.write_text("not netCDF at all")
@@ -490,7 +505,8 @@ def test_a_run_inside_a_gridded_file_uses_the_records_of_its_date(tmp_path):
     env = {"PYTHONPATH": f"{tmp_path}{os.pathsep}{os.environ.get('PYTHONPATH', '')}"}
     wind = [f'forcing.wind={{kind="file", path="{path}", u="u", v="v"}}', "solver.dt=1800.0",
             "run.duration=21600.0", "output.every=21600.0", "domain.resolution_m=50e3", "run.progress=false",
-            "output.plot=false", 'output.timeseries={every="1 steps", diagnostics=["windhook:wind_u"]}']
+            "output.plot=false", 'output.timeseries={every="1 steps", diagnostics=["windhook:wind_u"]}',
+            "checkpoint.every=21600.0"]
     out = tmp_path / "run"
     r = run_cli("run", "shear_box", "--out", out, sets=[*wind, 'run.start_date="2020-01-03 06:00:00"'], env=env)
     assert r.returncode == 0, r.stderr

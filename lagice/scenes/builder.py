@@ -308,6 +308,10 @@ def validate_config(cfg: dict) -> None:
         raise ConfigError(f"run.duration = {cfg['run']['duration']!r} is not a whole number (>= 1) of steps of "
                           f"solver.dt = {dt:g} s")
     check_range("run.max_speed_m_s", cfg["run"]["max_speed_m_s"], 0.0, None, low_open=True, unit="m s-1")
+    check_whole_steps("output.every", cfg["output"]["every"], dt)
+    check_whole_steps("checkpoint.every", cfg["checkpoint"]["every"], dt)
+    if isinstance(cfg["output"]["timeseries"], dict) and "every" in cfg["output"]["timeseries"]:
+        check_whole_steps("output.timeseries.every", cfg["output"]["timeseries"]["every"], dt)
     rheo = build_rheology(cfg)
     law = strength_law(cfg)
     check_state_file_strength(cfg, law)
@@ -391,6 +395,27 @@ def validate_config(cfg: dict) -> None:
                 raise ConfigError(f"drifters.positions_m[{k}] = {p!r} lies outside the domain (bounds "
                                   f"{tuple(round(b) for b in poly.bounds)} m in domain.crs)")
     components.check_forcing_files(cfg, _domain_points(poly), duration)
+
+
+def check_whole_steps(key: str, value, dt: float) -> None:
+    """An interval of simulated time (``output.every = "6h"``, not ``"N steps"`` or wall
+    time) must be a whole number (>= 1) of time steps, as ``run.duration`` is: otherwise
+    the activity falls due at irregular steps. ConfigError naming the key, the interval
+    and solver.dt, with the nearest whole multiples."""
+    from ..schedule import TimeInterval
+
+    if value is None:
+        return
+    sched = parse_schedule(value, key)
+    if not isinstance(sched, TimeInterval):
+        return
+    n = sched.interval / dt
+    if abs(n - round(n)) > 1e-9 * max(1.0, n) or round(n) < 1:
+        lo, hi = max(1, math.floor(n)), max(1, math.ceil(n))
+        near = f"{lo * dt:g} s" + (f" or {hi * dt:g} s" if hi != lo else "")
+        raise ConfigError(f"{key} = {value!r} ({sched.interval:g} s) is not a whole number (>= 1) of steps of "
+                          f"solver.dt = {dt:g} s; it would fall due at irregular steps (use e.g. {near}, "
+                          f"or '{lo} steps')")
 
 
 def checkpoint_schedule(cfg: dict):
