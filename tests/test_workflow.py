@@ -409,6 +409,29 @@ def test_output_and_checkpoint_intervals_must_be_whole_steps(setting, fragments,
     assert not out.exists()
 
 
+def test_nan_boundary_constant_is_refused_before_meshing(tmp_path):
+    out = tmp_path / "run"
+    one_line_error(run_cli("run", "shear_box", "--out", out, sets=[*QUICK, "boundary.top.v=nan"]),
+                   "boundary.top.v = nan", "finite")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("expr,fragments", [
+    ("1.0/(t-400.0)", ["cannot evaluate the expression at t = 400 s", "ZeroDivisionError"]),
+    ("0.01*sqrt(360.0 - t)", ["gives nan at t = 400 s", "finite"]),
+])
+def test_boundary_expression_failing_mid_run_is_one_line_with_a_summary(expr, fragments, tmp_path):
+    """A prescribed velocity that cannot be evaluated, or is not finite, at some time: the
+    error names the key, the expression and the time (not 'cg did not converge' or a
+    traceback), exit 2, and the run leaves summary.json and its last checkpoint."""
+    out = tmp_path / "run"
+    r = run_cli("run", "shear_box", "--out", out, sets=[*QUICK, f'boundary.top.u="{expr}"', "checkpoint.every=200.0"])
+    one_line_error(r, f"boundary.top.u = '{expr}'", *fragments)
+    s = json.loads((out / "summary.json").read_text())
+    assert not s["finished"] and s["stop_reason"].startswith("error: boundary.top.u") and s["steps"] == 9
+    assert s["checkpoint"].endswith("checkpoint_0000000005.npz") and Path(s["checkpoint"]).exists()
+
+
 def test_info_on_a_file_that_is_not_netcdf(tmp_path):
     bad = tmp_path / "notes.nc"
     bad.write_text("not netCDF at all")

@@ -934,22 +934,41 @@ def branch_strength(state, parent_cfg: dict, cfg: dict) -> str:
 
 def finish(sim: Simulation, plot: bool = True) -> dict:
     """Run a (new or resumed) simulation to its end (or until it is stopped), then
-    write ``summary.json`` and, when it finished, the plot."""
-    summary = sim.run()
+    write ``summary.json`` and, when it finished, the plot. A run stopped by an error
+    (a :class:`~lagice.errors.LagiceError`: a solver failure, a boundary value that is not
+    finite...) also writes ``summary.json`` (``stop_reason`` "error: ...", the last
+    checkpoint) before the error goes on to the caller."""
     out = Path(sim.out_dir if sim.out_dir is not None else ".")
+    try:
+        summary = sim.run()
+    except LagiceError as exc:
+        try:
+            failed = sim.summary()
+            failed.update(stop_reason=f"error: {exc}", error=str(exc), scene=sim.model.config["scene"]["name"])
+            _write_summary(out, failed)
+        except Exception as inner:  # noqa: BLE001 - the run's own error is the one to report
+            import logging
+
+            logging.getLogger("lagice").warning(f"could not write {out / 'summary.json'} after the error: {inner}")
+        raise
     out.mkdir(parents=True, exist_ok=True)
     cfg = sim.model.config
     summary["scene"] = cfg["scene"]["name"]
     res = {"summary": summary, "netcdf": out / "snapshots" / "index.json", "wall_s": summary["wall_s"],
            "png": None, "out_dir": out}
-    from ..io.cf import atomic_write_errors
-
-    with atomic_write_errors(out / "summary.json", out / "summary.json.tmp"):
-        (out / "summary.json.tmp").write_text(json.dumps(summary, indent=1, default=str))
-        (out / "summary.json.tmp").replace(out / "summary.json")
+    _write_summary(out, summary)
     if plot and sim.stop_reason is None:
         res["png"] = plot_scene(cfg, out, summary)
     return res
+
+
+def _write_summary(out: Path, summary: dict) -> None:
+    from ..io.cf import atomic_write_errors
+
+    out.mkdir(parents=True, exist_ok=True)
+    with atomic_write_errors(out / "summary.json", out / "summary.json.tmp"):
+        (out / "summary.json.tmp").write_text(json.dumps(summary, indent=1, default=str))
+        (out / "summary.json.tmp").replace(out / "summary.json")
 
 
 def plot_scene(cfg: dict, out: Path, summary: dict | None = None, drifters=None):
