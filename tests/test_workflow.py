@@ -324,6 +324,9 @@ def test_sigterm_writes_a_checkpoint_and_the_run_resumes_bit_identically(base_ru
     ("output.crs_epsg=3031", ["output.crs_epsg", "[domain] crs"]),
     ('forcing.ocean.colour="blue"', ["forcing.ocean.colour", "takes no keys"]),
     ('forcing.wind={kind="file", path="no/such/era5.nc"}', ["no/such/era5.nc", "file not found"]),
+    ('output.timeseries={every="1h", diagnostics=["mean_damagee"]}',
+     ["unknown diagnostic 'mean_damagee'", "did you mean 'mean_damage'?", "known: [", "'mean_damage'",
+      "'module:function' hook"]),
     ("domain.resolution_m=2000e3", ["domain.resolution_m = 2e+06 m", "larger than the domain", "942.7 km"]),
 ])
 def test_bad_setting_is_one_line_before_any_work(setting, fragments, tmp_path):

@@ -461,6 +461,13 @@ def timeseries_diagnostics(cfg: dict) -> dict | None:
             raise ConfigError(f"output.timeseries.diagnostics: {n!r} is not a name")
         if n in BUILTIN:
             out[n] = BUILTIN[n]
+        elif ":" not in n:  # not a hook: a misspelt built-in name
+            import difflib
+
+            near = difflib.get_close_matches(n, list(BUILTIN), n=1)
+            hint = f" (did you mean {near[0]!r}?)" if near else ""
+            raise ConfigError(f"output.timeseries.diagnostics: unknown diagnostic {n!r}{hint}; known: "
+                              f"{sorted(BUILTIN)}, or a 'module:function' hook")
         else:
             f = resolve_hook(n, "output.timeseries.diagnostics")
             out[n.partition(":")[2]] = ScalarDiagnostic(f, getattr(f, "units", "1"), getattr(f, "long_name", ""))
