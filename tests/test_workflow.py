@@ -435,6 +435,18 @@ def test_boundary_expression_failing_mid_run_is_one_line_with_a_summary(expr, fr
     assert s["checkpoint"].endswith("checkpoint_0000000005.npz") and Path(s["checkpoint"]).exists()
 
 
+def test_wind_file_with_missing_records_is_refused_before_meshing(tmp_path):
+    """The bundled 6-hourly ERA5 stub without records 1-3 (a 24 h gap)."""
+    ds = xr.open_dataset(ROOT / "data_stubs" / "era5_stub_arctic.nc")[["u10", "v10"]].load()
+    gap = tmp_path / "gap.nc"
+    ds.isel(time=[0, 4, 5, 6, 7, 8]).to_netcdf(gap)
+    out = tmp_path / "run"
+    r = run_cli("run", "winter_basin", "--out", out,
+                sets=["run.duration=12h", f'forcing.wind={{kind="file", path="{gap}"}}'])
+    one_line_error(r, str(gap), "not evenly spaced", "1 d apart", "the records are 6 h apart")
+    assert not out.exists()
+
+
 def test_info_on_a_file_that_is_not_netcdf(tmp_path):
     bad = tmp_path / "notes.nc"
     bad.write_text("not netCDF at all")
