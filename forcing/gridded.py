@@ -71,6 +71,40 @@ def _find(ds, names, given):
     return None
 
 
+def _span(td) -> str:
+    """A time span as ``6 h``, ``1 d 6 h``, ``30 min``."""
+    sec = int(td / np.timedelta64(1, "s"))
+    d, rem = divmod(sec, 86400)
+    h, rem = divmod(rem, 3600)
+    m, sec = divmod(rem, 60)
+    parts = [f"{v} {u}" for v, u in ((d, "d"), (h, "h"), (m, "min"), (sec, "s")) if v]
+    return " ".join(parts) or "0 s"
+
+
+def _check_spacing(path, tname, tvals) -> None:
+    """Records must be evenly spaced (to within a second): a gap (missing records) would be
+    interpolated across without a word. Monthly records (every spacing 28 to 31 days) are
+    accepted. The expected spacing is the most common one; ForcingError names the file,
+    the first record pair that departs from it, their times and spacing."""
+    if tvals.size < 3:
+        return
+    dts = np.diff(tvals)
+    vals, counts = np.unique(dts, return_counts=True)
+    expected = vals[int(np.argmax(counts))]
+    tol = np.timedelta64(1, "s")
+    off = np.flatnonzero(np.abs(dts - expected) > tol)
+    if not off.size:
+        return
+    if np.all((dts >= np.timedelta64(28, "D")) & (dts <= np.timedelta64(31, "D"))):
+        return  # calendar months
+    k = int(off[0])
+    what = "a gap (missing records?)" if dts[k] > expected else "records closer than the others"
+    raise ForcingError(f"{path}: variable {tname}: records are not evenly spaced: {what} between record {k} "
+                       f"({str(tvals[k])[:19]}) and record {k + 1} ({str(tvals[k + 1])[:19]}), {_span(dts[k])} "
+                       f"apart, where the records are {_span(expected)} apart; problem: uneven time steps "
+                       f"(they would be interpolated across without a word); give evenly spaced records")
+
+
 def _units_key(units):
     return " ".join(str(units).strip().lower().split())
 
@@ -170,6 +204,7 @@ class GriddedRecords:
                 raise ForcingError(f"{self.path}: variable {tname}: time is not strictly increasing "
                                    f"(record {k} at {tvals[k]} follows {tvals[k - 1]}); problem: "
                                    f"time not monotonic")
+        _check_spacing(self.path, tname, tvals)
         if reference_time is None:
             ref = tvals[0]
         else:

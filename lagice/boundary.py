@@ -24,10 +24,27 @@ class VelocityBC:
     v: object = None
 
     def value(self, comp, t, xy):
+        """Values of component ``comp`` (0: u, 1: v) at time ``t`` [s] on the nodes ``xy``;
+        a value that is not finite, or a callable that fails, is a ConfigError naming the
+        scene key (``boundary.TAG.u``), the time, the node and the value."""
         val = self.u if comp == 0 else self.v
+        key = f"boundary.{self.tag}.{'uv'[comp]}"
         if callable(val):
-            return np.broadcast_to(np.asarray(val(t, xy[:, 0], xy[:, 1]), np.float64), (len(xy),))
-        return np.full(len(xy), float(val))
+            try:
+                with np.errstate(all="ignore"):
+                    out = np.broadcast_to(np.asarray(val(t, xy[:, 0], xy[:, 1]), np.float64), (len(xy),))
+            except ConfigError:
+                raise
+            except Exception as exc:  # noqa: BLE001 - a user's function: name the key and the time
+                raise ConfigError(f"{key}: evaluating it at t = {t:g} s (day {t / 86400:.4f}) failed: "
+                                  f"{type(exc).__name__}: {exc}") from exc
+        else:
+            out = np.full(len(xy), float(val))
+        if not np.all(np.isfinite(out)):
+            i = int(np.flatnonzero(~np.isfinite(out))[0])
+            raise ConfigError(f"{key} = {out[i]} m s-1 at t = {t:g} s (day {t / 86400:.4f}) on the node at x = "
+                              f"{xy[i, 0]:.6g} m, y = {xy[i, 1]:.6g} m; expected a finite velocity")
+        return out
 
 
 class DirichletSet:

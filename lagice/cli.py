@@ -94,7 +94,7 @@ def _where(out: Path) -> str:
 
 
 def _run(args) -> int:
-    from .rundir import claim
+    from .rundir import claim, restart_unstarted
     from .scenes import DEFAULT_SCENE
     from .scenes.builder import build_simulation, resume_simulation, validate_config
     from .scenes.config import load_scene
@@ -108,7 +108,9 @@ def _run(args) -> int:
     if out is not None and args.resume and (out / "checkpoints").is_dir() and any(
             (out / "checkpoints").glob("checkpoint_*.npz")):
         return _continue(resume_simulation(out, config=cfg), out, resumed=True)
-    if out is not None:
+    if out is not None and args.resume:  # no checkpoint: start it (afresh, if it was stopped before one)
+        restart_unstarted(out, cfg)
+    elif out is not None:
         claim(out, overwrite=args.overwrite)
     sim = build_simulation(cfg, out)
     log.info(f"running scene {cfg['scene']['name']!r} ({cfg['scene']['source']}) -> {_where(sim.out_dir)}/")
@@ -153,9 +155,20 @@ def _report(res, sim):
 
 
 def _resume(args) -> int:
+    from .errors import RestartError
+    from .rundir import MARKER
     from .scenes.builder import resume_simulation
     from .simulation import load_checkpoint, run_folder_of
 
+    d = Path(args.checkpoint)
+    if (d / MARKER).is_file() and not any((d / "checkpoints").glob("checkpoint_*.npz")):
+        try:
+            info = json.loads((d / MARKER).read_text())
+        except (OSError, ValueError):
+            info = {}
+        scene = info.get("source") or info.get("scene") or "SCENE"
+        raise RestartError(f"no checkpoint in {d}: its run stopped before its first checkpoint; start it again "
+                           f"there with: lagice run {scene} --out {d} --resume")
     path = load_checkpoint(args.checkpoint)[0]
     run_dir = run_folder_of(path)
     sim = resume_simulation(path, args.set)

@@ -7,11 +7,16 @@
   asks to ``overwrite`` it (its contents are removed first, and only when it is a
   lagice run folder) or to ``resume`` the run in it.
 * :func:`prepare` creates the folder, proves it is writable (writes the marker
-  file ``lagice_run.json``) before any mesh work, and removes the temporary files
-  a killed write left behind (checkpoints, snapshots, VTU, index files).
+  file ``lagice_run.json``, with the fingerprint of the run's physics settings)
+  before any mesh work, and removes the temporary files a killed write left behind
+  (checkpoints, snapshots, VTU, index files).
+* :func:`restart_unstarted`: ``lagice run SCENE --out DIR --resume`` on a folder whose
+  run (same scene, same physics settings: its marker says so) was stopped before its
+  first checkpoint starts that run afresh there; any other content is refused.
 """
 from __future__ import annotations
 
+import hashlib
 import json
 import logging
 import os
@@ -25,6 +30,8 @@ from .errors import ConfigError, OutputError
 MARKER = "lagice_run.json"
 #: what marks a folder as a lagice run folder (besides the marker)
 RUN_ENTRIES = ("snapshots", "checkpoints", "summary.json", "timeseries.nc")
+#: what a run writes into its folder besides RUN_ENTRIES and the marker (``{scene}``: the scene name)
+RUN_OUTPUTS = ("drifters.nc", "{scene}.png")
 #: temporary files of the atomic writers (``*.tmp`` then ``os.replace``)
 TEMP_GLOBS = ("*.tmp", "snapshots/*.tmp", "snapshots/*.tmp.vtu", "checkpoints/*.tmp-*")
 
@@ -67,6 +74,16 @@ def is_run_dir(path) -> bool:
     return (p / MARKER).exists() or any((p / e).exists() for e in RUN_ENTRIES)
 
 
+def settings_fingerprint(config: dict) -> str:
+    """Hash of the settings that determine a run's trajectory (the physics view of its
+    configuration, :func:`lagice.scenes.config.physics_view`), as the checkpoints' scene
+    fingerprint (:meth:`lagice.model.Model.fingerprint`) hashes them."""
+    from .scenes.config import physics_view
+
+    view = {k: v for k, v in physics_view(config).items() if not k.startswith("_")}
+    return hashlib.sha256(json.dumps(view, sort_keys=True, default=str).encode()).hexdigest()[:16]
+
+
 def is_empty(path) -> bool:
     p = Path(path)
     return not p.exists() or (p.is_dir() and not any(p.iterdir()))
@@ -92,6 +109,60 @@ def claim(out, overwrite: bool = False) -> Path:
     return out
 
 
+def restart_unstarted(out, config: dict) -> Path:
+    """``lagice run SCENE --out DIR --resume`` when DIR holds no checkpoint: start the run
+    afresh in DIR. Allowed when DIR is empty or absent, or when it holds the run of the same
+    scene with the same physics settings (its marker ``lagice_run.json`` names the scene
+    and the settings fingerprint, :func:`settings_fingerprint`), stopped before its first
+    checkpoint; that run's partial outputs are removed (one line says so). A folder holding
+    another run (other scene or settings, a branch, an ensemble member, a marker without a
+    fingerprint) or files a run does not write is refused (ConfigError naming it)."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f"output folder {out} exists and is not a folder")
+    if is_empty(out):
+        return out
+    scene = config["scene"]["name"]
+    how = "replace it with --overwrite, or choose another --out (runs are never mixed in one folder)"
+    marker = out / MARKER
+    if not marker.is_file():
+        raise ConfigError(f"--resume: output folder {out} holds no checkpoint and no {MARKER}: it is not the folder "
+                          f"of a run of scene {scene!r}; {how}")
+    try:
+        info = json.loads(marker.read_text())
+    except (OSError, ValueError) as exc:
+        raise ConfigError(f"--resume: cannot read {marker} ({exc}); {how}") from None
+    if not isinstance(info, dict):
+        raise ConfigError(f"--resume: {marker} is not a lagice run marker; {how}")
+    if info.get("parent") or info.get("ensemble"):
+        what = "a branch of a checkpoint" if info.get("parent") else "an ensemble member"
+        raise ConfigError(f"--resume: output folder {out} holds {what} stopped before its first checkpoint, not a "
+                          f"run of scene {scene!r}; {how}")
+    if info.get("scene") != scene:
+        raise ConfigError(f"--resume: output folder {out} holds a run of scene {info.get('scene')!r} (no "
+                          f"checkpoint), not of {scene!r}; {how}")
+    if info.get("fingerprint") is None:
+        raise ConfigError(f"--resume: output folder {out} holds a run of {scene!r} without a checkpoint, and its "
+                          f"{MARKER} has no settings fingerprint (an older lagice) to tell whether it is this run; "
+                          f"{how}")
+    fp = settings_fingerprint(config)
+    if info["fingerprint"] != fp:
+        raise ConfigError(f"--resume: output folder {out} holds a run of {scene!r} with other physics settings "
+                          f"(fingerprint {info['fingerprint']}, these settings {fp}) and no checkpoint; {how}")
+    known = {MARKER, *RUN_ENTRIES, *(o.format(scene=scene) for o in RUN_OUTPUTS)}
+    for child in sorted(out.iterdir()):
+        if child.name not in known and not child.name.endswith(".tmp"):
+            raise ConfigError(f"--resume: output folder {out} holds {child.name}, which a run does not write; "
+                              f"refusing to replace the run in it (move {child.name} away, or choose another --out)")
+    ck = out / "checkpoints"
+    if ck.is_dir() and any(ck.glob("checkpoint_*.npz")):  # the caller resumes these
+        raise ConfigError(f"--resume: output folder {out} holds checkpoints: resume them")
+    clear_folder(out, why="--resume")
+    log.info(f"{out}/ holds this run of {scene!r} stopped before its first checkpoint: starting it afresh there "
+             f"(its partial outputs are replaced)")
+    return out
+
+
 def prepare(out, config: dict | None = None) -> list[Path]:
     """Create ``out``, prove it writable (by writing the marker ``lagice_run.json``:
     scene, lagice version, command, parent checkpoint of a branch, ensemble member; or, when it
@@ -111,6 +182,8 @@ def prepare(out, config: dict | None = None) -> list[Path]:
         info = {"scene": cfg.get("scene", {}).get("name"), "source": cfg.get("scene", {}).get("source"),
                 "lagice_version": __version__, "written": datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
                 "command": " ".join(sys.argv) if sys.argv and sys.argv[0] else None}
+        if cfg.get("scene"):
+            info["fingerprint"] = settings_fingerprint(cfg)
         if cfg.get("_parent"):
             info["parent"] = cfg["_parent"]
         if cfg.get("_ensemble"):
@@ -135,6 +208,20 @@ def prepare(out, config: dict | None = None) -> list[Path]:
     return removed
 
 
+def discard(out, remove_folder: bool) -> None:
+    """Undo :func:`prepare` for a new run that failed before it started (a check that
+    needed the mesh): remove what was written in ``out`` (it was empty), and ``out``
+    itself when ``remove_folder`` (it did not exist), so that the corrected command can
+    use the same folder. Failures to remove are reported, not raised (the first error matters)."""
+    out = Path(out)
+    try:
+        clear_folder(out, why="removing the folder of the failed run")
+        if remove_folder:
+            out.rmdir()
+    except (OSError, OutputError) as exc:
+        log.warning(f"could not remove {out} after the failed start: {exc}")
+
+
 def clean_stale(out) -> list[Path]:
     """Remove the temporary files killed writes left in the run folder ``out``."""
     from .io.checkpoint import clean_stale_temporaries
@@ -154,7 +241,7 @@ def clean_stale(out) -> list[Path]:
     return removed
 
 
-def clear_folder(folder: Path, keep: tuple[str, ...] = ()) -> None:
+def clear_folder(folder: Path, keep: tuple[str, ...] = (), why: str = "--overwrite") -> None:
     """Remove everything in ``folder`` but the names in ``keep`` (``--overwrite``);
     a file that cannot be removed is an :class:`OutputError` naming it."""
     for child in Path(folder).iterdir():
@@ -166,4 +253,4 @@ def clear_folder(folder: Path, keep: tuple[str, ...] = ()) -> None:
             else:
                 child.unlink()
         except OSError as exc:
-            raise OutputError(f"--overwrite: cannot remove {child}: {exc.strerror}") from None
+            raise OutputError(f"{why}: cannot remove {child}: {exc.strerror}") from None

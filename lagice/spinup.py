@@ -134,6 +134,54 @@ def _load(path: str, mtime_ns: int, key: str):
     return cKDTree(xy), fields
 
 
+#: a point lies in a state's footprint when a state centroid is within this many times the
+#: state's centroid spacing of it (:func:`check_footprint`)
+FOOTPRINT_SPACINGS = 5.0
+
+
+@lru_cache(maxsize=4)
+def _spacing(path: str, mtime_ns: int, key: str) -> float:
+    tree = _load(path, mtime_ns, key)[0]
+    if tree.n < 2:
+        return float("inf")
+    d, _ = tree.query(tree.data, k=2)
+    return float(np.median(d[:, 1]))
+
+
+def footprint_tolerance_m(spec, key: str = "initial.state_file") -> float:
+    """The distance [m] from a state centroid within which a point is covered by the state:
+    :data:`FOOTPRINT_SPACINGS` (5) times the state's centroid spacing ``s``, the median
+    distance from a state centroid to its nearest neighbour. On a mesh of equilateral
+    elements of side h, s = h / sqrt(3), so the tolerance is about 2.9 h: a domain point
+    (even a corner of the coast) is a fraction of an element from the nearest centroid of a
+    state made on the same domain, and a mesh beyond the state is refused."""
+    load_state_file(spec, key)
+    p = resolve_state_path(spec)
+    return FOOTPRINT_SPACINGS * _spacing(str(p.resolve()), p.stat().st_mtime_ns, key)
+
+
+def check_footprint(spec, x, y, key: str = "initial.state_file", what: str = "the mesh") -> None:
+    """ConfigError unless every point (x, y) [m] lies within :func:`footprint_tolerance_m`
+    of a centroid of the spin-up state ``spec``: the nearest-centroid lookup of
+    :func:`field_from_spinup` would otherwise fill a domain the state does not cover. The
+    message names ``key``, the file, the farthest point, its distance in km and the tolerance."""
+    tree, _ = load_state_file(spec, key)
+    xy = np.column_stack([np.asarray(x, np.float64).ravel(), np.asarray(y, np.float64).ravel()])
+    if not len(xy):
+        return
+    d, _ = tree.query(xy)
+    tol = footprint_tolerance_m(spec, key)
+    i = int(np.argmax(d))
+    if d[i] > tol:
+        lo, hi = tree.data.min(axis=0) / 1e3, tree.data.max(axis=0) / 1e3
+        raise ConfigError(
+            f"{key} = {str(spec)!r}: {what} lies outside the spin-up state's footprint: the point x = "
+            f"{xy[i, 0] / 1e3:.1f} km, y = {xy[i, 1] / 1e3:.1f} km is {d[i] / 1e3:.1f} km from the nearest state "
+            f"centroid (tolerance {tol / 1e3:.1f} km: {FOOTPRINT_SPACINGS:g} times the state's centroid spacing); "
+            f"the state covers x in [{lo[0]:.0f}, {hi[0]:.0f}] km, y in [{lo[1]:.0f}, {hi[1]:.0f}] km. Use a state "
+            f"made on this domain (and domain.crs)")
+
+
 def field_from_spinup(path, name, x, y) -> np.ndarray:
     """Value of spin-up field ``name`` at the nearest spin-up centroid of each (x, y)."""
     tree, fields = load_state_file(path)

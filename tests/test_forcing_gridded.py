@@ -210,6 +210,20 @@ def test_time_not_monotonic(tmp_path):
     _assert_names(e, p, "time")
 
 
+def test_time_with_a_gap_is_refused(tmp_path):
+    """A 6-hourly file that lacks two records (an 18 h gap): refused, naming the file, the
+    records either side of the gap and the expected spacing; an even file opens."""
+    times = np.datetime64("2021-02-01T00:00", "ns") + np.array([0, 1, 4, 5, 6]) * np.timedelta64(6, "h")
+    p = era5_like(tmp_path / "gap.nc", times=times)
+    with pytest.raises(ForcingError, match="not evenly spaced") as e:
+        open_wind(p)
+    _assert_names(e, p, "time")
+    msg = str(e.value)
+    assert "between record 1 (2021-02-01T06:00:00) and record 2 (2021-02-02T00:00:00), 18 h apart" in msg
+    assert "the records are 6 h apart" in msg
+    assert open_wind(era5_like(tmp_path / "even.nc")).source.record_times.size == 5
+
+
 def test_time_not_cf(tmp_path):
     lon = np.arange(0.0, 360.0, 10.0)
     lat = np.arange(70.0, 85.01, 5.0)

@@ -148,7 +148,7 @@ def test_solver_move_remesh_step_cycle(tmp_path):
     from lagice.remesh import RemeshLog, remesh_if_needed
 
     sim = scene_sim("uniaxial_compression", tmp_path, compression_overrides(
-        8, **{"run.seed": 3, "boundary.top.v": -0.05, "solver.dt": 600.0, "run.duration": "1d"}))
+        8, **{"run.seed": 3, "boundary.top.v": -0.05, "solver.dt": 600.0, "run.duration": "1d", "output.every": "1d"}))
     st, solver = sim.model.state, sim.model.stepper
     b = new_budget()
     log = RemeshLog()

@@ -52,6 +52,34 @@ def test_resume_is_bit_identical(tmp_path):
     assert np.array_equal(sa["damage"].values, sb["damage"].values)
 
 
+#: a moving mesh that remeshes (as tests/test_workflow.py BASE): 60 steps, several remesh events
+REMESHING = {"run.duration": 6000.0, "solver.dt": 100.0, "output.every": 3000.0, "checkpoint.every": 3000.0,
+             "domain.resolution_m": 25e3, "run.progress": False, "output.plot": False,
+             "boundary.top.u": "20.0*minimum(1.0, t/600.0)", "lagrangian.enabled": True, "remesh.enabled": True,
+             "run.max_speed_m_s": 50.0}
+
+
+def test_resumed_run_carries_the_remesh_event_count(tmp_path):
+    """components.remeshing.n_events of the final checkpoint counts the whole run: a run
+    resumed after some remesh events ends with the uninterrupted run's count."""
+    def n_events(run):
+        path = list_checkpoints(tmp_path / run / "checkpoints")[-1]
+        return read_checkpoint(path)[1]["components"]["remeshing"]["n_events"]
+
+    full = build_simulation(load_scene("shear_box", REMESHING), tmp_path / "full")
+    full.run()
+    part = build_simulation(load_scene("shear_box", REMESHING), tmp_path / "part")
+    part.run(n_steps=30)  # checkpoint at step 30
+    first = n_events("part")
+    assert 0 < first < n_events("full"), "remesh events before and after the checkpoint"
+    del part
+    resumed = Simulation.resume(tmp_path / "part" / "checkpoints")
+    assert resumed.model.component("remeshing").n_events == first
+    resumed.run()
+    assert n_events("part") == n_events("full")
+    assert resumed.model.state.counters["remesh_count"] == full.model.state.counters["remesh_count"]
+
+
 def _as_written_without(path, keys):
     """Rewrite checkpoint ``path`` as a version of lagice without the dotted ``keys``
     would have written it: its stored configuration lacks them and its fingerprint is

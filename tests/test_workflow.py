@@ -120,6 +120,60 @@ def test_output_folder_reuse_is_refused(tmp_path):
     assert (other / "thesis.tex").read_text() == "precious"
 
 
+def test_resume_starts_a_run_killed_before_its_first_checkpoint_and_refuses_other_folders(tmp_path):
+    """A batch queue requeues ``lagice run SCENE --out DIR --resume``: a run killed (SIGKILL)
+    before its first checkpoint is started afresh in its folder; a folder of another run, or
+    with files a run does not write, is refused and left as it is."""
+    hook = tmp_path / "killhook.py"
+    hook.write_text(textwrap.dedent("""
+        import os, pathlib, time
+        from lagice.io.timeseries import diagnostic
+
+        @diagnostic("1", "pause (slows the run so the test can kill it mid-run)")
+        def pause(model):
+            if model.clock.iteration >= 3:
+                pathlib.Path(os.environ["SENTINEL"]).touch()
+                time.sleep(0.2)
+            return 0.0
+    """))
+    out = tmp_path / "run"
+    sentinel = tmp_path / "sentinel"
+    env = {"PYTHONPATH": f"{tmp_path}{os.pathsep}{os.environ.get('PYTHONPATH', '')}", "SENTINEL": str(sentinel)}
+    sets = [*QUICK, 'output.timeseries.every="1 steps"', 'output.timeseries.diagnostics=["killhook:pause"]']
+    cmd = [sys.executable, "-m", "lagice.cli", "run", "shear_box", "--out", str(out), "--resume"]
+    for s in sets:
+        cmd += ["--set", s]
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**os.environ, **env})
+    t0 = time.time()
+    while not sentinel.exists():
+        assert p.poll() is None, p.communicate()
+        assert time.time() - t0 < 120
+        time.sleep(0.02)
+    p.kill()
+    p.communicate(timeout=60)
+    assert (out / "lagice_run.json").exists() and (out / "snapshots").is_dir()
+    assert not list(out.glob("checkpoints/checkpoint_*.npz")), "killed before its first checkpoint"
+    one_line_error(run_cli("resume", out), f"no checkpoint in {out}", "lagice run", f"--out {out} --resume")
+    before = sorted(p.name for p in out.rglob("*"))
+    # another run (other physics) in the folder: refused, nothing touched
+    r = run_cli("run", "shear_box", "--out", out, "--resume", sets=[*sets, "run.seed=5"], env=env)
+    one_line_error(r, str(out), "other physics settings", "--overwrite")
+    (out / "notes.txt").write_text("mine")
+    r = run_cli("run", "shear_box", "--out", out, "--resume", sets=sets, env=env)
+    one_line_error(r, str(out), "notes.txt", "a run does not write")
+    assert sorted(p.name for p in out.rglob("*")) == sorted([*before, "notes.txt"])
+    (out / "notes.txt").unlink()
+    # the same run: started afresh, its partial outputs replaced, one line says so
+    env["SENTINEL"] = str(tmp_path / "s2")
+    r = run_cli("run", "shear_box", "--out", out, "--resume", sets=sets, env=env)
+    assert r.returncode == 0, r.stderr[-3000:]
+    assert sum("starting it afresh" in ln for ln in r.stdout.splitlines()) == 1, r.stdout
+    assert json.loads((out / "summary.json").read_text())["finished"]
+    assert last_snapshot(out)[1][-1]["step"] == 20 and list(out.glob("checkpoints/checkpoint_*.npz"))
+    ts = xr.load_dataset(out / "timeseries.nc", decode_times=False)
+    assert np.array_equal(ts["time"].values, np.arange(0.0, 801.0, 40.0)), "one row per step, no killed rows left"
+
+
 @pytest.mark.slow
 def test_default_folders_never_collide_and_latest_follows(tmp_path):
     a = run_cli("run", "shear_box", sets=QUICK, cwd=tmp_path)
@@ -270,6 +324,10 @@ def test_sigterm_writes_a_checkpoint_and_the_run_resumes_bit_identically(base_ru
     ("output.crs_epsg=3031", ["output.crs_epsg", "[domain] crs"]),
     ('forcing.ocean.colour="blue"', ["forcing.ocean.colour", "takes no keys"]),
     ('forcing.wind={kind="file", path="no/such/era5.nc"}', ["no/such/era5.nc", "file not found"]),
+    ('output.timeseries={every="1h", diagnostics=["mean_damagee"]}',
+     ["unknown diagnostic 'mean_damagee'", "did you mean 'mean_damage'?", "known: [", "'mean_damage'",
+      "'module:function' hook"]),
+    ("domain.resolution_m=2000e3", ["domain.resolution_m = 2e+06 m", "larger than the domain", "942.7 km"]),
 ])
 def test_bad_setting_is_one_line_before_any_work(setting, fragments, tmp_path):
     out = tmp_path / "run"
@@ -278,6 +336,115 @@ def test_bad_setting_is_one_line_before_any_work(setting, fragments, tmp_path):
     one_line_error(r, *fragments)
     assert not out.exists(), "nothing is written (and no mesh made) before the settings are checked"
     assert time.time() - t0 < 60
+
+
+@pytest.mark.parametrize("shift_km", [4500.0, 150.0])
+def test_spinup_state_that_does_not_cover_the_domain_is_refused_before_meshing(shift_km, tmp_path):
+    """The bundled winter-basin spin-up state moved east: its nearest-centroid lookup would
+    fill the domain (all of it, or its western part) from ice far away."""
+    z = dict(np.load(ROOT / "data_stubs" / "winter_basin_spinup.npz"))
+    z["centroid_x_m"] = (z["centroid_x_m"] + shift_km * 1e3).astype(np.float32)
+    state = tmp_path / "moved.npz"
+    np.savez(state, **z)
+    out = tmp_path / "run"
+    r = run_cli("run", "winter_basin_pack", "--out", out,
+                sets=["run.duration=1h", "domain.resolution_m=80e3", f'initial.state_file="{state}"'])
+    line = one_line_error(r, "initial.state_file", str(state), "outside the spin-up state's footprint",
+                          "tolerance 20.", "km from the nearest state centroid")
+    far = float(line.split(" km from the nearest")[0].rsplit(" ", 1)[1])
+    assert far > 100.0 and (shift_km < 1000 or far > 3000.0), line
+    assert not out.exists(), "refused before the output folder and the mesh"
+
+
+def test_resolution_larger_than_the_domain_is_refused_before_meshing(tmp_path):
+    from lagice.errors import ConfigError
+    from lagice.scenes.builder import validate_config
+    from lagice.scenes.config import load_scene
+
+    out = tmp_path / "run"
+    r = run_cli("run", "shear_box", "--out", out, sets=[*QUICK, "domain.resolution_m=500e3"])
+    one_line_error(r, "domain.resolution_m = 500000 m", "larger than the domain", "smallest extent is 200.0 km")
+    assert not out.exists()
+    validate_config(load_scene("shear_box", {"domain.resolution_m": 200e3}))  # one element across: allowed
+    with pytest.raises(ConfigError, match="smallest extent is 200.0 km"):
+        validate_config(load_scene("shear_box", {"domain.resolution_m": 200.001e3}))
+
+
+@pytest.mark.parametrize("setting,fragments", [
+    ("initial.thickness_m=-1", ["initial.thickness_m = -1 m", "out of range", "[0, inf] m"]),
+    ("initial.concentration=1.5", ["initial.concentration = 1.5", "out of range", "[0, 1]"]),
+    ("initial.damage=1.5", ["initial.damage = 1.5", "out of range", "[0, 1)"]),
+    ("initial.damage=1.0", ["initial.damage = 1.0", "out of range", "[0, 1)"]),
+    ("initial.thickness_m=nan", ["initial.thickness_m = nan", "out of range"]),
+])
+def test_initial_constant_out_of_range_is_refused_before_meshing(setting, fragments, tmp_path):
+    out = tmp_path / "run"
+    one_line_error(run_cli("run", "shear_box", "--out", out, sets=[*QUICK, setting]), *fragments)
+    assert not out.exists(), "refused before the output folder (and the mesh)"
+
+
+def test_initial_expression_out_of_range_names_the_key_and_leaves_no_folder(tmp_path):
+    """An expression is checked on the mesh (its values at the element centroids); the
+    failed start leaves no folder, so the corrected command may use the same --out."""
+    out = tmp_path / "run"
+    r = run_cli("run", "shear_box", "--out", out, sets=[*QUICK, 'initial.concentration="0.5 + x / 2e5"'])
+    one_line_error(r, "initial.concentration = '0.5 + x / 2e5' gives values in [", "elements outside",
+                   "expected values in [0, 1]")
+    assert not out.exists(), "the failed start left its folder behind"
+    r = run_cli("run", "shear_box", "--out", out, sets=[*QUICK, 'initial.concentration="0.5 + x / 4e5"'])
+    assert r.returncode == 0, r.stderr[-3000:]
+    ds, _ = last_snapshot(out)
+    assert 0.5 < float(ds["concentration"].min()) and float(ds["concentration"].max()) < 1.0
+
+
+@pytest.mark.parametrize("setting,fragments", [
+    ('output.every="50s"', ["output.every = '50s' (50 s)", "solver.dt = 40 s", "40 s or 80 s", "'1 steps'"]),
+    ("checkpoint.every=100.0", ["checkpoint.every = 100.0 (100 s)", "solver.dt = 40 s", "80 s or 120 s"]),
+    ("output.every=10.0", ["output.every = 10.0 (10 s)", "whole number (>= 1) of steps", "40 s"]),
+    ('output.timeseries={every="1min", diagnostics=["mean_damage"]}',
+     ["output.timeseries.every = '1min' (60 s)", "solver.dt = 40 s"]),
+])
+def test_output_and_checkpoint_intervals_must_be_whole_steps(setting, fragments, tmp_path):
+    """As run.duration: an interval that is not a whole number of steps would fall due at
+    irregular steps (every 40 or 80 s for 50 s)."""
+    out = tmp_path / "run"
+    one_line_error(run_cli("run", "shear_box", "--out", out, sets=[*QUICK, setting]), *fragments)
+    assert not out.exists()
+
+
+def test_nan_boundary_constant_is_refused_before_meshing(tmp_path):
+    out = tmp_path / "run"
+    one_line_error(run_cli("run", "shear_box", "--out", out, sets=[*QUICK, "boundary.top.v=nan"]),
+                   "boundary.top.v = nan", "finite")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("expr,fragments", [
+    ("1.0/(t-400.0)", ["cannot evaluate the expression at t = 400 s", "ZeroDivisionError"]),
+    ("0.01*sqrt(360.0 - t)", ["gives nan at t = 400 s", "finite"]),
+])
+def test_boundary_expression_failing_mid_run_is_one_line_with_a_summary(expr, fragments, tmp_path):
+    """A prescribed velocity that cannot be evaluated, or is not finite, at some time: the
+    error names the key, the expression and the time (not 'cg did not converge' or a
+    traceback), exit 2, and the run leaves summary.json and its last checkpoint."""
+    out = tmp_path / "run"
+    r = run_cli("run", "shear_box", "--out", out, sets=[*QUICK, f'boundary.top.u="{expr}"', "checkpoint.every=200.0"])
+    one_line_error(r, f"boundary.top.u = '{expr}'", *fragments)
+    s = json.loads((out / "summary.json").read_text())
+    assert not s["finished"] and s["stop_reason"].startswith("error: boundary.top.u") and s["steps"] == 9
+    assert s["checkpoint"].endswith("checkpoint_0000000005.npz") and Path(s["checkpoint"]).exists()
+
+
+def test_wind_file_with_missing_records_is_refused_before_meshing(tmp_path):
+    """The bundled 6-hourly ERA5 stub without records 1-3 (a 24 h gap)."""
+    ds = xr.open_dataset(ROOT / "data_stubs" / "era5_stub_arctic.nc")[["u10", "v10"]].load()
+    gap = tmp_path / "gap.nc"
+    ds.isel(time=[0, 4, 5, 6, 7, 8]).to_netcdf(gap)
+    out = tmp_path / "run"
+    r = run_cli("run", "winter_basin", "--out", out,
+                sets=["run.duration=12h", f'forcing.wind={{kind="file", path="{gap}"}}'])
+    one_line_error(r, str(gap), "not evenly spaced", "1 d apart", "the records are 6 h apart")
+    assert not out.exists()
 
 
 def test_info_on_a_file_that_is_not_netcdf(tmp_path):
@@ -376,7 +543,8 @@ def test_a_run_inside_a_gridded_file_uses_the_records_of_its_date(tmp_path):
     env = {"PYTHONPATH": f"{tmp_path}{os.pathsep}{os.environ.get('PYTHONPATH', '')}"}
     wind = [f'forcing.wind={{kind="file", path="{path}", u="u", v="v"}}', "solver.dt=1800.0",
             "run.duration=21600.0", "output.every=21600.0", "domain.resolution_m=50e3", "run.progress=false",
-            "output.plot=false", 'output.timeseries={every="1 steps", diagnostics=["windhook:wind_u"]}']
+            "output.plot=false", 'output.timeseries={every="1 steps", diagnostics=["windhook:wind_u"]}',
+            "checkpoint.every=21600.0"]
     out = tmp_path / "run"
     r = run_cli("run", "shear_box", "--out", out, sets=[*wind, 'run.start_date="2020-01-03 06:00:00"'], env=env)
     assert r.returncode == 0, r.stderr

@@ -40,6 +40,8 @@ class Remesher:
             raise ConfigError(f"[remesh.params]: {exc}") from None
         self.options = {k: v for k, v in params.items() if k in REMESH_OPTIONS}
         self.log = RemeshLog()
+        #: events before the checkpoint this run resumed from (:meth:`restore`)
+        self.n_events_before = 0
         self.renumber = bool(renumber)
         #: callables ``f(state)`` run after each successful remesh, after the remap (e.g.
         #: :meth:`lagice.strength.StrengthLaw.apply`: every element gets the strength of its size)
@@ -61,8 +63,14 @@ class Remesher:
                 f(st)
         return ev
 
+    @property
+    def n_events(self) -> int:
+        """Remesh events (failed ones included) over the whole run, parts before a resume included."""
+        return self.n_events_before + len(self.log)
+
     def checkpoint_state(self):
-        return {}, {"n_events": len(self.log)}
+        return {}, {"n_events": self.n_events}
 
     def restore(self, arrays, meta):
-        pass
+        """Carry the event count of the run so far (:attr:`log` holds this session's events only)."""
+        self.n_events_before = int(meta.get("n_events", 0))

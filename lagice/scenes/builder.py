@@ -16,7 +16,7 @@ import numpy as np
 import shapely
 from shapely.geometry import LineString, Polygon, shape
 
-from ..errors import ConfigError, check_range
+from ..errors import ConfigError, LagiceError, check_range
 from ..mesh import generate_mesh, rectangle_domain, renumber_for_locality, rotate_mesh
 from ..model import Model
 from ..params import MaxwellEBParams
@@ -24,7 +24,7 @@ from ..rheology import MaxwellEB, ViscousPlastic, ViscousPlasticParams, draw_coh
 from ..schedule import parse_duration, parse_schedule
 from ..simulation import Simulation
 from ..solvers import SOLVER_RHEOLOGY, SOLVERS, VelocityBC
-from ..spinup import field_from_spinup, load_state_file
+from ..spinup import check_footprint, field_from_spinup, load_state_file
 from ..state import IceState
 from . import components
 from .components import time_step_s  # noqa: F401 - part of the builder API
@@ -198,6 +198,40 @@ def _domain_points(poly, n: int = 30) -> np.ndarray:
     return np.vstack([v, np.column_stack([gx.ravel(), gy.ravel()])])
 
 
+def smallest_extent_m(poly) -> float:
+    """The domain's smallest extent [m]: the shorter side of its minimum rotated rectangle
+    (a rectangle's width or height, whichever is smaller)."""
+    r = np.asarray(poly.minimum_rotated_rectangle.exterior.coords)
+    sides = np.hypot(*np.diff(r[:3], axis=0).T)
+    return float(sides.min())
+
+
+def check_resolution(res, poly) -> None:
+    """A numeric ``domain.resolution_m`` (the target element size) must not exceed the
+    domain's smallest extent (:func:`smallest_extent_m`): a mesh needs at least one element
+    across the domain. ConfigError naming the key, the value and the extent in km."""
+    if isinstance(res, str):
+        return
+    ext = smallest_extent_m(poly)
+    if res > ext:
+        raise ConfigError(f"domain.resolution_m = {res:g} m is larger than the domain: its smallest extent is "
+                          f"{ext / 1e3:.1f} km; expected an element size of at most {ext:g} m (at least one "
+                          f"element across the domain)")
+
+
+def _footprint_points(poly, state_file) -> np.ndarray:
+    """Points covering a polygon, to check a spin-up state's footprint before meshing: its
+    boundary every state centroid spacing, and a 60 x 60 grid over its bounding box (inside)."""
+    from ..spinup import FOOTPRINT_SPACINGS, footprint_tolerance_m
+
+    step = footprint_tolerance_m(state_file) / FOOTPRINT_SPACINGS
+    rings = (poly.exterior, *poly.interiors)
+    bnd = [np.asarray((r.segmentize(step) if math.isfinite(step) and step > 0 else r).coords) for r in rings]
+    g = _domain_points(poly, 60)
+    inside = g[shapely.contains_xy(poly, g[:, 0], g[:, 1])]
+    return np.vstack([*bnd, inside])
+
+
 def build_mesh(cfg: dict, with_order: bool = False):
     """The scene's mesh (gmsh), renumbered and rotated as asked; also returns the polygon.
 
@@ -274,6 +308,10 @@ def validate_config(cfg: dict) -> None:
         raise ConfigError(f"run.duration = {cfg['run']['duration']!r} is not a whole number (>= 1) of steps of "
                           f"solver.dt = {dt:g} s")
     check_range("run.max_speed_m_s", cfg["run"]["max_speed_m_s"], 0.0, None, low_open=True, unit="m s-1")
+    check_whole_steps("output.every", cfg["output"]["every"], dt)
+    check_whole_steps("checkpoint.every", cfg["checkpoint"]["every"], dt)
+    if isinstance(cfg["output"]["timeseries"], dict) and "every" in cfg["output"]["timeseries"]:
+        check_whole_steps("output.timeseries.every", cfg["output"]["timeseries"]["every"], dt)
     rheo = build_rheology(cfg)
     law = strength_law(cfg)
     check_state_file_strength(cfg, law)
@@ -337,6 +375,8 @@ def validate_config(cfg: dict) -> None:
     for key, val in cfg["initial"].items():
         if val is None or (key == "cohesion_pa" and val == "random") or key == "state_file" or key in state_fields:
             continue
+        if isinstance(val, (int, float)) and not isinstance(val, bool):  # a constant: its range now
+            check_initial_range(key, val)
         if key == "stress_pa" and isinstance(val, str) and ":" in val:
             resolve_hook(val, "initial.stress_pa")
             continue
@@ -345,12 +385,37 @@ def validate_config(cfg: dict) -> None:
     poly = domain_polygon(cfg)  # no mesh yet: the polygon only
     if not poly.is_valid or poly.area <= 0:
         raise ConfigError(f"domain: the polygon is not valid ({shapely.validation.explain_validity(poly)})")
+    check_resolution(d["resolution_m"], poly)
+    if state_fields:  # the spin-up state must cover the domain (its boundary and inside)
+        check_footprint(cfg["initial"]["state_file"], *_footprint_points(poly, cfg["initial"]["state_file"]).T,
+                        "initial.state_file", "the domain")
     if dr["positions_m"]:
         for k, p in enumerate(dr["positions_m"]):
             if not poly.contains(shapely.Point(p)):
                 raise ConfigError(f"drifters.positions_m[{k}] = {p!r} lies outside the domain (bounds "
                                   f"{tuple(round(b) for b in poly.bounds)} m in domain.crs)")
     components.check_forcing_files(cfg, _domain_points(poly), duration)
+
+
+def check_whole_steps(key: str, value, dt: float) -> None:
+    """An interval of simulated time (``output.every = "6h"``, not ``"N steps"`` or wall
+    time) must be a whole number (>= 1) of time steps, as ``run.duration`` is: otherwise
+    the activity falls due at irregular steps. ConfigError naming the key, the interval
+    and solver.dt, with the nearest whole multiples."""
+    from ..schedule import TimeInterval
+
+    if value is None:
+        return
+    sched = parse_schedule(value, key)
+    if not isinstance(sched, TimeInterval):
+        return
+    n = sched.interval / dt
+    if abs(n - round(n)) > 1e-9 * max(1.0, n) or round(n) < 1:
+        lo, hi = max(1, math.floor(n)), max(1, math.ceil(n))
+        near = f"{lo * dt:g} s" + (f" or {hi * dt:g} s" if hi != lo else "")
+        raise ConfigError(f"{key} = {value!r} ({sched.interval:g} s) is not a whole number (>= 1) of steps of "
+                          f"solver.dt = {dt:g} s; it would fall due at irregular steps (use e.g. {near}, "
+                          f"or '{lo} steps')")
 
 
 def checkpoint_schedule(cfg: dict):
@@ -396,6 +461,13 @@ def timeseries_diagnostics(cfg: dict) -> dict | None:
             raise ConfigError(f"output.timeseries.diagnostics: {n!r} is not a name")
         if n in BUILTIN:
             out[n] = BUILTIN[n]
+        elif ":" not in n:  # not a hook: a misspelt built-in name
+            import difflib
+
+            near = difflib.get_close_matches(n, list(BUILTIN), n=1)
+            hint = f" (did you mean {near[0]!r}?)" if near else ""
+            raise ConfigError(f"output.timeseries.diagnostics: unknown diagnostic {n!r}{hint}; known: "
+                              f"{sorted(BUILTIN)}, or a 'module:function' hook")
         else:
             f = resolve_hook(n, "output.timeseries.diagnostics")
             out[n.partition(":")[2]] = ScalarDiagnostic(f, getattr(f, "units", "1"), getattr(f, "long_name", ""))
@@ -494,6 +566,45 @@ def check_state_file_strength(cfg: dict, law) -> None:
                           f"carries a factor made with {ell:g} m and {a:g}; use the state file's values")
 
 
+#: valid range of each ``[initial]`` field, as the state checks it (:func:`lagice.fields.validate_state`):
+#: (low, high, high_open, unit)
+INITIAL_RANGES = {"thickness_m": (0.0, None, False, "m"), "concentration": (0.0, 1.0, False, ""),
+                  "damage": (0.0, 1.0, True, ""), "cohesion_pa": (0.0, None, False, "Pa"),
+                  "snow_m": (0.0, None, False, "m"), "stress_pa": (None, None, False, "Pa")}
+
+
+def check_initial_range(key: str, value) -> None:
+    """ConfigError naming ``initial.KEY``, the value and the expected range, unless the
+    constant ``value`` lies in :data:`INITIAL_RANGES` (and is finite)."""
+    if key not in INITIAL_RANGES:
+        return
+    lo, hi, hi_open, unit = INITIAL_RANGES[key]
+    check_range(f"initial.{key}", value, lo, hi, high_open=hi_open, unit=unit)
+    if not math.isfinite(float(value)):
+        raise ConfigError(f"initial.{key} = {value!r}: expected a finite number{' in ' + unit if unit else ''}")
+
+
+def check_initial_values(key: str, spec, values) -> None:
+    """The values of ``initial.KEY`` (= ``spec``, an expression or a hook) over the mesh's
+    elements in :data:`INITIAL_RANGES`; ConfigError naming the key, the range found and the one expected."""
+    if key not in INITIAL_RANGES or not np.size(values):
+        return
+    lo, hi, hi_open, unit = INITIAL_RANGES[key]
+    v = np.asarray(values, np.float64)
+    bad = ~np.isfinite(v)
+    if lo is not None:
+        bad |= v < lo
+    if hi is not None:
+        bad |= (v >= hi) if hi_open else (v > hi)
+    if bad.any():
+        rng = (f"[{lo:g}, " if lo is not None else "(-inf, ") + (
+            "inf)" if hi is None else f"{hi:g})" if hi_open else f"{hi:g}]")
+        u = f" {unit}" if unit else ""
+        raise ConfigError(f"initial.{key} = {spec!r} gives values in [{np.nanmin(v):.6g}, {np.nanmax(v):.6g}]{u} "
+                          f"over the mesh ({int(bad.sum())} of {v.size} elements outside); expected values in "
+                          f"{rng}{u}")
+
+
 def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
     """The scene's initial state on ``mesh``; ``order`` (see :func:`build_mesh`): random
     cohesion is drawn in the mesh generator's element order, then permuted, so the
@@ -514,11 +625,17 @@ def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
                 cohesion = cohesion[order]
     else:
         cohesion = spatial_values(coh, x, y, "initial.cohesion_pa")
+        check_initial_values("cohesion_pa", coh, cohesion)
+
     def field(key):
         if ini[key] == "from_state":
             return field_from_spinup(ini["state_file"], FROM_STATE[key], x, y)
-        return spatial_values(ini[key], x, y, f"initial.{key}")
+        v = spatial_values(ini[key], x, y, f"initial.{key}")
+        check_initial_values(key, ini[key], v)
+        return v
 
+    if any(ini[k] == "from_state" for k in FROM_STATE):
+        check_footprint(ini["state_file"], x, y, "initial.state_file", "the mesh")
     state = IceState.uniform(mesh, thickness_m=field("thickness_m"), concentration=field("concentration"),
                              damage=field("damage"), cohesion_pa=cohesion)
     if coh == "random" and law is not None and law.correlated:  # a law only for Maxwell-EB (strength_law)
@@ -531,6 +648,7 @@ def initial_state(cfg: dict, mesh, rheo, rng, order=None) -> IceState:
         state.cohesion = state.cohesion * state.strength_factor
     if ini["snow_m"] is not None:
         state.snow = spatial_values(ini["snow_m"], x, y, "initial.snow_m")
+        check_initial_values("snow_m", ini["snow_m"], state.snow)
     sp = ini["stress_pa"]
     if isinstance(sp, str) and ":" in sp:
         stress = np.asarray(resolve_hook(sp, "initial.stress_pa")(x, y), np.float64)
@@ -625,13 +743,23 @@ def build_simulation(cfg: dict, out_dir=None, progress: bool | None = None, over
     # checks that they do what that version did)
     cfg = override_config(cfg, overrides or {})
     validate_config(cfg)
+    out = rundir.new_run_dir(cfg["scene"]["name"]) if out_dir is None else Path(out_dir)
+    existed, fresh = out.exists(), rundir.is_empty(out)
+    rundir.prepare(out, cfg)
+    try:
+        sim = _simulation(cfg, out, progress)
+    except LagiceError:
+        if fresh:  # a new run failed its checks on the mesh: leave no folder that blocks the corrected rerun
+            rundir.discard(out, remove_folder=not existed)
+        raise
     if out_dir is None:
-        out = rundir.new_run_dir(cfg["scene"]["name"])
-        rundir.prepare(out, cfg)
         rundir.update_latest(out, cfg["scene"]["name"])
-    else:
-        out = Path(out_dir)
-        rundir.prepare(out, cfg)
+    return sim
+
+
+def _simulation(cfg: dict, out: Path, progress) -> Simulation:
+    """The model (mesh, initial state: the checks that need the mesh) and its
+    :class:`Simulation` writing into the prepared folder ``out``."""
     model = build_model(cfg, validated=True)
     prog = cfg["run"]["progress"] if progress is None else progress
     sim = Simulation(model, dt=time_step_s(cfg), stop=cfg["run"]["duration"], progress=prog, builder=BUILDER,
@@ -813,22 +941,41 @@ def branch_strength(state, parent_cfg: dict, cfg: dict) -> str:
 
 def finish(sim: Simulation, plot: bool = True) -> dict:
     """Run a (new or resumed) simulation to its end (or until it is stopped), then
-    write ``summary.json`` and, when it finished, the plot."""
-    summary = sim.run()
+    write ``summary.json`` and, when it finished, the plot. A run stopped by an error
+    (a :class:`~lagice.errors.LagiceError`: a solver failure, a boundary value that is not
+    finite...) also writes ``summary.json`` (``stop_reason`` "error: ...", the last
+    checkpoint) before the error goes on to the caller."""
     out = Path(sim.out_dir if sim.out_dir is not None else ".")
+    try:
+        summary = sim.run()
+    except LagiceError as exc:
+        try:
+            failed = sim.summary()
+            failed.update(stop_reason=f"error: {exc}", error=str(exc), scene=sim.model.config["scene"]["name"])
+            _write_summary(out, failed)
+        except Exception as inner:  # noqa: BLE001 - the run's own error is the one to report
+            import logging
+
+            logging.getLogger("lagice").warning(f"could not write {out / 'summary.json'} after the error: {inner}")
+        raise
     out.mkdir(parents=True, exist_ok=True)
     cfg = sim.model.config
     summary["scene"] = cfg["scene"]["name"]
     res = {"summary": summary, "netcdf": out / "snapshots" / "index.json", "wall_s": summary["wall_s"],
            "png": None, "out_dir": out}
-    from ..io.cf import atomic_write_errors
-
-    with atomic_write_errors(out / "summary.json", out / "summary.json.tmp"):
-        (out / "summary.json.tmp").write_text(json.dumps(summary, indent=1, default=str))
-        (out / "summary.json.tmp").replace(out / "summary.json")
+    _write_summary(out, summary)
     if plot and sim.stop_reason is None:
         res["png"] = plot_scene(cfg, out, summary)
     return res
+
+
+def _write_summary(out: Path, summary: dict) -> None:
+    from ..io.cf import atomic_write_errors
+
+    out.mkdir(parents=True, exist_ok=True)
+    with atomic_write_errors(out / "summary.json", out / "summary.json.tmp"):
+        (out / "summary.json.tmp").write_text(json.dumps(summary, indent=1, default=str))
+        (out / "summary.json.tmp").replace(out / "summary.json")
 
 
 def plot_scene(cfg: dict, out: Path, summary: dict | None = None, drifters=None):

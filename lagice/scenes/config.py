@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import copy
 import importlib
+import math
 import re
 import tomllib
 from pathlib import Path
@@ -512,6 +513,8 @@ def time_space_callable(value, key: str):
     """A callable f(t, x, y) from a number, expression in t, x, y, or module:function."""
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         v = float(value)
+        if not math.isfinite(v):
+            raise ConfigError(f"{key} = {value!r}: expected a finite number (or an expression in t, x, y)")
         return lambda t, x, y: np.full(np.shape(x), v)
     if isinstance(value, str):
         if _MODFUNC.match(value):
@@ -521,12 +524,26 @@ def time_space_callable(value, key: str):
         except SyntaxError as exc:
             raise ConfigError(f"{key} = {value!r}: not a valid expression: {exc}") from exc
 
-        def f(t, x, y, _code=code):
-            return np.broadcast_to(np.asarray(eval(_code, {"__builtins__": {}},
-                                                   {**_NP_NAMES, "t": t, "x": x, "y": y}), np.float64),
-                                   np.shape(x))
+        def raw(t, x, y, _code=code):
+            with np.errstate(all="ignore"):
+                return np.broadcast_to(np.asarray(eval(_code, {"__builtins__": {}},
+                                                       {**_NP_NAMES, "t": t, "x": x, "y": y}), np.float64),
+                                       np.shape(x))
+
+        def f(t, x, y):
+            """``raw``; a failure or a value that is not finite is a ConfigError naming the key and the time."""
+            try:
+                out = raw(t, x, y)
+            except Exception as exc:  # noqa: BLE001 - a user's expression: name it and the time
+                raise ConfigError(f"{key} = {value!r}: cannot evaluate the expression at t = {float(np.max(t)):g} s: "
+                                  f"{type(exc).__name__}: {exc}") from exc
+            if not np.all(np.isfinite(out)):
+                bad = out[~np.isfinite(out)].flat[0]
+                raise ConfigError(f"{key} = {value!r} gives {bad} at t = {float(np.max(t)):g} s; expected finite "
+                                  f"values")
+            return out
         try:
-            f(0.0, np.zeros(2), np.zeros(2))
+            raw(0.0, np.zeros(2), np.zeros(2))  # it evaluates (its values are checked where it is used)
         except Exception as exc:  # noqa: BLE001
             raise ConfigError(f"{key} = {value!r}: cannot evaluate the expression in t, x, y: {exc}") from exc
         return f
