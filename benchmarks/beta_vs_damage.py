@@ -10,6 +10,7 @@ the other thing β moves with), and writes ``docs/figures/beta_vs_damage.json``.
 
     python benchmarks/beta_vs_damage.py F10-hthick-1125 F10s-hthick-1125 F10-hthick-1125-intact F10s-hthick-1125-intact
     python benchmarks/beta_vs_damage.py F10-hthick-1125-intact --at 7 10      # the damage at given days
+    python benchmarks/beta_vs_damage.py F10-hthick-1125 --contrast 8 9 10     # active elements against the rest
 
 Runs are read from ``benchmarks/out/physics`` (made by ``physics_experiments.py run``); a run
 whose snapshots are missing stops the script with its name, so no window is left out silently.
@@ -41,6 +42,8 @@ BUFFER_M = 100e3
 BROKEN = 0.9
 #: damage above which an element counts in ``damaged_area_share`` (the over-failure's measure)
 DAMAGED = 0.5
+#: share of the interior's area that ``activity_contrast`` calls active (the highest rates)
+ACTIVE_SHARE = 0.05
 
 
 def start_damage(run_dir, day: float, buffer_m: float = BUFFER_M) -> dict:
@@ -70,6 +73,70 @@ def start_damage(run_dir, day: float, buffer_m: float = BUFFER_M) -> dict:
             "broken_area_share": float(area[d > BROKEN].sum() / area.sum()),
             "damaged_area_share": float(area[d > DAMAGED].sum() / area.sum()),
             "damage_area_m2": float(np.sum(area * d)), "area_m2": float(area.sum())}
+
+
+def load_ratio(stress: np.ndarray, cohesion: np.ndarray, friction: float) -> np.ndarray:
+    """The stress against the nominal envelope of Dansereau et al. (2016): max(σ1/σT,
+    (q σ1 − σ2)/σc) per element, σ1 ≥ σ2 the principal stresses (tension positive) of
+    ``stress`` (m, 3) = (σxx, σyy, σxy) [Pa], (q, σc, σT) of the cohesion [Pa] and friction
+    (:func:`lagice.rheology.maxwell_eb.envelope`). 1 on the envelope, k for k times such a
+    stress (so 1/d_crit of the origin path outside), ≤ 0 under an isotropic compression."""
+    from lagice.rheology.maxwell_eb import envelope
+
+    q, sigma_c, sigma_t = envelope(np.asarray(cohesion, np.float64), friction)
+    m = 0.5 * (stress[:, 0] + stress[:, 1])
+    r = np.sqrt(0.25 * (stress[:, 0] - stress[:, 1]) ** 2 + stress[:, 2] ** 2)
+    s1, s2 = m + r, m - r
+    return np.maximum(s1 / sigma_t, (q * s1 - s2) / sigma_c)
+
+
+def split_by_rate(rate: np.ndarray, area: np.ndarray, top: float):
+    """Boolean mask of the elements that carry the highest ``rate`` over a share ``top`` of the
+    total ``area`` (the most active elements first; the element that crosses the share is in)."""
+    order = np.argsort(-np.asarray(rate), kind="stable")
+    cum = np.cumsum(np.asarray(area)[order])
+    n = int(np.searchsorted(cum, top * cum[-1])) + 1
+    mask = np.zeros(len(rate), dtype=bool)
+    mask[order[:n]] = True
+    return mask
+
+
+def activity_contrast(run_dir, day: float, top: float = ACTIVE_SHARE, buffer_m: float = BUFFER_M) -> dict:
+    """Damage and load of the interior's most active elements against the rest, in the snapshot
+    nearest ``day``: the elements >= ``buffer_m`` from the boundary that carry the highest total
+    deformation rate (of the snapshot's node velocity, the last sub-step's) over ``top`` of the
+    interior's area, and the others. Medians of their damage and of their :func:`load_ratio`
+    (the friction from the run's configuration), and the share of each group's area above a load
+    ratio of 0.9. Raises ConfigError when no snapshot lies within an hour of ``day``."""
+    from lagice.diagnostics.strain import velocity_gradients
+
+    idx = read_index(run_dir)
+    times = np.array([e["time_s"] for e in idx])
+    i = int(np.argmin(np.abs(times - day * DAY_S)))
+    if abs(times[i] - day * DAY_S) > 3600.0:
+        raise ConfigError(f"{run_dir}: no snapshot within an hour of day {day:g} (nearest: day "
+                          f"{times[i] / DAY_S:g})")
+    with xr.open_dataset(snapshot_dir(run_dir) / idx[i]["file"], decode_times=False) as ds:
+        xy = np.column_stack([ds["mesh_node_x"].values, ds["mesh_node_y"].values])
+        tri = ds["mesh_face_nodes"].values.astype(np.int64)
+        vel = np.column_stack([ds["velocity_x"].values.reshape(-1), ds["velocity_y"].values.reshape(-1)])
+        damage = np.asarray(ds["damage"].values, np.float64).reshape(-1)
+        stress = np.column_stack([np.asarray(ds[f"stress_{k}"].values, np.float64).reshape(-1)
+                                  for k in ("xx", "yy", "xy")])
+        cohesion = np.asarray(ds["cohesion"].values, np.float64).reshape(-1)
+        friction = float(json.loads(ds.attrs["lagice_config"])["rheology"]["friction"])
+    inner = interior_triangles(xy, tri, buffer_m)
+    area = np.abs(triangle_geometry(xy, tri)[0])[inner]
+    rate = velocity_gradients(xy, tri, vel).total_s[inner]
+    load = load_ratio(stress, cohesion, friction)[inner]
+    d = damage[inner]
+    act = split_by_rate(rate, area, top)
+    out = {"snapshot_day": float(times[i] / DAY_S), "active_share": top,
+           "median_rate_per_day": float(np.median(rate) * DAY_S)}
+    for name, sel in (("active", act), ("rest", ~act)):
+        out[name] = {"median_damage": float(np.median(d[sel])), "median_load_ratio": float(np.median(load[sel])),
+                     "area_share_load_above_0.9": float(area[sel][load[sel] > 0.9].sum() / area[sel].sum())}
+    return out
 
 
 def rows_for(name: str, records: dict, runs: Path = RUNS) -> list:
@@ -103,7 +170,20 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=OUT, help=f"the JSON written (default {OUT.relative_to(ROOT)})")
     ap.add_argument("--at", type=float, nargs="+", metavar="DAY",
                     help="print the interior's damage of each run at these days instead (nothing written)")
+    ap.add_argument("--contrast", type=float, nargs="+", metavar="DAY",
+                    help="print the damage and load of the most active 5 %% of the interior against the rest "
+                         "at these days instead (nothing written)")
     args = ap.parse_args(argv)
+    if args.contrast:
+        for name in args.runs:
+            for day in args.contrast:
+                r = activity_contrast(RUNS / name, day)
+                a, o = r["active"], r["rest"]
+                print(f"{name:28s} day {day:5.1f} (median rate {r['median_rate_per_day']:.4f}/day): active 5 %: "
+                      f"damage {a['median_damage']:.3f}, load {a['median_load_ratio']:.2f}, "
+                      f"above 0.9 {a['area_share_load_above_0.9']:.2f} | rest: damage {o['median_damage']:.3f}, "
+                      f"load {o['median_load_ratio']:.2f}, above 0.9 {o['area_share_load_above_0.9']:.2f}")
+        return 0
     if args.at:
         for name in args.runs:
             for day in args.at:

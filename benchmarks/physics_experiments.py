@@ -1420,6 +1420,31 @@ EXPERIMENTS["B20-hthick-own"] = ("closed", from_spinup("H20"), 20e3, 28,
                                  "thick-and-thin pack at 20 km from its own 20 km spin-up (nominal criterion)")
 EXPERIMENTS["B20-hthick-eff"] = ("closed", EFFECTIVE + from_spinup("H20-eff"), 20e3, 28,
                                  "20 km: the envelope judges the effective stress sigma/(1 - d), own spin-up")
+# Results (10:49 UTC): (a) holds: the closed basin's beta at 10 km is 0.189 (strait 0.171); (b) holds:
+# the area above damage 0.5 at day 10 is 0.46 and 0.45 (shipped 0.99, 1.00); (c) fails in the strait:
+# 2 bands inside in each basin (beta and the rate, 0.021 and 0.022 per day), against 2 and 3; the
+# half-shear area 8.6 and 8.05 %, both tails light (4.2-5.6), R2 0.66 and 0.65. As predicted.
+# The wind factor is 0.0133 and 0.0136 (band 0.006-0.010, R2 0.94-0.95): the floes drift almost
+# freely. In the storm window the intact floes carry 2-3 % of their strength (median load ratio)
+# and the broken ice (damage 0.986) none: it flows with no viscosity left, so the friction the
+# effective envelope keeps never acts.
+# Broken ice that keeps its pressure below neXtSIM's P_max (its compressive term, sourced: PMAX
+# above) with the effective criterion, stated 2026-11-28 10:56 UTC before its runs: a 20 km screen
+# (closed basin, its own 20 km spin-up with both changes) against the effective criterion alone at
+# 20 km (B20-hthick-eff: 2 bands inside, beta 0.192). It is a lead for the 10 km month if it puts
+# more bands inside with beta still inside its band. Predicted: the rubble holds pressure, the
+# pack slows (rate 0.01-0.02 per day), R2 comes into its band, the tails stay light: 3 bands inside,
+# beta inside.
+SPINUPS["H20-effP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + PMAX, OUT / "spinup-H20-effP.npz",
+                       20e3)
+EXPERIMENTS["B20-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H20-effP"), 20e3, 28,
+                                  "20 km: effective envelope and neXtSIM's compressive term, own spin-up")
+SPINUPS["H1125-effP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + PMAX,
+                         OUT / "spinup-H1125-effP.npz", 10e3)
+EXPERIMENTS["F10-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H1125-effP"), 10e3, 28,
+                                  "effective envelope and neXtSIM's compressive term, own spin-up")
+EXPERIMENTS["F10s-hthick-effP"] = ("strait", EFFECTIVE + PMAX + from_spinup("H1125-effP"), 10e3, 28,
+                                   "strait: effective envelope and neXtSIM's compressive term, own spin-up")
 
 
 def command(scene, overrides, res, days, out) -> list:
@@ -1931,6 +1956,8 @@ LEADS = (
     ("damage averaged over R = 14 km (R calibrated on β; a network of short segments)", "F10-hthick-1125-nl14",
      "F10s-hthick-1125-nl14", "§3, The averaging length"),
     ("damage averaged over R = 10 km (a diagnostic)", "F10-hthick-1125-nl10", None, "§3, The averaging length"),
+    ("the envelope judges σ/(1 − d): broken ice keeps no cohesion (own spin-up; a diagnostic)", "F10-hthick-eff",
+     "F10s-hthick-eff", "Broken ice that keeps no cohesion"),
 )
 
 

@@ -652,3 +652,30 @@ def test_compression_cycle_measures_on_known_series():
     assert w["n_windowed_cycles"] == w["n_relaxations"] - 1
     gaps = np.diff(w["relaxation_times_t_h"])
     assert np.allclose(gaps, 0.5)
+
+
+def test_load_ratio_and_activity_split_on_known_stresses():
+    """``beta_vs_damage.load_ratio`` is 1 on both branches of the nominal envelope (uniaxial
+    compression at σc, uniaxial tension at σT), k for k times those stresses, and ≤ 0 under an
+    isotropic compression; ``split_by_rate`` takes the most active elements until their area
+    reaches the share asked, whatever their order."""
+    from beta_vs_damage import load_ratio, split_by_rate
+
+    from lagice.rheology.maxwell_eb import envelope
+
+    coh, mu = np.array([2e4, 3e4]), 0.7
+    q, sc, st = envelope(coh, mu)
+    for k in (0.5, 1.0, 2.0):
+        comp = np.array([[0.0, -k * sc[0], 0.0], [-k * sc[1], 0.0, 0.0]])  # along y, along x
+        tens = np.array([[k * st[0], 0.0, 0.0], [0.0, k * st[1], 0.0]])
+        assert np.allclose(load_ratio(comp, coh, mu), k, rtol=1e-12)
+        assert np.allclose(load_ratio(tens, coh, mu), k, rtol=1e-12)
+        rot = np.array([[-0.5 * k * sc[0], -0.5 * k * sc[0], 0.5 * k * sc[0]]] * 2)  # the first, turned 45°
+        assert np.allclose(load_ratio(rot, coh[:1].repeat(2), mu), k, rtol=1e-12)
+    assert np.all(load_ratio(np.array([[-5e4, -5e4, 0.0]] * 2), coh, mu) <= 0.0)
+    rate = np.array([0.1, 5.0, 0.3, 4.0, 0.2])
+    area = np.array([1.0, 1.0, 1.0, 2.0, 1.0])  # total 6
+    assert split_by_rate(rate, area, 0.1).tolist() == [False, True, False, False, False]
+    assert split_by_rate(rate, area, 0.4).tolist() == [False, True, False, True, False]  # 3 of 6 reached at 0.5
+    assert split_by_rate(rate, area, 0.5).tolist() == [False, True, False, True, False]
+    assert split_by_rate(rate, area, 0.51).tolist() == [False, True, True, True, False]
