@@ -1435,6 +1435,9 @@ EXPERIMENTS["B20-hthick-eff"] = ("closed", EFFECTIVE + from_spinup("H20-eff"), 2
 # more bands inside with beta still inside its band. Predicted: the rubble holds pressure, the
 # pack slows (rate 0.01-0.02 per day), R2 comes into its band, the tails stay light: 3 bands inside,
 # beta inside.
+# Result (10:58 UTC): not a lead. B20-hthick-effP puts 1 band inside (the rate, 0.035 per day), against
+# 2: beta 0.285 leaves its band, both tails 5.1-5.3, half-shear area 15.8 %, R2 0.51. The prediction
+# was wrong in every part: the pack moves faster, not slower. The 10 km runs are not made.
 SPINUPS["H20-effP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + PMAX, OUT / "spinup-H20-effP.npz",
                        20e3)
 EXPERIMENTS["B20-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H20-effP"), 20e3, 28,
