@@ -1442,6 +1442,19 @@ SPINUPS["H20-effP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE +
                        20e3)
 EXPERIMENTS["B20-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H20-effP"), 20e3, 28,
                                   "20 km: effective envelope and neXtSIM's compressive term, own spin-up")
+# Broken ice that keeps its mean stress with the effective criterion (rheology.relax_mean_stress =
+# false: the Maxwell relaxation acts on the deviator only, so a broken element keeps its pressure,
+# and the effective envelope caps its shear at friction times that pressure: a frictional rubble),
+# stated 2026-11-28 11:00 UTC before its runs: a 20 km screen (closed basin, its own 20 km spin-up
+# with both changes) against the effective criterion alone at 20 km (2 bands inside, beta 0.192).
+# A lead for the 10 km month if it puts more bands inside with beta still inside its band.
+# Predicted: the rubble transmits pressure, the pack slows (rate 0.005-0.01 per day), R2 and the
+# tails move towards their bands, and beta falls below its band (about 0.1): the rule fails on beta.
+KEEPMEAN = ["rheology.relax_mean_stress=false"]
+SPINUPS["H20-effK"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + KEEPMEAN,
+                       OUT / "spinup-H20-effK.npz", 20e3)
+EXPERIMENTS["B20-hthick-effK"] = ("closed", EFFECTIVE + KEEPMEAN + from_spinup("H20-effK"), 20e3, 28,
+                                  "20 km: effective envelope, broken ice keeps its mean stress, own spin-up")
 SPINUPS["H1125-effP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + PMAX,
                          OUT / "spinup-H1125-effP.npz", 10e3)
 EXPERIMENTS["F10-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H1125-effP"), 10e3, 28,
