@@ -1450,6 +1450,9 @@ EXPERIMENTS["B20-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H20-
 # A lead for the 10 km month if it puts more bands inside with beta still inside its band.
 # Predicted: the rubble transmits pressure, the pack slows (rate 0.005-0.01 per day), R2 and the
 # tails move towards their bands, and beta falls below its band (about 0.1): the rule fails on beta.
+# Result (11:02 UTC): not a lead. B20-hthick-effK puts 1 band inside (the rate, 0.0105 per day) against
+# 2; beta 0.096, below its band, as predicted; but R2 falls to 0.11 and the half-shear area rises to
+# 27.7 % (tails 6.1 / 4.4): the deformation spreads, as with the mean stress kept on the shipped set.
 KEEPMEAN = ["rheology.relax_mean_stress=false"]
 SPINUPS["H20-effK"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + KEEPMEAN,
                        OUT / "spinup-H20-effK.npz", 20e3)
