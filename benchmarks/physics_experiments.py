@@ -1412,6 +1412,16 @@ EXPERIMENTS["F10-hthick-eff"] = ("closed", EFFECTIVE + from_spinup("H1125-eff"),
                                  "the envelope judges the effective stress sigma/(1 - d), own spin-up")
 EXPERIMENTS["F10s-hthick-eff"] = ("strait", EFFECTIVE + from_spinup("H1125-eff"), 10e3, 28,
                                   "strait: the envelope judges the effective stress sigma/(1 - d), own spin-up")
+# Two more months for the effective criterion (closed basin, the same spin-up H1125-eff, wind seeds
+# 2027, the windy month, and 2028, the calm one), stated 2026-11-28 11:03 UTC before their runs,
+# after the validation month (beta 0.189, rate 0.021 per day): beta is the criterion's, not the
+# month's, if it lies within 0.14-0.23 (the band widened by the spread of the shipped set's beta
+# between months) in both months, and the rate is at least 0.01 per day in both (the calm month,
+# 0.0004 with the shipped set, unlocks). Predicted: both hold; the wind factor stays above its band.
+for _seed in (2027, 2028):
+    EXPERIMENTS[f"F10-hthick-eff-w{_seed}"] = (
+        "closed", EFFECTIVE + from_spinup("H1125-eff") + [f"forcing.wind.seed={_seed}"], 10e3, 28,
+        f"the envelope judges the effective stress sigma/(1 - d), own spin-up, wind seed {_seed}")
 # the 20 km screen again through the committed code (its own 20 km spin-ups; the prototype's
 # numbers above must come back)
 SPINUPS["H20"] = ([f"initial.thickness_m={HETERO_THICKNESS}"], OUT / "spinup-H20.npz", 20e3)
