@@ -268,8 +268,9 @@ CORRECTION_PATHS = {"implicit": STRESS_CORRECTIONS, "explicit": ("origin", "mean
 #: the optional terms of :class:`lagice.params.MaxwellEBParams` that each stepper implements.
 #: A term set away from its default (:meth:`MaxwellEBParams.optional_terms`) is refused by a
 #: stepper that does not list it, so no stepper silently runs without it
-OPTIONAL_TERMS = {"implicit": ("failure_stress",), "explicit": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg",
-                                               "damage_nonlocal_radius_m", "failure_stress"),
+OPTIONAL_TERMS = {"implicit": ("failure_stress",),
+                  "explicit": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg",
+                               "damage_nonlocal_radius_m", "failure_stress"),
                   "explicit_cuda": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg"), "prescribed": ()}
 STEPPER_LABELS = {"implicit": "the implicit solver (solver.name = 'implicit')",
                   "prescribed": "the prescribed-velocity stepper (solver.name = 'prescribed', no damage update)",
