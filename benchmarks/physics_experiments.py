@@ -1472,6 +1472,19 @@ SPINUPS["H20-effK"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE +
                        OUT / "spinup-H20-effK.npz", 20e3)
 EXPERIMENTS["B20-hthick-effK"] = ("closed", EFFECTIVE + KEEPMEAN + from_spinup("H20-effK"), 20e3, 28,
                                   "20 km: effective envelope, broken ice keeps its mean stress, own spin-up")
+# A residual strength of broken ice (a diagnostic of the mechanism, not a calibration to ship): the
+# damage cap rheology.max_damage (default 1 - 1e-6) at 0.99 and 0.9 with the effective criterion, so
+# broken ice keeps a cohesion (1 - cap) C and a relaxation time lambda0 (1 - cap)^3 (0.99: 10 s;
+# 0.9: 3 h). 20 km, closed basin, each from its own 20 km spin-up. Stated 2026-11-28 11:20 UTC before
+# the runs: a lead if, for either cap, the wind factor (drift_response.py) lies in 0.006-0.010 with
+# beta in 0.14-0.23 and at least 3 bands inside. Predicted: 0.99 changes little (wind factor about
+# 0.012), 0.9 binds the floes (wind factor about 0.006, beta about 0.1): neither cap meets all three.
+for _tag, _cap in (("cap99", "0.99"), ("cap90", "0.9")):
+    SPINUPS[f"H20-eff-{_tag}"] = ([f"initial.thickness_m={HETERO_THICKNESS}", f"rheology.max_damage={_cap}"]
+                                  + EFFECTIVE, OUT / f"spinup-H20-eff-{_tag}.npz", 20e3)
+    EXPERIMENTS[f"B20-hthick-eff-{_tag}"] = (
+        "closed", EFFECTIVE + [f"rheology.max_damage={_cap}"] + from_spinup(f"H20-eff-{_tag}"), 20e3, 28,
+        f"20 km: effective envelope, damage cap {_cap}, own spin-up")
 SPINUPS["H1125-effP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + PMAX,
                          OUT / "spinup-H1125-effP.npz", 10e3)
 EXPERIMENTS["F10-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H1125-effP"), 10e3, 28,
