@@ -1479,6 +1479,11 @@ EXPERIMENTS["B20-hthick-effK"] = ("closed", EFFECTIVE + KEEPMEAN + from_spinup("
 # the runs: a lead if, for either cap, the wind factor (drift_response.py) lies in 0.006-0.010 with
 # beta in 0.14-0.23 and at least 3 bands inside. Predicted: 0.99 changes little (wind factor about
 # 0.012), 0.9 binds the floes (wind factor about 0.006, beta about 0.1): neither cap meets all three.
+# Result (11:25 UTC): neither cap is a lead, as predicted. 0.99: beta 0.178, wind factor 0.0133, 2 bands
+# inside (as the effective criterion alone). 0.9: the wind factor 0.0072 comes into its band (drift R2
+# 0.71), the rate 0.013 per day stays in, but beta falls to 0.049 and the shear spreads (half-shear
+# area 23.9 %, R2 0.48, tails 4.3 / 5.0): 1 band inside. The strength left in broken ice moves the
+# drift and beta in opposite directions.
 for _tag, _cap in (("cap99", "0.99"), ("cap90", "0.9")):
     SPINUPS[f"H20-eff-{_tag}"] = ([f"initial.thickness_m={HETERO_THICKNESS}", f"rheology.max_damage={_cap}"]
                                   + EFFECTIVE, OUT / f"spinup-H20-eff-{_tag}.npz", 20e3)
