@@ -419,6 +419,22 @@ def test_nan_boundary_constant_is_refused_before_meshing(tmp_path):
     assert not out.exists()
 
 
+def test_keys_of_the_other_rheology_law(tmp_path):
+    """A viscous-plastic key set under maxwell_eb is refused before meshing (nothing reads it, and
+    its value is not even range-checked there); Maxwell-EB keys of a scene run with
+    law = 'viscous_plastic' (the EVP comparison) are named once as ignored, and the run goes on."""
+    out = tmp_path / "run"
+    one_line_error(run_cli("run", "shear_box", "--out", out, sets=[*QUICK, "rheology.p_star=-5"]),
+                   "rheology.p_star = -5", "rheology.law = 'maxwell_eb' does not use it")
+    assert not out.exists()
+    r = run_cli("run", "shear_box", "--out", tmp_path / "evp",
+                sets=[*QUICK, "rheology.law=viscous_plastic", "solver.name=evp", "healing.law=none",
+                      "rheology.friction=0.9"])
+    assert r.returncode == 0, r.stderr[-2000:]
+    warned = [ln for ln in r.stderr.splitlines() if "ignores these Maxwell-EB keys" in ln]
+    assert len(warned) == 1 and "rheology.friction = 0.9" in warned[0], r.stderr
+
+
 @pytest.mark.parametrize("expr,fragments", [
     ("1.0/(t-400.0)", ["cannot evaluate the expression at t = 400 s", "ZeroDivisionError"]),
     ("0.01*sqrt(360.0 - t)", ["gives nan at t = 400 s", "finite"]),

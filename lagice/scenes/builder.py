@@ -31,6 +31,7 @@ from .components import time_step_s  # noqa: F401 - part of the builder API
 from .config import (
     RHEOLOGY_KEYS,
     ROOT,
+    SCHEMA,
     load_scene,
     override_config,
     physics_view,
@@ -274,9 +275,42 @@ def strength_law(cfg: dict):
     return law if cfg["rheology"]["law"] == "maxwell_eb" else None
 
 
+#: messages of :func:`check_other_law_keys` already logged in this process (the checks run more
+#: than once per run: the CLI, then the builder)
+_LOGGED_UNUSED: set = set()
+
+
+def check_other_law_keys(rp: dict) -> None:
+    """Keys of ``[rheology]`` that only the other law uses, set away from their schema defaults:
+    under ``maxwell_eb`` a viscous-plastic key (``p_star`` ...) is refused, since nothing would
+    read it; under ``viscous_plastic`` the Maxwell-EB keys (and the strength law's) are logged
+    once as not used, since the EVP comparison runs a Maxwell-EB scene file with ``law`` switched."""
+    from .. import strength
+
+    law = rp["law"]
+    if law not in RHEOLOGY_KEYS:
+        return
+    own = set(RHEOLOGY_KEYS[law]) | ({"law"} | set(strength.RHEOLOGY_KEYS) if law == "maxwell_eb" else {"law"})
+    other = [k for k in SCHEMA["rheology"] if k not in own and rp.get(k) != SCHEMA["rheology"][k][1]]
+    if not other:
+        return
+    shown = ", ".join(f"rheology.{k} = {rp[k]!r}" for k in other)
+    if law == "maxwell_eb":
+        raise ConfigError(f"{shown}: rheology.law = 'maxwell_eb' does not use "
+                          f"{'it' if len(other) == 1 else 'them'} (keys of the viscous-plastic law); remove "
+                          f"{'it' if len(other) == 1 else 'them'}, or set rheology.law = 'viscous_plastic'")
+    msg = f"rheology.law = {law!r} ignores these Maxwell-EB keys of the scene: {shown}"
+    if msg not in _LOGGED_UNUSED:
+        _LOGGED_UNUSED.add(msg)
+        import logging
+
+        logging.getLogger("lagice").warning(msg)
+
+
 def build_rheology(cfg: dict):
     rp = cfg["rheology"]
     law = rp["law"]
+    check_other_law_keys(rp)
     if law == "maxwell_eb":
         return MaxwellEB(MaxwellEBParams(**{k: rp[k] for k in RHEOLOGY_KEYS[law]}))
     if law == "viscous_plastic":
