@@ -1422,6 +1422,13 @@ EXPERIMENTS["F10s-hthick-eff"] = ("strait", EFFECTIVE + from_spinup("H1125-eff")
 # 0.026 and 0.025 per day (the calm month x60 the shipped set's 0.0004). 2 bands inside in each (the
 # half-shear area, 7.7 and 7.5 %, and the rate); the wind factor 0.0138 and 0.0133, above its band.
 # So the validation month's beta was partly the month's; the unlocked rate is the criterion's.
+# The same two months in the strait (the same spin-up), stated 2026-11-28 11:41 UTC before their runs,
+# after the closed basin's: the same rule (beta in 0.14-0.23 in both, the rate >= 0.01 per day in
+# both). Predicted: as in the closed basin, the rate holds and beta fails (about 0.1).
+for _seed in (2027, 2028):
+    EXPERIMENTS[f"F10s-hthick-eff-w{_seed}"] = (
+        "strait", EFFECTIVE + from_spinup("H1125-eff") + [f"forcing.wind.seed={_seed}"], 10e3, 28,
+        f"strait: the envelope judges the effective stress sigma/(1 - d), own spin-up, wind seed {_seed}")
 for _seed in (2027, 2028):
     EXPERIMENTS[f"F10-hthick-eff-w{_seed}"] = (
         "closed", EFFECTIVE + from_spinup("H1125-eff") + [f"forcing.wind.seed={_seed}"], 10e3, 28,
