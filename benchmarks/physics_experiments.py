@@ -1425,6 +1425,9 @@ EXPERIMENTS["F10s-hthick-eff"] = ("strait", EFFECTIVE + from_spinup("H1125-eff")
 # The same two months in the strait (the same spin-up), stated 2026-11-28 11:41 UTC before their runs,
 # after the closed basin's: the same rule (beta in 0.14-0.23 in both, the rate >= 0.01 per day in
 # both). Predicted: as in the closed basin, the rate holds and beta fails (about 0.1).
+# Result (11:54 UTC): as predicted: beta 0.122 (2027) and 0.108 (2028) fails, the rate 0.025 per day in
+# both holds (the calm month x60 the shipped strait's 0.0004); 2 bands inside in each; wind factor
+# 0.0141 and 0.0134.
 for _seed in (2027, 2028):
     EXPERIMENTS[f"F10s-hthick-eff-w{_seed}"] = (
         "strait", EFFECTIVE + from_spinup("H1125-eff") + [f"forcing.wind.seed={_seed}"], 10e3, 28,
