@@ -46,6 +46,18 @@ DAMAGED = 0.5
 ACTIVE_SHARE = 0.05
 
 
+def nearest_snapshot(run_dir, day: float):
+    """(path, day) of the run's snapshot nearest ``day`` [days]; ConfigError when none lies
+    within an hour of it."""
+    idx = read_index(run_dir)
+    times = np.array([e["time_s"] for e in idx])
+    i = int(np.argmin(np.abs(times - day * DAY_S)))
+    if abs(times[i] - day * DAY_S) > 3600.0:
+        raise ConfigError(f"{run_dir}: no snapshot within an hour of day {day:g} (nearest: day "
+                          f"{times[i] / DAY_S:g})")
+    return snapshot_dir(run_dir) / idx[i]["file"], float(times[i] / DAY_S)
+
+
 def start_damage(run_dir, day: float, buffer_m: float = BUFFER_M) -> dict:
     """The interior's damage in the snapshot nearest ``day`` [days]: ``mean_damage``
     (area-weighted over the elements whose centroid is >= ``buffer_m`` [m] from the mesh
@@ -53,23 +65,18 @@ def start_damage(run_dir, day: float, buffer_m: float = BUFFER_M) -> dict:
     ``damaged_area_share`` (with damage > :data:`DAMAGED`), and the sums
     ``damage_area_m2`` (Σ d·A) and ``area_m2`` (Σ A) over those elements.
     Raises ConfigError when no snapshot lies within an hour of ``day``."""
-    idx = read_index(run_dir)
-    times = np.array([e["time_s"] for e in idx])
-    i = int(np.argmin(np.abs(times - day * DAY_S)))
-    if abs(times[i] - day * DAY_S) > 3600.0:
-        raise ConfigError(f"{run_dir}: no snapshot within an hour of day {day:g} (nearest: day "
-                          f"{times[i] / DAY_S:g})")
-    with xr.open_dataset(snapshot_dir(run_dir) / idx[i]["file"], decode_times=False) as ds:
+    path, snap_day = nearest_snapshot(run_dir, day)
+    with xr.open_dataset(path, decode_times=False) as ds:
         xy = np.column_stack([ds["mesh_node_x"].values, ds["mesh_node_y"].values])
         tri = ds["mesh_face_nodes"].values.astype(np.int64)
         damage = np.asarray(ds["damage"].values, np.float64).reshape(-1)
     if damage.shape[0] != tri.shape[0]:
-        raise ConfigError(f"{run_dir}: snapshot {idx[i]['file']}: {damage.shape[0]} damage values for "
+        raise ConfigError(f"{run_dir}: snapshot {path.name}: {damage.shape[0]} damage values for "
                           f"{tri.shape[0]} elements")
     inner = interior_triangles(xy, tri, buffer_m)
     area = np.abs(triangle_geometry(xy, tri)[0])[inner]
     d = damage[inner]
-    return {"snapshot_day": float(times[i] / DAY_S), "mean_damage": float(np.sum(area * d) / area.sum()),
+    return {"snapshot_day": snap_day, "mean_damage": float(np.sum(area * d) / area.sum()),
             "broken_area_share": float(area[d > BROKEN].sum() / area.sum()),
             "damaged_area_share": float(area[d > DAMAGED].sum() / area.sum()),
             "damage_area_m2": float(np.sum(area * d)), "area_m2": float(area.sum())}
@@ -110,13 +117,8 @@ def activity_contrast(run_dir, day: float, top: float = ACTIVE_SHARE, buffer_m: 
     ratio of 0.9. Raises ConfigError when no snapshot lies within an hour of ``day``."""
     from lagice.diagnostics.strain import velocity_gradients
 
-    idx = read_index(run_dir)
-    times = np.array([e["time_s"] for e in idx])
-    i = int(np.argmin(np.abs(times - day * DAY_S)))
-    if abs(times[i] - day * DAY_S) > 3600.0:
-        raise ConfigError(f"{run_dir}: no snapshot within an hour of day {day:g} (nearest: day "
-                          f"{times[i] / DAY_S:g})")
-    with xr.open_dataset(snapshot_dir(run_dir) / idx[i]["file"], decode_times=False) as ds:
+    path, snap_day = nearest_snapshot(run_dir, day)
+    with xr.open_dataset(path, decode_times=False) as ds:
         xy = np.column_stack([ds["mesh_node_x"].values, ds["mesh_node_y"].values])
         tri = ds["mesh_face_nodes"].values.astype(np.int64)
         vel = np.column_stack([ds["velocity_x"].values.reshape(-1), ds["velocity_y"].values.reshape(-1)])
@@ -131,7 +133,7 @@ def activity_contrast(run_dir, day: float, top: float = ACTIVE_SHARE, buffer_m: 
     load = load_ratio(stress, cohesion, friction)[inner]
     d = damage[inner]
     act = split_by_rate(rate, area, top)
-    out = {"snapshot_day": float(times[i] / DAY_S), "active_share": top,
+    out = {"snapshot_day": snap_day, "active_share": top,
            "median_rate_per_day": float(np.median(rate) * DAY_S)}
     for name, sel in (("active", act), ("rest", ~act)):
         out[name] = {"median_damage": float(np.median(d[sel])), "median_load_ratio": float(np.median(load[sel])),
