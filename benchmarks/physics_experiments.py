@@ -1500,6 +1500,25 @@ for _tag, _cap in (("cap99", "0.99"), ("cap90", "0.9")):
     EXPERIMENTS[f"B20-hthick-eff-{_tag}"] = (
         "closed", EFFECTIVE + [f"rheology.max_damage={_cap}"] + from_spinup(f"H20-eff-{_tag}"), 20e3, 28,
         f"20 km: effective envelope, damage cap {_cap}, own spin-up")
+# Refrozen leads that are intact again with the effective criterion (thermo.new_ice_undamaged, the
+# neXtSIM-DG form, sourced: "Undamaged new ice"), stated 2026-11-28 12:13 UTC before its runs. With
+# the effective criterion the broken network holds no stress at all (damage 0.986 in the storm
+# window), the floes drift almost freely (wind factor 0.013) and the broken share grows through the
+# month (0.40 -> 0.54, healing cannot keep up). New ice that forms in an opening lead brings back
+# cohesion C (1 - d A/A') where it forms, so a band that opens should lock again as it refreezes:
+# the mechanism the effective criterion lacks for intermittent bands. A 20 km screen (closed basin,
+# the validation month, its own 20 km spin-up with both changes) against the effective criterion
+# alone at 20 km (B20-hthick-eff: 2 bands inside, beta 0.192, wind factor 0.0132). It is a lead for
+# the 10 km months if it puts at least 3 bands inside with beta still in 0.14-0.23 (the widened band
+# of the multi-month rule). Reported beside it: the wind factor (drift_response.py) and the area
+# above damage 0.5 at days 10 and 28 (beta_vs_damage.py --at). Predicted: the refrozen leads slow
+# the floes (wind factor 0.009-0.012), the broken share stops growing, the tails get heavier
+# (3-4) but stay outside, and beta falls to 0.12-0.17: 2 bands inside, so not a lead.
+NEWICE = ["thermo.new_ice_undamaged=true"]
+SPINUPS["H20-effN"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + NEWICE,
+                       OUT / "spinup-H20-effN.npz", 20e3)
+EXPERIMENTS["B20-hthick-effN"] = ("closed", EFFECTIVE + NEWICE + from_spinup("H20-effN"), 20e3, 28,
+                                  "20 km: effective envelope, refrozen leads undamaged, own spin-up")
 SPINUPS["H1125-effP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + PMAX,
                          OUT / "spinup-H1125-effP.npz", 10e3)
 EXPERIMENTS["F10-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H1125-effP"), 10e3, 28,
