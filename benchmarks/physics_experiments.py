@@ -1501,7 +1501,7 @@ for _tag, _cap in (("cap99", "0.99"), ("cap90", "0.9")):
         "closed", EFFECTIVE + [f"rheology.max_damage={_cap}"] + from_spinup(f"H20-eff-{_tag}"), 20e3, 28,
         f"20 km: effective envelope, damage cap {_cap}, own spin-up")
 # Refrozen leads that are intact again with the effective criterion (thermo.new_ice_undamaged, the
-# neXtSIM-DG form, sourced: "Undamaged new ice"), stated 2026-11-28 12:13 UTC before its runs. With
+# neXtSIM-DG form, sourced: "Undamaged new ice"), stated 2026-11-28 12:11 UTC before its runs. With
 # the effective criterion the broken network holds no stress at all (damage 0.986 in the storm
 # window), the floes drift almost freely (wind factor 0.013) and the broken share grows through the
 # month (0.40 -> 0.54, healing cannot keep up). New ice that forms in an opening lead brings back
@@ -1514,6 +1514,12 @@ for _tag, _cap in (("cap99", "0.99"), ("cap90", "0.9")):
 # above damage 0.5 at days 10 and 28 (beta_vs_damage.py --at). Predicted: the refrozen leads slow
 # the floes (wind factor 0.009-0.012), the broken share stops growing, the tails get heavier
 # (3-4) but stay outside, and beta falls to 0.12-0.17: 2 bands inside, so not a lead.
+# Result (12:15 UTC): not a lead. B20-hthick-effN puts 1 band inside (the rate, 0.027 per day): beta
+# 0.211 (inside the widened band, outside the observed 0.17-0.20), tails 4.23 / 4.52, half-shear
+# area 14.5 %, R2 0.54. The prediction was wrong where it mattered: the wind factor is unchanged
+# (0.0133, R2 0.94) and the broken share still grows (area above damage 0.9: 0.54 at day 1, 0.58 at
+# day 10, 0.69 at day 28; the effective criterion alone 0.50, 0.56, 0.68). The new ice of a 20 km
+# step is too small a part of an element to bring its cohesion back. The 10 km runs are not made.
 NEWICE = ["thermo.new_ice_undamaged=true"]
 SPINUPS["H20-effN"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + NEWICE,
                        OUT / "spinup-H20-effN.npz", 20e3)
