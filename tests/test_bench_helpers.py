@@ -679,3 +679,21 @@ def test_load_ratio_and_activity_split_on_known_stresses():
     assert split_by_rate(rate, area, 0.4).tolist() == [False, True, False, True, False]  # 3 of 6 reached at 0.5
     assert split_by_rate(rate, area, 0.5).tolist() == [False, True, False, True, False]
     assert split_by_rate(rate, area, 0.51).tolist() == [False, True, True, True, False]
+
+
+def test_benchmark_runs_without_outputs_take_any_step_and_runs_with_outputs_keep_the_whole_step_check():
+    """A benchmark sets its own solver.dt (sub-steps × a stability limit), which rarely divides the
+    scene's output interval ("6h"). Without outputs the writing activities are left out, so their
+    schedules must not stop the build (bench_explicit was refused after the whole-step check came
+    in); with outputs the builder's refusal must still name the key."""
+    from lagice.errors import ConfigError
+    from scene_runs import scene_simulation
+
+    ov = {"domain.resolution_m": 100e3, "solver.dt": 198.009, "run.duration": 2 * 198.009}
+    sim = scene_simulation("wind_square", ov)
+    assert sim.dt == pytest.approx(198.009)
+    assert not {"snapshots", "timeseries", "checkpointer"} & set(sim.activities)
+    sim.run(n_steps=1)
+    assert sim.model.clock.iteration == 1
+    with pytest.raises(ConfigError, match=r"output\.every = '6h'.*whole number"):
+        scene_simulation("wind_square", ov, outputs=True)
