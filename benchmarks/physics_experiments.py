@@ -1525,6 +1525,24 @@ SPINUPS["H20-effN"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE +
                        OUT / "spinup-H20-effN.npz", 20e3)
 EXPERIMENTS["B20-hthick-effN"] = ("closed", EFFECTIVE + NEWICE + from_spinup("H20-effN"), 20e3, 28,
                                   "20 km: effective envelope, refrozen leads undamaged, own spin-up")
+# How fast a fault must heal with the effective criterion (a diagnostic of the mechanism, not a value
+# to ship: neXtSIM's th0 = 25 days is sourced), stated 2026-11-28 12:18 UTC before its runs. With the
+# effective criterion a broken band keeps no cohesion, and neXtSIM's healing (25 days at dT = 20 K)
+# gives back 4 % of it a day, so a band never locks again (the broken share grows 0.50 -> 0.68 at
+# 20 km) and the floes drift almost freely. RGPS bands live for days, and new ice in a lead reaches
+# 0.1 m in about a day of winter freezing. 20 km, closed basin, validation month, each from its own
+# 20 km spin-up with both changes: th0 = 5 days and 1 day. The fault-healing time is a lever if, for
+# either value, the wind factor lies in 0.006-0.010 with beta at least 0.14 and both tails at least
+# 1.0 lower (heavier) than the effective criterion alone (4.29 / 4.25). Predicted: neither meets all
+# three. 5 days: tails about 3.5, wind factor about 0.011, beta about 0.15; 1 day: the bands lock
+# between storms (the healing conflict of the nominal criterion): wind factor about 0.006, beta
+# about 0.08, the rate x0.3.
+for _tag, _th in (("th5d", "432000"), ("th1d", "86400")):
+    SPINUPS[f"H20-eff-{_tag}"] = ([f"initial.thickness_m={HETERO_THICKNESS}", f"healing.params.th0_s={_th}"]
+                                  + EFFECTIVE, OUT / f"spinup-H20-eff-{_tag}.npz", 20e3)
+    EXPERIMENTS[f"B20-hthick-eff-{_tag}"] = (
+        "closed", EFFECTIVE + [f"healing.params.th0_s={_th}"] + from_spinup(f"H20-eff-{_tag}"), 20e3, 28,
+        f"20 km: effective envelope, neXtSIM healing th0 = {int(_th) // 86400} days (a diagnostic), own spin-up")
 SPINUPS["H1125-effP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + PMAX,
                          OUT / "spinup-H1125-effP.npz", 10e3)
 EXPERIMENTS["F10-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H1125-effP"), 10e3, 28,
