@@ -1537,6 +1537,14 @@ EXPERIMENTS["B20-hthick-effN"] = ("closed", EFFECTIVE + NEWICE + from_spinup("H2
 # three. 5 days: tails about 3.5, wind factor about 0.011, beta about 0.15; 1 day: the bands lock
 # between storms (the healing conflict of the nominal criterion): wind factor about 0.006, beta
 # about 0.08, the rate x0.3.
+# Result (12:25 UTC): not a lever, and the prediction for 1 day was wrong: the bands do not lock.
+# th0 = 5 days: beta 0.224, tails 5.33 / 4.56, half-shear area 13.4 %, R2 0.54, rate 0.025 per day,
+# wind factor 0.0124. th0 = 1 day: beta 0.212, tails 5.16 / 3.49, 11.5 %, R2 0.57, rate 0.024 per
+# day, wind factor 0.0120 (the effective criterion alone: 0.192, 4.29 / 4.25, 0.024, 0.0132). With
+# 1-day healing the broken share falls (area above damage 0.9 at day 28: 0.47 against 0.68), but
+# the 5 % of the interior that deforms fastest stays at damage 0.983-0.986 in days 8-10, as without
+# it: a band that heals is broken again at once, since its damage grows on the elastic time scale
+# (td = dx/cs, 40 s at 20 km) and any load exceeds its healed cohesion C (1 - d).
 for _tag, _th in (("th5d", "432000"), ("th1d", "86400")):
     SPINUPS[f"H20-eff-{_tag}"] = ([f"initial.thickness_m={HETERO_THICKNESS}", f"healing.params.th0_s={_th}"]
                                   + EFFECTIVE, OUT / f"spinup-H20-eff-{_tag}.npz", 20e3)
