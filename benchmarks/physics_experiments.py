@@ -1537,7 +1537,7 @@ EXPERIMENTS["B20-hthick-effN"] = ("closed", EFFECTIVE + NEWICE + from_spinup("H2
 # three. 5 days: tails about 3.5, wind factor about 0.011, beta about 0.15; 1 day: the bands lock
 # between storms (the healing conflict of the nominal criterion): wind factor about 0.006, beta
 # about 0.08, the rate x0.3.
-# Result (12:25 UTC): not a lever, and the prediction for 1 day was wrong: the bands do not lock.
+# Result (12:23 UTC): not a lever, and the prediction for 1 day was wrong: the bands do not lock.
 # th0 = 5 days: beta 0.224, tails 5.33 / 4.56, half-shear area 13.4 %, R2 0.54, rate 0.025 per day,
 # wind factor 0.0124. th0 = 1 day: beta 0.212, tails 5.16 / 3.49, 11.5 %, R2 0.57, rate 0.024 per
 # day, wind factor 0.0120 (the effective criterion alone: 0.192, 4.29 / 4.25, 0.024, 0.0132). With
