@@ -88,6 +88,16 @@ class MaxwellEBParams:
             strength of an element are C (1 − d) and the friction μ is kept: broken ice holds by
             friction alone, as a fault does. Explicit CPU stepper and implicit solver, with the
             local damage (no ``damage_nonlocal_radius_m``)
+        crack_closure: False (Dansereau et al. 2016, neXtSIM; the default): damage lowers the
+            modulus for every strain. True (a diagnostic of lagice, 2026-11-28; docs/physics.md §4,
+            "Broken ice whose cracks close"): quasi-unilateral damage (Ladevèze and Lemaitre 1984,
+            "Damage effective stress in quasi unilateral conditions", 16th ICTAM; Mazars 1986): the
+            cracks of damaged ice close under compression, so the mean normal stress of an
+            element whose mean stress is compressive changes with the undamaged modulus E0
+            exp(−c*(1 − A)) (the concentration factor kept, so an open lead closes freely), and
+            with the damaged one where it is tensile; the deviator keeps the damaged modulus.
+            Only with ``relax_mean_stress`` false (the mean stress must not creep away as it is
+            built); explicit CPU stepper only
     """
 
     poisson: float = 0.3
@@ -110,6 +120,7 @@ class MaxwellEBParams:
     dilatancy_angle_deg: float | None = None
     damage_nonlocal_radius_m: float | None = None
     failure_stress: str = "nominal"
+    crack_closure: bool = False
 
     def __post_init__(self):
         check_range("poisson (ν)", self.poisson, 0.0, 0.5, high_open=True)
@@ -157,6 +168,12 @@ class MaxwellEBParams:
             raise ConfigError(f"rheology.failure_stress = {self.failure_stress!r} is implemented with the local "
                               f"damage only; it is set with damage_nonlocal_radius_m = "
                               f"{self.damage_nonlocal_radius_m!r} m")
+        if not isinstance(self.crack_closure, bool):
+            raise ConfigError(f"rheology.crack_closure = {self.crack_closure!r}: expected true or false")
+        if self.crack_closure and self.relax_mean_stress:
+            raise ConfigError("rheology.crack_closure = true needs rheology.relax_mean_stress = false: the closed "
+                              "cracks build the mean stress with the undamaged modulus, and a relaxing mean stress "
+                              "would creep away as it is built")
         if self.stress_correction not in STRESS_CORRECTIONS:
             raise ConfigError(f"rheology.stress_correction = {self.stress_correction!r}: expected one of "
                               f"{list(STRESS_CORRECTIONS)}")
@@ -189,6 +206,8 @@ class MaxwellEBParams:
             out["damage_nonlocal_radius_m"] = self.damage_nonlocal_radius_m
         if self.failure_stress != "nominal":
             out["failure_stress"] = self.failure_stress
+        if self.crack_closure:
+            out["crack_closure"] = True
         return out
 
     @property

@@ -64,7 +64,7 @@ def test_element_kernel_damage_matches_rheology(kernel, theta):
     kc, kt = envelope_factors(rheo)
     e_dt, gam = np.zeros(m), np.ones(m)
     kernel(tri, zeros3, zeros3, np.zeros((1, 2)), s2, d2, conc_factor, coh, kc, kt, td, heal, e_dt, gam, None,
-           None, theta, None, None, 7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0,
+           None, theta, None, None, None, 7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0,
            p.relaxation_time_s, p.alpha, flag)
     assert (dc < 1).sum() > 100
     if theta is not None:  # the path differs from the origin's where the correction acted
@@ -112,7 +112,7 @@ def test_element_kernel_stress_update_uses_rheology_moduli(kernel):
         kc, kt = envelope_factors(rheo)
         E, lam = rheo.moduli(damage, conc)
         kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, conc_factor, np.full(m, 1e15), kc, kt,
-               np.full(m, 20.0), np.zeros(m), dt_s * E, lam / (lam + dt_s), None, None, None, None, None, dt_s,
+               np.full(m, 20.0), np.zeros(m), dt_s * E, lam / (lam + dt_s), None, None, None, None, None, None, dt_s,
                *rheo.K[0, :2],
                rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, float(alpha),
                np.zeros(m, np.int8))
@@ -150,7 +150,7 @@ def test_effective_failure_stress(kernel):
     def run(eff, cohesion, sigma, damage):
         sg, dm, flag = sigma.copy(), damage.copy(), np.zeros(m, np.int8)
         kernel(tri, zeros3, zeros3, np.zeros((1, 2)), sg, dm, np.ones(m), cohesion, kc, kt, np.full(m, 20.0),
-               np.zeros(m), np.zeros(m), np.ones(m), None, None, None, None, eff, 7.0, *rheo.K[0, :2], rheo.K[2, 2],
+               np.zeros(m), np.zeros(m), np.ones(m), None, None, None, None, eff, None, 7.0, *rheo.K[0, :2], rheo.K[2, 2],
                rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
         return sg, dm, flag
 
@@ -185,6 +185,84 @@ def test_effective_failure_stress(kernel):
         MaxwellEB(failure_stress="plastic")
 
 
+@pytest.mark.parametrize("kernel", [element_stress_damage_kernel_serial, element_stress_damage_kernel_a4])
+def test_crack_closure_builds_the_mean_stress_of_compressed_broken_ice_with_the_undamaged_modulus(kernel):
+    """``rheology.crack_closure`` (quasi-unilateral damage, with ``relax_mean_stress`` false): one
+    sub-step of a uniform strain rate on a real mesh, no damage event (huge cohesion, no healing),
+    no relaxation (γ = 1). (1) Converging from σ = 0, broken ice (d = 0.99) builds the mean stress
+    m = Δt_s E0 g tr(ε̇)/(2(1 − ν)) of intact ice (g the concentration factor), where the damaged
+    modulus gives 1 − d of it; its deviator keeps the damaged modulus. (2) Diverging from a
+    compressed state, the mean unloads with the undamaged modulus down to 0, and the rest of the
+    step's opening adds tension with the damaged one. (3) A tensile element that converges takes
+    the damaged modulus down to 0 and the undamaged one beyond. (4) Intact ice is unchanged to
+    round-off. (5) Refusals: without relax_mean_stress false, and by the CUDA stepper and the
+    implicit solver, naming the key."""
+    from lagice.fem import shape_gradients
+
+    poly, _ = rectangle_domain(40e3, 40e3)
+    mesh = generate_mesh(poly, 8e3)
+    m = mesh.n_elements
+    b, c, _ = shape_gradients(mesh.nodes, mesh.triangles)
+    tri = mesh.triangles.astype(np.int32)
+    rheo = MaxwellEB(relax_mean_stress=False, crack_closure=True)
+    p = rheo.params
+    kc, kt = envelope_factors(rheo)
+    dt_s = 5.0
+    g = np.full(m, 0.8)
+    d = np.full(m, 0.99)
+    d[: m // 4] = 0.0  # a quarter intact
+    E, lam = rheo.moduli(d, np.full(m, 1.0 + np.log(0.8) / p.concentration_c))
+    assert np.allclose(E, p.E0 * (1.0 - d) * g, rtol=1e-12)
+    kb = 0.5 * (rheo.K[0, 0] + rheo.K[0, 1])  # 1/(2(1 − ν))
+
+    def run(closure, rate, sigma0, shear=0.0):
+        """One sub-step under the velocity field u = rate·x (+ a simple shear)."""
+        vel = rate * mesh.nodes + shear * np.column_stack([mesh.nodes[:, 1], 0.0 * mesh.nodes[:, 0]])
+        sg, dm, flag = sigma0.copy(), d.copy(), np.zeros(m, np.int8)
+        kernel(tri, b, c, vel, sg, dm, g, np.full(m, 1e15), kc, kt, np.full(m, 20.0), np.zeros(m), dt_s * E,
+               np.ones(m), None, True, None, None, None, closure, dt_s, *rheo.K[0, :2], rheo.K[2, 2], rheo.q,
+               rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
+        assert np.array_equal(dm, d) and not flag.any()
+        return sg
+
+    broken = d > 0
+    mean = lambda s: 0.5 * (s[:, 0] + s[:, 1])  # noqa: E731
+    dev = lambda s: np.column_stack([0.5 * (s[:, 0] - s[:, 1]), s[:, 2]])  # noqa: E731
+    intact_mean = dt_s * p.E0 * g * kb * (2 * -1e-7)  # tr(ε̇) = −2e-7 s-1
+    # (1) convergence from rest
+    zero = np.zeros((m, 3))
+    on, off = run(True, -1e-7, zero, shear=3e-8), run(None, -1e-7, zero, shear=3e-8)
+    assert np.allclose(mean(on)[broken], intact_mean[broken], rtol=1e-12)
+    assert np.allclose(mean(off)[broken], (1.0 - d[broken]) * intact_mean[broken], rtol=1e-12)
+    assert np.allclose(dev(on), dev(off), rtol=0, atol=1e-12 * np.abs(dev(off)).max())
+    assert np.abs(dev(off)[broken]).max() > 0
+    # (4) intact ice: the same to round-off
+    assert np.allclose(on[~broken], off[~broken], rtol=1e-13, atol=1e-13 * np.abs(off).max())
+    # (2) divergence from a compressed state: unload with E0 g to 0, then open with E0 (1 − d) g
+    p0 = 0.25 * np.abs(intact_mean)  # the step's undamaged unloading (|intact_mean|) overshoots it 4×
+    sig_c = np.column_stack([-p0, -p0, np.zeros(m)])
+    on = run(True, 1e-7, sig_c)
+    expect = (1.0 - d) * (np.abs(intact_mean) - p0)
+    assert np.allclose(mean(on)[broken], expect[broken], rtol=1e-10)
+    assert np.all(mean(on)[broken] > 0)
+    off = run(None, 1e-7, sig_c)
+    assert np.allclose(mean(off)[broken], (-p0 + (1.0 - d) * np.abs(intact_mean))[broken], rtol=1e-10)
+    # (3) convergence from tension: the damaged modulus to 0, the undamaged beyond
+    t0 = 0.5 * (1.0 - d) * np.abs(intact_mean)  # half the step's damaged increment
+    sig_t = np.column_stack([t0, t0, np.zeros(m)])
+    on = run(True, -1e-7, sig_t)
+    expect = -(np.abs(intact_mean) - t0 / (1.0 - d))
+    assert np.allclose(mean(on)[broken], expect[broken], rtol=1e-10)
+    # (5) refusals
+    with pytest.raises(ConfigError, match="crack_closure = true needs rheology.relax_mean_stress = false"):
+        MaxwellEB(crack_closure=True)
+    with pytest.raises(ConfigError, match="crack_closure"):
+        rheo.require_stepper("explicit_cuda")
+    with pytest.raises(ConfigError, match=r"implicit solver .* does not implement"):  # names its first term
+        rheo.require_stepper("implicit")
+    rheo.require_stepper("explicit")
+
+
 def test_alpha4_builds_equal_general_builds():
     """The α = 4 builds (λ = λ0 x³ compiled in) give bit for bit what the general kernel
     gives with α = 4 (stress, damage, flags and the refreshed moduli), on a sub-step where
@@ -211,7 +289,7 @@ def test_alpha4_builds_equal_general_builds():
         sigma, d, flag = sigma0.copy(), damage0.copy(), np.zeros(m, np.int8)
         e_dt, gam = dt_s * E, lam / (lam + dt_s)
         capped = kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, np.full(m, 0.9),
-                        coh, kc, kt, np.full(m, 30.0), np.full(m, 1e-6), e_dt, gam, None, None, None, None, None, dt_s,
+                        coh, kc, kt, np.full(m, 30.0), np.full(m, 1e-6), e_dt, gam, None, None, None, None, None, None, dt_s,
                         *rheo.K[0, :2],
                         rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
         out.append((sigma, d, flag, capped, e_dt, gam))

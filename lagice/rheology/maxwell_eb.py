@@ -270,7 +270,7 @@ CORRECTION_PATHS = {"implicit": STRESS_CORRECTIONS, "explicit": ("origin", "mean
 #: stepper that does not list it, so no stepper silently runs without it
 OPTIONAL_TERMS = {"implicit": ("failure_stress",),
                   "explicit": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg",
-                               "damage_nonlocal_radius_m", "failure_stress"),
+                               "damage_nonlocal_radius_m", "failure_stress", "crack_closure"),
                   "explicit_cuda": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg"), "prescribed": ()}
 STEPPER_LABELS = {"implicit": "the implicit solver (solver.name = 'implicit')",
                   "prescribed": "the prescribed-velocity stepper (solver.name = 'prescribed', no damage update)",

@@ -73,6 +73,9 @@ SCHEMA = {
         # the stress the failure envelope judges: "nominal" (Dansereau et al. 2016) or "effective",
         # σ/(1 − d): cohesion C (1 − d), friction kept (MaxwellEBParams.failure_stress)
         "failure_stress": (str, "nominal"),
+        # quasi-unilateral damage: the mean stress of compressed ice changes with the undamaged
+        # modulus (MaxwellEBParams.crack_closure; needs relax_mean_stress = false)
+        "crack_closure": (bool, False),
         "p_star": (NUM, 27.5e3), "c_star": (NUM, 20.0), "ellipse": (NUM, 2.0), "delta_min": (NUM, 2e-9),
         "replacement_pressure": (bool, False),
         # strength law (lagice.strength; issue 12): "uniform" = cohesion_min/max_pa,
@@ -126,7 +129,7 @@ RHEOLOGY_KEYS = {
                    "alpha", "cohesion_min_pa", "cohesion_max_pa", "healing_time_s", "concentration_c",
                    "max_damage", "stress_correction", "stress_correction_mean_fraction", "max_pressure_pa",
                    "max_pressure_thickness_exponent", "relax_mean_stress",
-                   "dilatancy_angle_deg", "damage_nonlocal_radius_m", "failure_stress"),
+                   "dilatancy_angle_deg", "damage_nonlocal_radius_m", "failure_stress", "crack_closure"),
     "viscous_plastic": ("p_star", "c_star", "ellipse", "delta_min", "replacement_pressure", "rho_ice"),
 }
 
@@ -162,6 +165,7 @@ LEGACY_VALUES = {
     "rheology.dilatancy_angle_deg": (None, 0, 0.0),   # 2026-11-27: the viscous flow does not dilate
     "rheology.damage_nonlocal_radius_m": (None, 0, 0.0),  # 2026-11-28: local damage
     "rheology.failure_stress": ("nominal",),         # 2026-11-28: the envelope judges the nominal stress
+    "rheology.crack_closure": (False,),              # 2026-11-28: damage lowers the modulus for every strain
     "thermo.new_ice_undamaged": (False,),            # 2026-11-27: new ice takes the element's damage
     "initial.state_file": (None, ""),                # 2026-11-24: no spin-up state
     "solver.substep_limit": (None, "mesh"),          # 2026-11-25: the whole-mesh limit

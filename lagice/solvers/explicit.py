@@ -201,7 +201,7 @@ _ALPHA_IS_4 = False
 
 
 def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion, kc, kt,
-                           td, heal_rate, e_dt, gamma, pmax, keep_mean, theta, dilat, eff, dt_s, kxx, kxy, kss, q,
+                           td, heal_rate, e_dt, gamma, pmax, keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, q,
                            denom, max_damage, E0, lambda0, alpha, damaged_flag):
     """Maxwell stress update and damage/healing of one sub-step, in place (module doc, step 2).
 
@@ -239,6 +239,11 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     judges σ with the element's cohesion C. True (``"effective"``): it judges the effective
     stress σ/(1 − d), i.e. σ against the envelope of cohesion C (1 − d) (the friction is
     kept), d the damage at the start of the sub-step.
+    closure: None (rheology.crack_closure false, the default; pruned as pmax is). True: only with
+    keep_mean (params refuse the rest), quasi-unilateral damage: the mean normal stress m changes
+    with the undamaged Δt_s E0 exp(−c*(1−A)) where m ≤ 0 (the cracks closed) and with the
+    damaged e_dt where m ≥ 0; a sub-step that crosses m = 0 takes each modulus for its part of
+    the volumetric strain. Intact ice (d = 0) is unchanged.
     Returns the number of elements whose damage hit the cap.
     """
     m = tri.shape[0]
@@ -265,6 +270,22 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
             axx = sigma[e, 0] + ed * (kxx * exx + kxy * eyy)
             ayy = sigma[e, 1] + ed * (kxy * exx + kxx * eyy)
             am = 0.5 * (axx + ayy)
+            if closure is not None:  # pruned when None, as pmax is
+                # the mean m0 + Δm, Δm = ed kb tr(ε̇), with the undamaged ed0 wherever m ≤ 0
+                # (closed cracks), the damaged ed where m ≥ 0, split where the step crosses 0
+                m0 = 0.5 * (sigma[e, 0] + sigma[e, 1])
+                ed0 = dt_s * E0 * conc_factor[e]
+                if m0 < 0.0:
+                    mc = m0 + (ed0 / ed) * (am - m0)
+                    if mc > 0.0:
+                        mc *= ed / ed0
+                elif am < 0.0:
+                    mc = am * (ed0 / ed)
+                else:
+                    mc = am
+                axx += mc - am
+                ayy += mc - am
+                am = mc
             gm = 1.0 if pmax is None else gp
             sxx = (axx - am) * g + am * gm
             syy = (ayy - am) * g + am * gm
@@ -437,7 +458,7 @@ PARALLEL_MIN_ELEMENTS = PARALLEL_MIN_SIZE
 @njit(cache=True, error_model="numpy")
 def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
                       c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat,
-                      eff, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+                      eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
     """All ``n_sub`` sub-steps of one outer step in compiled code (one call per outer
     step, no Python per sub-step): the node kernel then the element kernel, serial
     builds; the same calls as a Python loop over the kernels, bit-identical results."""
@@ -447,14 +468,14 @@ def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t,
                                     (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel_serial(
             tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta,
-            dilat, eff, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
 
 @njit(cache=True, error_model="numpy")
 def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
                       c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat,
-                      eff, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+                      eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
     """:func:`substeps_serial` with the parallel kernel builds (one fork/join per
     kernel and sub-step, launched from compiled code)."""
     n_capped = 0
@@ -463,7 +484,7 @@ def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_
                              (k + 1) / n_sub)
         n_capped += element_stress_damage_kernel(
             tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta,
-            dilat, eff, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
     return n_capped
 
 
@@ -730,7 +751,7 @@ class ExplicitSolver:
     def _profiled_substeps(self, par, n_sub, args):
         """The sub-step loop in Python with each kernel timed (``profile_kernels``)."""
         (vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b, c, damage, conc_factor,
-         coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat, eff, dt_s, kxx, kxy, kss, q, denom,
+         coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom,
          max_damage, E0, lambda0, alpha, flag) = args
         node_k = node_velocity_kernel if par else node_velocity_kernel_serial
         elem_k = element_kernels(alpha)[int(par)]
@@ -741,7 +762,7 @@ class ExplicitSolver:
             node_k(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, (k + 1) / n_sub)
             tb = time.perf_counter()
             n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma,
-                               pmax, keep_mean, theta, dilat, eff, dt_s, kxx, kxy, kss, q, denom, max_damage, E0,
+                               pmax, keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0,
                                lambda0, alpha, flag)
             tc = time.perf_counter()
             tn += tb - ta
@@ -783,6 +804,7 @@ class ExplicitSolver:
         theta = None if p.stress_correction == "origin" else float(p.mean_fraction)
         dilat = p.dilatancy_factor  # None: off
         eff = None if p.failure_stress == "nominal" else True
+        closure = True if p.crack_closure else None
         heal = (self.heal_rate(state, t_s) if self.heal_rate is not None
                 else self.rheology.constant_heal_rate(mesh.n_elements))
         heal = np.ascontiguousarray(heal, np.float64)
@@ -802,7 +824,7 @@ class ExplicitSolver:
         ptr32, elems32, tri32 = self._indices(mesh)
         args = (vel, vel_sum, sigma, ptr32, elems32, su.w, nc, terms.cos_turn, terms.sin_turn, ns.fixed, pres0,
                 pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, k_c, k_t, self.td, heal, e_dt, gamma, pmax,
-                keep_mean, theta, dilat, eff, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0,
+                keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0,
                 p.relaxation_time_s, float(p.alpha), flag)
         if self.kernel_choice is None or (
                 self.parallel_setting is None
