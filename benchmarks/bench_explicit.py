@@ -135,7 +135,8 @@ def element_kernel_rates(n_target: int = 50_000, reps: int = 20) -> dict:
         cohv = np.full(m, coh)
         kc, kt = envelope_factors(rheo)
         args = (tri, b, c, vel, sigma, damage, np.ones(m), cohv, kc, kt, np.full(m, 20.0),
-                np.full(m, heal), np.full(m, 4.0 * p.E0), np.full(m, 0.99), None, None, None, None, None, None, 4.0, 1.1,
+                np.full(m, heal), np.full(m, 4.0 * p.E0), np.full(m, 0.99), None, None, None, None, None, None,
+                4.0, 1.1,
                 0.3, 0.7,
                 rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), np.zeros(m, np.int8))
         kernel(*args)

@@ -686,8 +686,9 @@ def test_benchmark_runs_without_outputs_take_any_step_and_runs_with_outputs_keep
     scene's output interval ("6h"). Without outputs the writing activities are left out, so their
     schedules must not stop the build (bench_explicit was refused after the whole-step check came
     in); with outputs the builder's refusal must still name the key."""
-    from lagice.errors import ConfigError
     from scene_runs import scene_simulation
+
+    from lagice.errors import ConfigError
 
     ov = {"domain.resolution_m": 100e3, "solver.dt": 198.009, "run.duration": 2 * 198.009}
     sim = scene_simulation("wind_square", ov)

@@ -150,8 +150,8 @@ def test_effective_failure_stress(kernel):
     def run(eff, cohesion, sigma, damage):
         sg, dm, flag = sigma.copy(), damage.copy(), np.zeros(m, np.int8)
         kernel(tri, zeros3, zeros3, np.zeros((1, 2)), sg, dm, np.ones(m), cohesion, kc, kt, np.full(m, 20.0),
-               np.zeros(m), np.zeros(m), np.ones(m), None, None, None, None, eff, None, 7.0, *rheo.K[0, :2], rheo.K[2, 2],
-               rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
+               np.zeros(m), np.zeros(m), np.ones(m), None, None, None, None, eff, None, 7.0, *rheo.K[0, :2],
+               rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
         return sg, dm, flag
 
     _, d_eff, f_eff = run(True, coh, sig0, d)
@@ -289,8 +289,8 @@ def test_alpha4_builds_equal_general_builds():
         sigma, d, flag = sigma0.copy(), damage0.copy(), np.zeros(m, np.int8)
         e_dt, gam = dt_s * E, lam / (lam + dt_s)
         capped = kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, np.full(m, 0.9),
-                        coh, kc, kt, np.full(m, 30.0), np.full(m, 1e-6), e_dt, gam, None, None, None, None, None, None, dt_s,
-                        *rheo.K[0, :2],
+                        coh, kc, kt, np.full(m, 30.0), np.full(m, 1e-6), e_dt, gam, None, None, None, None, None, None,
+                        dt_s, *rheo.K[0, :2],
                         rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
         out.append((sigma, d, flag, capped, e_dt, gam))
     assert 0 < out[0][2].sum() < m  # some elements damage, some do not

@@ -201,8 +201,8 @@ _ALPHA_IS_4 = False
 
 
 def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion, kc, kt,
-                           td, heal_rate, e_dt, gamma, pmax, keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, q,
-                           denom, max_damage, E0, lambda0, alpha, damaged_flag):
+                           td, heal_rate, e_dt, gamma, pmax, keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy,
+                           kss, q, denom, max_damage, E0, lambda0, alpha, damaged_flag):
     """Maxwell stress update and damage/healing of one sub-step, in place (module doc, step 2).
 
     e_dt = Δt_s E [Pa s], gamma = λ/(λ+Δt_s) per element, refreshed here where damage
@@ -762,8 +762,8 @@ class ExplicitSolver:
             node_k(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, (k + 1) / n_sub)
             tb = time.perf_counter()
             n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma,
-                               pmax, keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0,
-                               lambda0, alpha, flag)
+                               pmax, keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom,
+                               max_damage, E0, lambda0, alpha, flag)
             tc = time.perf_counter()
             tn += tb - ta
             tm += tc - tb
