@@ -1551,6 +1551,33 @@ for _tag, _th in (("th5d", "432000"), ("th1d", "86400")):
     EXPERIMENTS[f"B20-hthick-eff-{_tag}"] = (
         "closed", EFFECTIVE + [f"healing.params.th0_s={_th}"] + from_spinup(f"H20-eff-{_tag}"), 20e3, 28,
         f"20 km: effective envelope, neXtSIM healing th0 = {int(_th) // 86400} days (a diagnostic), own spin-up")
+# Broken ice whose cracks close (rheology.crack_closure, new: quasi-unilateral damage, Ladeveze and
+# Lemaitre 1984) with the effective criterion, stated 2026-11-28 12:28 UTC before its runs. The
+# healing screens above show that a loaded band stays broken whatever its healing: what would lock
+# it must act on the load. With the effective envelope a band holds nothing, and neXtSIM's
+# compressive term (effP) could not help, since broken ice has no stiffness left to build a
+# pressure with. With closed cracks, the mean stress of compressed broken ice builds with the
+# undamaged modulus (the concentration factor kept, so an open lead closes freely), it does not
+# creep below neXtSIM's P_max (relax_mean_stress = false with PMAX: ridging above it), and it
+# opens freely; the deviator keeps the damaged modulus. So the broken network becomes a cavitating
+# fluid with a pressure cap (Flato and Hibler 1992) between elastic-brittle floes: bands slide
+# freely in shear and resist convergence up to P_max. A 20 km screen (closed basin, validation
+# month, its own 20 km spin-up with all the changes), against the effective criterion alone at 20
+# km (2 bands inside, beta 0.192, wind factor 0.0132). A lead for the 10 km months if it puts at
+# least 3 bands inside with beta in 0.14-0.23. Beside it, a diagnostic without P_max (no ridging:
+# the pressure of closed cracks is bounded by nothing but the envelope), not a candidate.
+# Predicted: with P_max, the floes slow (wind factor 0.008-0.011), beta 0.12-0.18, the rate
+# 0.01-0.02 per day, the tails still light (above 3): 2 bands inside, not a lead; without P_max
+# the pack locks (wind factor below 0.004, rate below 0.005 per day).
+CLOSURE = ["rheology.crack_closure=true"] + KEEPMEAN
+SPINUPS["H20-effCP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + CLOSURE + PMAX,
+                        OUT / "spinup-H20-effCP.npz", 20e3)
+EXPERIMENTS["B20-hthick-effCP"] = ("closed", EFFECTIVE + CLOSURE + PMAX + from_spinup("H20-effCP"), 20e3, 28,
+                                   "20 km: effective envelope, cracks close, neXtSIM's P_max, own spin-up")
+SPINUPS["H20-effC"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + CLOSURE,
+                       OUT / "spinup-H20-effC.npz", 20e3)
+EXPERIMENTS["B20-hthick-effC"] = ("closed", EFFECTIVE + CLOSURE + from_spinup("H20-effC"), 20e3, 28,
+                                  "20 km: effective envelope, cracks close, no P_max (a diagnostic), own spin-up")
 SPINUPS["H1125-effP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + PMAX,
                          OUT / "spinup-H1125-effP.npz", 10e3)
 EXPERIMENTS["F10-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H1125-effP"), 10e3, 28,
