@@ -1569,7 +1569,7 @@ for _tag, _th in (("th5d", "432000"), ("th1d", "86400")):
 # Predicted: with P_max, the floes slow (wind factor 0.008-0.011), beta 0.12-0.18, the rate
 # 0.01-0.02 per day, the tails still light (above 3): 2 bands inside, not a lead; without P_max
 # the pack locks (wind factor below 0.004, rate below 0.005 per day).
-# Result (12:38 UTC): not a lead (2 bands inside: the |divergence| tail, 2.63, and the rate, 0.0166 per
+# Result (12:32 UTC): not a lead (2 bands inside: the |divergence| tail, 2.63, and the rate, 0.0166 per
 # day). beta 0.152 (inside the widened band, outside the observed one), shear tail 4.34, half-shear
 # area 13.8 %, R2 0.18. The prediction was wrong on the drift: the floes do not slow, they stop (wind
 # factor 0.0018, drift R2 0.27; mean drift 21 km against 143), while the pack deforms in place: the
