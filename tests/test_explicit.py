@@ -263,6 +263,30 @@ def test_crack_closure_builds_the_mean_stress_of_compressed_broken_ice_with_the_
     rheo.require_stepper("explicit")
 
 
+def test_crack_closure_sets_the_substep_limit_with_the_undamaged_modulus(tmp_path):
+    """With ``crack_closure`` the mean stress of closed cracks responds with E0 exp(−c*(1−A)), so
+    a pack damaged everywhere (d = 0.9, E ten times lower) must keep the sub-steps of undamaged
+    ice; without it the count follows the damaged E_max (a third of them: sqrt(10))."""
+    import math
+
+    from lagice.stability import explicit_substep_limit
+
+    counts = {}
+    for tag, ov in (("off", {}), ("on", {"rheology.crack_closure": True, "rheology.relax_mean_stress": False})):
+        sim = scene_sim("wind_square", tmp_path / tag,
+                        {"domain.resolution_m": 25e3, "run.duration": "1h", "output.timeseries": None,
+                         "lagrangian.enabled": False, **ov})
+        sim.model.state.damage = np.full(sim.model.mesh.n_elements, 0.9)
+        sim.run(n_steps=1)
+        st = sim.model.stepper
+        counts[tag] = st.last_substeps
+        assert np.isfinite(sim.model.state.velocity).all()
+    E0 = st.rheology.params.E0
+    assert counts["on"] == math.ceil(sim.dt / (0.7 * explicit_substep_limit(st.dx_min, E0)))
+    assert counts["off"] == math.ceil(sim.dt / (0.7 * explicit_substep_limit(st.dx_min, 0.1 * E0)))
+    assert counts["on"] >= 2.5 * counts["off"]
+
+
 def test_alpha4_builds_equal_general_builds():
     """The α = 4 builds (λ = λ0 x³ compiled in) give bit for bit what the general kernel
     gives with α = 4 (stress, damage, flags and the refreshed moduli), on a sub-step where

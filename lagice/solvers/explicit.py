@@ -185,6 +185,16 @@ def _node_velocity(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, 
         vel_sum[i, 1] += vn
 
 
+def stability_modulus(params, E, concentration):
+    """The modulus [Pa] per element that sets the sub-step limit: the damaged E of the
+    Maxwell update, or with ``crack_closure`` the undamaged E0 exp(−c*(1 − A)), with which the
+    mean stress of closed cracks responds (a pack broken everywhere would otherwise get
+    sub-steps too long for that stiffness). The default path returns ``E`` itself."""
+    if not params.crack_closure:
+        return E
+    return params.E0 * np.exp(-params.concentration_c * (1.0 - np.asarray(concentration, np.float64)))
+
+
 def envelope_factors(rheology):
     """(kc, kt) [-] of the element kernel's cheap inside-the-envelope test: σc = 2C/denom and
     σT = σc/q (Dansereau et al. 2016 eqs. 4, 6) are taken as C·kc and C·kt, lowered by
@@ -778,8 +788,9 @@ class ExplicitSolver:
         mesh, p = ns.mesh, self.rheology.params
         t0 = time.perf_counter()
         E, lam = self.rheology.moduli(state.damage, state.concentration)
-        E_max = float(E.max()) if len(E) else p.E0
-        self.dx_eff = (effective_dx(self.dx_min, E_max, float((E / ns.area).max()))
+        E_stab = stability_modulus(p, E, state.concentration)
+        E_max = float(E_stab.max()) if len(E) else p.E0
+        self.dx_eff = (effective_dx(self.dx_min, E_max, float((E_stab / ns.area).max()))
                        if len(E) and self.substep_limit == "element" else self.dx_min)
         n_sub = self.substeps_for(dt, E_max)
         dt_s = dt / n_sub
