@@ -20,7 +20,9 @@
 
 A new run writes to ``runs/SCENE-YYYYmmdd-HHMMSS/`` (linked as ``runs/SCENE-latest``)
 unless ``--out`` names a folder, which must be empty (``--overwrite`` replaces a
-previous run in it, ``--resume`` continues it). SIGTERM/SIGINT stop a run cleanly
+previous run in it, ``--resume`` continues it). The process that runs into a folder holds its
+lock (``DIR/.lock``, :class:`lagice.rundir.RunLock`) until it exits: a second ``run``, ``resume``
+or ``branch`` on the folder fails at once (exit 2). SIGTERM/SIGINT stop a run cleanly
 with a checkpoint (exit 0). Errors in the input, the files or the file system print
 one line and exit with status 2 (``--log-level debug`` shows the traceback).
 """
@@ -94,7 +96,7 @@ def _where(out: Path) -> str:
 
 
 def _run(args) -> int:
-    from .rundir import claim, restart_unstarted
+    from .rundir import RunLock, claim, make_run_dir, restart_unstarted, update_latest
     from .scenes import DEFAULT_SCENE
     from .scenes.builder import build_simulation, resume_simulation, validate_config
     from .scenes.config import load_scene
@@ -105,18 +107,24 @@ def _run(args) -> int:
     out = Path(args.out) if args.out else None
     if args.resume and out is None:
         raise LagiceError("--resume needs --out DIR (the run folder to continue)")
-    if out is not None and args.resume and (out / "checkpoints").is_dir() and any(
-            (out / "checkpoints").glob("checkpoint_*.npz")):
-        return _continue(resume_simulation(out, config=cfg), out, resumed=True)
-    if out is not None and args.resume:  # no checkpoint: start it (afresh, if it was stopped before one)
-        restart_unstarted(out, cfg)
-    elif out is not None:
-        claim(out, overwrite=args.overwrite)
-    sim = build_simulation(cfg, out)
-    log.info(f"running scene {cfg['scene']['name']!r} ({cfg['scene']['source']}) -> {_where(sim.out_dir)}/")
-    if out is None:
-        log.info(f"(also reachable as {sim.out_dir.parent / (cfg['scene']['name'] + '-latest')}/)")
-    return _continue(sim, sim.out_dir)
+    default = out is None
+    if default:  # a new runs/SCENE-YYYYmmdd-HHMMSS, made here (and removed again if the run cannot start)
+        out = make_run_dir(cfg["scene"]["name"])
+    # the run folder is this process's until it exits: a second process on it fails here, at once
+    with RunLock(out, created=default):
+        if args.resume and (out / "checkpoints").is_dir() and any((out / "checkpoints").glob("checkpoint_*.npz")):
+            return _continue(resume_simulation(out, config=cfg), out, resumed=True)
+        if args.resume:  # no checkpoint: start it (afresh, if it was stopped before one)
+            restart_unstarted(out, cfg)
+        elif not default:
+            claim(out, overwrite=args.overwrite)
+        sim = build_simulation(cfg, out)
+        log.info(f"running scene {cfg['scene']['name']!r} ({cfg['scene']['source']}) -> {_where(sim.out_dir)}/")
+        if default:
+            link = update_latest(out, cfg["scene"]["name"])
+            if link is not None:
+                log.info(f"(also reachable as {link}/)")
+        return _continue(sim, sim.out_dir)
 
 
 def _continue(sim, run_dir: Path, resumed: bool = False) -> int:
@@ -156,7 +164,7 @@ def _report(res, sim):
 
 def _resume(args) -> int:
     from .errors import RestartError
-    from .rundir import MARKER
+    from .rundir import MARKER, RunLock
     from .scenes.builder import resume_simulation
     from .simulation import load_checkpoint, run_folder_of
 
@@ -169,21 +177,52 @@ def _resume(args) -> int:
         scene = info.get("source") or info.get("scene") or "SCENE"
         raise RestartError(f"no checkpoint in {d}: its run stopped before its first checkpoint; start it again "
                            f"there with: lagice run {scene} --out {d} --resume")
-    path = load_checkpoint(args.checkpoint)[0]
-    run_dir = run_folder_of(path)
-    sim = resume_simulation(path, args.set)
-    return _continue(sim, run_dir, resumed=True)
+    folder = _resume_folder(d)
+    if folder is None:  # no such file or folder: load_checkpoint says what is wrong
+        load_checkpoint(args.checkpoint)
+        raise RestartError(f"{d}: not a checkpoint, checkpoint folder or run folder")
+    with RunLock(folder):  # the run folder is this process's until it exits
+        path = load_checkpoint(args.checkpoint)[0]
+        run_dir = run_folder_of(path)
+        if run_dir.resolve() != folder.resolve():  # pragma: no cover - _resume_folder follows load_checkpoint
+            raise RestartError(f"{d}: its checkpoint {path} is not in the run folder {folder}")
+        sim = resume_simulation(path, args.set)
+        return _continue(sim, run_dir, resumed=True)
+
+
+def _resume_folder(d: Path) -> Path | None:
+    """The run folder ``lagice resume d`` writes (as :func:`lagice.simulation.load_checkpoint`
+    finds the checkpoint: a file, a checkpoint folder or a run folder), without reading a
+    checkpoint; None when ``d`` does not exist."""
+    from .simulation import run_folder_of
+
+    if d.is_file():
+        return run_folder_of(d)
+    if not d.is_dir():
+        return None
+    if (d / "checkpoints").is_dir() and not list(d.glob("checkpoint_*.npz")):
+        return d  # a run folder
+    return run_folder_of(d / "checkpoint")
 
 
 def _branch(args) -> int:
-    from .scenes.builder import branch_simulation
+    from .rundir import RunLock, make_run_dir, update_latest
+    from .scenes.builder import branch_config, branch_simulation
+    from .simulation import load_checkpoint
 
-    sim = branch_simulation(args.checkpoint, args.out, args.set, overwrite=args.overwrite)
-    p = sim.branched_from
-    log.info(f"branching {sim.model.config['scene']['name']!r} from {p['checkpoint']} (step "
-             f"{sim.model.clock.iteration}, day {sim.model.clock.time_s / 86400:.3f}, sha256 {p['sha256'][:12]}...) "
-             f"-> {_where(sim.out_dir)}/")
-    return _continue(sim, sim.out_dir)
+    path, _, meta = load_checkpoint(args.checkpoint)
+    cfg = branch_config(path, meta, args.set)  # every check that needs no mesh and no folder
+    default = args.out is None
+    out = make_run_dir(cfg["scene"]["name"]) if default else Path(args.out)
+    with RunLock(out, created=default):  # the new run's folder is this process's until it exits
+        sim = branch_simulation(path, out, config=cfg, overwrite=args.overwrite)
+        p = sim.branched_from
+        log.info(f"branching {sim.model.config['scene']['name']!r} from {p['checkpoint']} (step "
+                 f"{sim.model.clock.iteration}, day {sim.model.clock.time_s / 86400:.3f}, sha256 "
+                 f"{p['sha256'][:12]}...) -> {_where(sim.out_dir)}/")
+        if default:
+            update_latest(out, cfg["scene"]["name"])
+        return _continue(sim, sim.out_dir)
 
 
 def _plot(args) -> int:

@@ -30,6 +30,10 @@ class OutputError(LagiceError):
     """An output or checkpoint file could not be written (disk full, read-only folder)."""
 
 
+class RunFolderLocked(LagiceError):
+    """Another process holds the lock of a run folder (or the folder cannot be locked)."""
+
+
 class SolverError(LagiceError):
     """A time step could not be completed (divergence, NaN, inverted element)."""
 

@@ -13,21 +13,33 @@
 * :func:`restart_unstarted`: ``lagice run SCENE --out DIR --resume`` on a folder whose
   run (same scene, same physics settings: its marker says so) was stopped before its
   first checkpoint starts that run afresh there; any other content is refused.
+* :class:`RunLock`: the process that writes a run into a folder holds an exclusive
+  advisory lock (``flock``) on ``DIR/.lock`` for the whole run; a second process on the
+  same folder (``lagice run --out``, ``--resume``, ``lagice resume``, ``lagice branch
+  --out``, an ensemble member) fails at once (:class:`~lagice.errors.RunFolderLocked`,
+  naming the holder's pid, host and start time) before it reads or writes anything
+  there. The kernel drops the lock when its process ends, also on a crash or SIGKILL, so
+  a ``.lock`` file left behind never blocks a later run: the lock decides, not the file.
 """
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
 import logging
 import os
 import shutil
+import socket
 import sys
+import time
 from datetime import UTC, datetime
 from pathlib import Path
 
-from .errors import ConfigError, OutputError
+from .errors import ConfigError, OutputError, RunFolderLocked
 
 MARKER = "lagice_run.json"
+#: the run-folder lock file (:class:`RunLock`): ``flock``-ed by the process writing the run
+LOCK = ".lock"
 #: what marks a folder as a lagice run folder (besides the marker)
 RUN_ENTRIES = ("snapshots", "checkpoints", "summary.json", "timeseries.nc")
 #: what a run writes into its folder besides RUN_ENTRIES and the marker (``{scene}``: the scene name)
@@ -85,8 +97,9 @@ def settings_fingerprint(config: dict) -> str:
 
 
 def is_empty(path) -> bool:
+    """Absent, or a folder that holds nothing but the lock file :data:`LOCK`."""
     p = Path(path)
-    return not p.exists() or (p.is_dir() and not any(p.iterdir()))
+    return not p.exists() or (p.is_dir() and not any(c.name != LOCK for c in p.iterdir()))
 
 
 def claim(out, overwrite: bool = False) -> Path:
@@ -104,7 +117,7 @@ def claim(out, overwrite: bool = False) -> Path:
     if not is_run_dir(out):
         raise ConfigError(f"output folder {out} is not empty and is not a lagice run folder (no {MARKER}, "
                           f"snapshots/ or checkpoints/); refusing to delete it with --overwrite")
-    clear_folder(out)
+    clear_folder(out, keep=(LOCK,))
     log.info(f"cleared {out}/ (--overwrite)")
     return out
 
@@ -149,7 +162,7 @@ def restart_unstarted(out, config: dict) -> Path:
     if info["fingerprint"] != fp:
         raise ConfigError(f"--resume: output folder {out} holds a run of {scene!r} with other physics settings "
                           f"(fingerprint {info['fingerprint']}, these settings {fp}) and no checkpoint; {how}")
-    known = {MARKER, *RUN_ENTRIES, *(o.format(scene=scene) for o in RUN_OUTPUTS)}
+    known = {MARKER, LOCK, *RUN_ENTRIES, *(o.format(scene=scene) for o in RUN_OUTPUTS)}
     for child in sorted(out.iterdir()):
         if child.name not in known and not child.name.endswith(".tmp"):
             raise ConfigError(f"--resume: output folder {out} holds {child.name}, which a run does not write; "
@@ -157,7 +170,7 @@ def restart_unstarted(out, config: dict) -> Path:
     ck = out / "checkpoints"
     if ck.is_dir() and any(ck.glob("checkpoint_*.npz")):  # the caller resumes these
         raise ConfigError(f"--resume: output folder {out} holds checkpoints: resume them")
-    clear_folder(out, why="--resume")
+    clear_folder(out, keep=(LOCK,), why="--resume")
     log.info(f"{out}/ holds this run of {scene!r} stopped before its first checkpoint: starting it afresh there "
              f"(its partial outputs are replaced)")
     return out
@@ -212,11 +225,13 @@ def discard(out, remove_folder: bool) -> None:
     """Undo :func:`prepare` for a new run that failed before it started (a check that
     needed the mesh): remove what was written in ``out`` (it was empty), and ``out``
     itself when ``remove_folder`` (it did not exist), so that the corrected command can
-    use the same folder. Failures to remove are reported, not raised (the first error matters)."""
+    use the same folder. The lock file :data:`LOCK` stays for the process that holds it
+    (:meth:`RunLock.release` removes it with the folder it made). Failures to remove are
+    reported, not raised (the first error matters)."""
     out = Path(out)
     try:
-        clear_folder(out, why="removing the folder of the failed run")
-        if remove_folder:
+        clear_folder(out, keep=(LOCK,), why="removing the folder of the failed run")
+        if remove_folder and not any(out.iterdir()):
             out.rmdir()
     except (OSError, OutputError) as exc:
         log.warning(f"could not remove {out} after the failed start: {exc}")
@@ -254,3 +269,191 @@ def clear_folder(folder: Path, keep: tuple[str, ...] = (), why: str = "--overwri
                 child.unlink()
         except OSError as exc:
             raise OutputError(f"{why}: cannot remove {child}: {exc.strerror}") from None
+
+
+def make_run_dir(scene: str, root="runs") -> Path:
+    """A new, empty default run folder ``root/SCENE-YYYYmmdd-HHMMSS`` (:func:`new_run_dir`),
+    created here: two processes started in the same second get two folders."""
+    for _ in range(100):
+        p = new_run_dir(scene, root)
+        try:
+            p.mkdir(parents=True)
+        except FileExistsError:
+            continue  # taken between the look and the mkdir: the next suffix
+        except OSError as exc:
+            raise OutputError(f"cannot create the output folder {p}: {exc.strerror}") from None
+        return p
+    raise OutputError(f"cannot create a new run folder for {scene!r} in {root}/ (every name was taken)")
+
+
+class RunLock:
+    """The exclusive advisory lock of the run folder ``folder``: ``flock`` on
+    ``folder/.lock`` (:data:`LOCK`), which holds the holder's pid, host, start time and
+    command as one line of JSON while it runs (empty once it is done).
+
+    :meth:`acquire` (or ``with RunLock(folder):``) creates the folder when it is absent
+    and fails at once, with :class:`~lagice.errors.RunFolderLocked` naming the folder and
+    the holder, when another process holds the lock; or when the file system cannot lock
+    (lagice does not run unlocked). The kernel drops the lock when its process ends, so a
+    ``.lock`` file left by a killed run never blocks a later one. The lock file stays in
+    a run folder, emptied, when the lock is released; when no run was started in the
+    folder (a command refused after taking the lock, a new run that failed its checks on
+    the mesh), :meth:`release` removes the lock file it made, and the folder when it made
+    that too (``created``) and it is empty, so no trace is left and the corrected command
+    can use the folder. A ``.lock`` in a folder that is not a run folder and holds other
+    files is not lagice's: it is refused (ConfigError), not overwritten.
+
+    One lock per run folder and process: a second ``RunLock`` on the same folder in the
+    same process is refused like another process's (``flock`` locks open files)."""
+
+    def __init__(self, folder, created: bool = False):
+        self.folder = Path(folder)
+        self.path = self.folder / LOCK
+        self.created = created
+        self._made_file = False
+        self._fd = None
+
+    def __enter__(self):
+        return self.acquire()
+
+    def __exit__(self, *exc):
+        self.release()
+        return False
+
+    @property
+    def held(self) -> bool:
+        return self._fd is not None
+
+    def acquire(self) -> RunLock:
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover - not a POSIX system
+            raise RunFolderLocked(f"cannot lock the run folder {self.folder}: this system has no flock (fcntl); "
+                                  f"lagice does not write a run folder unlocked") from None
+        folder = self.folder
+        if folder.exists() and not folder.is_dir():
+            raise ConfigError(f"output folder {folder} exists and is not a folder")
+        if not folder.exists():
+            try:
+                folder.mkdir(parents=True)
+                self.created = True
+            except FileExistsError:
+                pass  # made by another process just now: the lock decides
+            except OSError as exc:
+                raise OutputError(f"cannot create the output folder {folder}: {exc.strerror}") from None
+        for _ in range(10):
+            try:
+                fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o644)
+                self._made_file = True
+            except FileExistsError:
+                fd = None
+                if not is_run_dir(folder) and not is_empty(folder):  # not a lock of lagice's: leave it alone
+                    raise ConfigError(f"output folder {folder} holds a {LOCK} file and other files but is not a "
+                                      f"lagice run folder (no {MARKER}, snapshots/ or checkpoints/); refusing to "
+                                      f"take {self.path} as its run lock: choose another --out") from None
+            except OSError as exc:
+                fd = -1
+                err = exc
+            if fd is None:  # an earlier run's lock file (held or not: the lock decides)
+                try:
+                    fd = os.open(self.path, os.O_RDWR | os.O_CLOEXEC)
+                except FileNotFoundError:
+                    continue  # removed just now by its holder's release: make it again
+                except OSError as exc:
+                    fd = -1
+                    err = exc
+            if fd == -1:
+                if self.created:
+                    try:
+                        folder.rmdir()
+                    except OSError:
+                        pass
+                raise OutputError(f"cannot write in the output folder {folder}: {err.strerror}") from None
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = _lock_holder(fd)
+                os.close(fd)
+                raise RunFolderLocked(
+                    f"run folder {folder} is in use by another lagice process ({holder}); wait for it to finish, "
+                    f"or stop it (SIGTERM: it writes a checkpoint), then run this command again") from None
+            except OSError as exc:
+                os.close(fd)
+                self._tidy()
+                raise RunFolderLocked(
+                    f"cannot lock the run folder {folder}: flock on {self.path} failed ({exc.strerror}; errno "
+                    f"{errno.errorcode.get(exc.errno, exc.errno)}), so the file system does not support file locks; "
+                    f"lagice does not write a run folder unlocked (another process could write the same folder): "
+                    f"use a folder on a file system with locks (a local disk, NFS with locking)") from None
+            try:  # the file this lock holds is still the folder's lock file (not removed by a release meanwhile)
+                same = os.stat(self.path).st_ino == os.fstat(fd).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
+            os.close(fd)
+        else:  # pragma: no cover - the lock file was replaced ten times in a row
+            raise RunFolderLocked(f"cannot lock the run folder {folder}: its lock file {self.path} keeps changing")
+        info = {"pid": os.getpid(), "host": socket.gethostname(),
+                "started": datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
+                "command": " ".join(sys.argv) if sys.argv and sys.argv[0] else None}
+        try:
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, (json.dumps(info) + "\n").encode(), 0)
+        except OSError as exc:
+            fcntl.flock(fd, fcntl.LOCK_UN)
+            os.close(fd)
+            raise OutputError(f"cannot write in the output folder {folder}: {exc.strerror}") from None
+        self._fd = fd
+        return self
+
+    def release(self) -> None:
+        """Give the lock up: the lock file is emptied (or removed, with the folder this lock
+        made when nothing else is in it), then unlocked. Never raises."""
+        if self._fd is None:
+            return
+        import fcntl
+
+        fd, self._fd = self._fd, None
+        try:
+            if not self._tidy():
+                os.ftruncate(fd, 0)
+        except OSError:
+            pass
+        finally:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_UN)
+            finally:
+                os.close(fd)
+
+    def _tidy(self) -> bool:
+        """When no run was started in the folder (it is not a run folder: a start that was
+        refused, or that failed its checks on the mesh) and this lock made the lock file,
+        remove that file, and the folder when this lock made it and nothing else is in it;
+        True when it did."""
+        if not self._made_file:
+            return False
+        try:
+            if is_run_dir(self.folder):
+                return False
+            self.path.unlink(missing_ok=True)
+            if self.created and not any(self.folder.iterdir()):
+                self.folder.rmdir()
+        except OSError:
+            return False
+        return True
+
+
+def _lock_holder(fd) -> str:
+    """'pid P on host H, since T' of the lock file ``fd`` (its holder writes it
+    just after it takes the lock: read again for a moment when it is still empty)."""
+    for _ in range(20):
+        try:
+            raw = os.pread(fd, 4096, 0)
+            info = json.loads(raw.decode()) if raw.strip() else None
+        except (OSError, ValueError, UnicodeDecodeError):
+            info = None
+        if isinstance(info, dict):  # its command is in the file too (often long: not in the one-line error)
+            return f"pid {info.get('pid')} on host {info.get('host')}, since {info.get('started')}"
+        time.sleep(0.025)
+    return "its pid, host and start time are not in the lock file yet"

@@ -488,6 +488,33 @@ def test_a_second_ensemble_on_the_same_folder_is_refused(ensemble_run, tmp_path)
     assert list(s["status"].values) == ["done", "done", "done", "failed"] and not lock.exists()
 
 
+def test_a_member_folder_another_process_writes_is_left_alone(tmp_path):
+    """A member holds the lock of its run folder (lagice.rundir.RunLock) while it runs: when
+    another process holds it (a `lagice resume` of the member folder), the member fails at
+    once, naming the folder and that process, and writes nothing there; the next run of the
+    ensemble continues it."""
+    spec = spec_dict(members={"a": {"rheology.friction": 0.6}}, common={**COMMON, "run.duration": "20min"})
+    out = tmp_path / "out"
+    assert list(Ensemble(spec, out).run(serial=True, plot=False)["status"].values) == ["done"]
+    mdir = out / "members" / "a"
+    longer = spec_dict(members={"a": {"rheology.friction": 0.6}}, common={**COMMON, "run.duration": "40min"})
+    holder = subprocess.Popen([sys.executable, "-c", "import sys; from lagice.rundir import RunLock; "
+                               "RunLock(sys.argv[1]).acquire(); print('held', flush=True); sys.stdin.read()",
+                               str(mdir)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        before = {q: q.stat().st_mtime_ns for q in mdir.rglob("*")}
+        s = Ensemble(longer, out).run(serial=True, plot=False)
+        assert list(s["status"].values) == ["failed"]
+        err = str(s["error"].sel(member="a").values)
+        assert f"run folder {mdir} is in use by another lagice process (pid {holder.pid} on host" in err, err
+        assert {q: q.stat().st_mtime_ns for q in mdir.rglob("*")} == before, "the member wrote into the folder"
+    finally:
+        holder.communicate(input="", timeout=60)
+    s = Ensemble(longer, out).run(serial=True, plot=False)
+    assert list(s["status"].values) == ["done"] and int(s["steps"].sel(member="a")) == 60
+
+
 def test_gmsh_start_keeps_the_sigterm_handler():
     """gmsh's first initialisation resets SIGTERM to the default action at the C level;
     lagice.mesh.generate puts the Python handler back (else a clean stop on SIGTERM

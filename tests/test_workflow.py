@@ -187,6 +187,174 @@ def test_default_folders_never_collide_and_latest_follows(tmp_path):
     assert (link / "snapshots" / "index.json").exists()
 
 
+# -- 1b. one process per run folder: the run-folder lock ----------------------------------
+HOLD_HOOK = """
+import os, pathlib, time
+from lagice.io.timeseries import diagnostic
+
+@diagnostic("1", "hold (the run waits at step HOLD_AT until the file GO exists)")
+def hold(model):
+    if model.clock.iteration == int(os.environ.get("HOLD_AT", "-1")):
+        pathlib.Path(os.environ["SENTINEL"]).touch()
+        go = pathlib.Path(os.environ["GO"])
+        t0 = time.time()
+        while not go.exists() and time.time() - t0 < 300:
+            time.sleep(0.02)
+    return 0.0
+"""
+HELD = ['output.timeseries.every="1 steps"', 'output.timeseries.diagnostics=["holdhook:hold"]']
+
+
+def _held_run(tmp_path, out, sets, hold_at):
+    """``lagice run shear_box --out out`` as a background process, held at step ``hold_at``
+    (until ``tmp_path/go`` exists) once it has written its first outputs; returns the
+    process and the environment of its hook."""
+    (tmp_path / "holdhook.py").write_text(HOLD_HOOK)
+    env = {"PYTHONPATH": f"{tmp_path}{os.pathsep}{os.environ.get('PYTHONPATH', '')}",
+           "SENTINEL": str(tmp_path / "held"), "GO": str(tmp_path / "go"), "HOLD_AT": str(hold_at)}
+    cmd = [sys.executable, "-m", "lagice.cli", "run", "shear_box", "--out", str(out)]
+    for s in sets:
+        cmd += ["--set", s]
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**os.environ, **env})
+    t0 = time.time()
+    while not (tmp_path / "held").exists():
+        assert p.poll() is None, p.communicate()
+        assert time.time() - t0 < 180, "the run did not reach its hold step"
+        time.sleep(0.02)
+    return p, env
+
+
+def _tree(folder):
+    """Every file under ``folder`` with its size and modification time."""
+    return {str(q.relative_to(folder)): (q.stat().st_size, q.stat().st_mtime_ns) for q in sorted(folder.rglob("*"))}
+
+
+def assert_same_snapshot(a_dir, b_dir):
+    a, ia = last_snapshot(a_dir)
+    b, ib = last_snapshot(b_dir)
+    assert ia[-1]["step"] == ib[-1]["step"] and set(STATE_VARS) <= set(a.variables)
+    for v in a.variables:
+        assert np.array_equal(a[v].values, b[v].values), f"{v} differs"
+
+
+def test_a_second_process_on_a_running_run_folder_fails_at_once(tmp_path):
+    """The process that runs a simulation into a folder holds its lock (DIR/.lock, flock) for
+    the whole run: a new run, --overwrite, --resume, `lagice resume` and `lagice branch --out`
+    on that folder each fail at once (exit 2, one line naming the folder and the holder's pid,
+    host and start time) and touch nothing; the held run then finishes as a straight run does."""
+    import socket
+
+    sets = [*QUICK, "checkpoint.every=80.0"]
+    ref = tmp_path / "ref"
+    r = run_cli("run", "shear_box", "--out", ref, sets=sets)
+    assert r.returncode == 0, r.stderr[-3000:]
+    out = tmp_path / "run"
+    p, env = _held_run(tmp_path, out, [*sets, *HELD], hold_at=3)
+    try:
+        holder = json.loads((out / ".lock").read_text())
+        assert holder["pid"] == p.pid and holder["host"] == socket.gethostname() and holder["started"]
+        assert list(out.glob("checkpoints/checkpoint_*.npz")), "held after its first checkpoint"
+        before = _tree(out)
+        parent = sorted((ref / "checkpoints").glob("checkpoint_*.npz"))[0]
+        for args in (["run", "shear_box", "--out", out], ["run", "shear_box", "--out", out, "--overwrite"],
+                     ["run", "shear_box", "--out", out, "--resume"], ["resume", out],
+                     ["branch", parent, "--out", out, "--overwrite"]):
+            t0 = time.time()
+            r = run_cli(*args, sets=[*sets, *HELD] if args[0] == "run" else (), env=env)
+            took = time.time() - t0
+            one_line_error(r, f"run folder {out} is in use by another lagice process", f"pid {p.pid}",
+                           f"host {holder['host']}", f"since {holder['started']}")
+            assert took < 60, f"{args}: {took:.0f} s"
+            assert _tree(out) == before, f"{args} touched the folder of the running run"
+    finally:
+        (tmp_path / "go").touch()
+        stdout, stderr = p.communicate(timeout=300)
+    assert p.returncode == 0, stderr[-3000:]
+    assert json.loads((out / "summary.json").read_text())["finished"]
+    assert_same_snapshot(ref, out)
+    assert (out / ".lock").read_text() == "", "released: the lock file stays, empty"
+
+
+def test_a_lock_left_by_a_killed_run_does_not_block_its_resume(tmp_path):
+    """SIGKILL leaves DIR/.lock (with the dead process's pid) behind; the kernel dropped its
+    lock, so `lagice resume` and `lagice run --resume` take it and continue the run bit for bit."""
+    sets = [*QUICK, "checkpoint.every=200.0"]
+    ref = tmp_path / "ref"
+    assert run_cli("run", "shear_box", "--out", ref, sets=sets).returncode == 0
+    for how in ("resume", "run --resume"):
+        out = tmp_path / how.replace(" ", "")
+        for f in ("held", "go"):
+            (tmp_path / f).unlink(missing_ok=True)
+        p, env = _held_run(tmp_path, out, [*sets, *HELD], hold_at=12)
+        p.kill()
+        p.communicate(timeout=60)
+        assert json.loads((out / ".lock").read_text())["pid"] == p.pid, "the killed run's lock file is left"
+        env.pop("HOLD_AT")
+        if how == "resume":
+            r = run_cli("resume", out, env=env)
+        else:
+            r = run_cli("run", "shear_box", "--out", out, "--resume", sets=[*sets, *HELD], env=env)
+        assert r.returncode == 0, r.stderr[-3000:]
+        assert "resuming" in r.stdout and "checkpoint_0000000010" in r.stdout, r.stdout
+        assert json.loads((out / "summary.json").read_text())["finished"]
+        assert_same_snapshot(ref, out)
+        assert (out / ".lock").read_text() == ""
+
+
+def test_run_lock_in_one_process(tmp_path):
+    """flock locks an open file: a second lock of the same folder is refused in the same
+    process too; a released lock is taken again; a lock that made its folder removes it
+    again when nothing else was written (a run that failed its checks on the mesh), and
+    leaves no lock file in a folder where no run started."""
+    from lagice.errors import ConfigError, RunFolderLocked
+    from lagice.rundir import LOCK, RunLock, claim, is_empty
+
+    out = tmp_path / "new" / "run"
+    with RunLock(out) as lock:
+        assert lock.held and lock.created and (out / LOCK).exists() and is_empty(out)
+        with pytest.raises(RunFolderLocked, match=rf"run folder {out} is in use .*pid {os.getpid()} on host "):
+            RunLock(out).acquire()
+    assert not out.exists(), "the lock made the folder and nothing else was written: removed"
+    with RunLock(out):
+        (out / "lagice_run.json").write_text("{}")
+    assert (out / LOCK).read_text() == "" and (out / "lagice_run.json").exists(), "kept, the lock file emptied"
+    with RunLock(out):  # taken again
+        pass
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(ConfigError, match="exists and is not a folder"):
+        RunLock(tmp_path / "file").acquire()
+    # a folder that is not a run folder: a refused start leaves no trace; a .lock of its own is not taken over
+    notes = tmp_path / "notes"
+    notes.mkdir()
+    (notes / "thesis.tex").write_text("precious")
+    with RunLock(notes), pytest.raises(ConfigError, match="not empty"):
+        claim(notes)
+    assert sorted(q.name for q in notes.iterdir()) == ["thesis.tex"]
+    (notes / LOCK).write_text("another tool's lock")
+    with pytest.raises(ConfigError, match=rf"holds a {LOCK} file and other files but is not a lagice run folder"):
+        RunLock(notes).acquire()
+    assert (notes / LOCK).read_text() == "another tool's lock"
+
+
+def test_a_file_system_without_flock_is_refused_not_run_unlocked(tmp_path, monkeypatch):
+    """No file system here lacks flock: flock is made to fail as it does there (EOPNOTSUPP /
+    ENOLCK) to show the message; the run does not go on unlocked."""
+    import errno
+    import fcntl
+
+    from lagice.errors import RunFolderLocked
+    from lagice.rundir import RunLock
+
+    def no_flock(fd, op):
+        raise OSError(errno.ENOLCK, os.strerror(errno.ENOLCK))
+
+    monkeypatch.setattr(fcntl, "flock", no_flock)
+    out = tmp_path / "run"
+    with pytest.raises(RunFolderLocked, match=rf"cannot lock the run folder {out}: .*does not support file locks"):
+        RunLock(out).acquire()
+    assert not out.exists()
+
+
 # -- 2. extend and branch ------------------------------------------------------------
 @pytest.mark.slow
 def test_extend_is_bit_identical_and_bookkeeping_is_whole_run(base_run, tmp_path):
@@ -433,6 +601,124 @@ def test_keys_of_the_other_rheology_law(tmp_path):
     assert r.returncode == 0, r.stderr[-2000:]
     warned = [ln for ln in r.stderr.splitlines() if "ignores these Maxwell-EB keys" in ln]
     assert len(warned) == 1 and "rheology.friction = 0.9" in warned[0], r.stderr
+
+
+def test_keys_of_components_that_are_off_are_named_once_and_change_nothing(tmp_path):
+    """Keys that only a component that is off (or another kind) reads, set away from their
+    defaults, are named in one warning (key, value, why) and the run goes on: the same result
+    as without them. A scene file carries such keys legitimately when a --set switches their
+    component off (the EVP comparison, tests that switch remeshing off)."""
+    sets = [*QUICK, "healing.law=none"]
+    plain = tmp_path / "plain"
+    assert run_cli("run", "shear_box", "--out", plain, sets=sets).returncode == 0
+    out = tmp_path / "run"
+    r = run_cli("run", "shear_box", "--out", out,
+                sets=[*sets, "remesh.min_angle_deg=25.0", "lagrangian.max_halvings=4", "rheology.healing_time_s=2e5",
+                      'domain.file="data_stubs/winter_basin_coast.geojson"'])
+    assert r.returncode == 0, r.stderr[-2000:]
+    warned = [ln for ln in r.stderr.splitlines() if "ignores these keys of the scene" in ln]
+    assert len(warned) == 1 and warned[0].startswith("lagice: warning: this run ignores these keys of the scene: "), \
+        r.stderr
+    for part in ("remesh.min_angle_deg = 25.0 (remeshing is off: remesh.enabled = false)",
+                 "lagrangian.max_halvings = 4 (the mesh does not move: lagrangian.enabled = false)",
+                 "rheology.healing_time_s = 200000.0 (healing.law = 'none': no healing)",
+                 "domain.file = 'data_stubs/winter_basin_coast.geojson' (domain.kind = 'rectangle'; it is a key of "
+                 "kind 'file')"):
+        assert part in warned[0], (part, warned[0])
+    assert_same_snapshot(plain, out)
+    assert "ignores these keys" not in run_cli("run", "shear_box", "--out", tmp_path / "p2", sets=QUICK).stderr
+
+
+@pytest.mark.parametrize("scene,override,expected", [
+    ("shear_box", {"lagrangian.min_area_ratio": 0.1},
+     [("lagrangian.min_area_ratio", 0.1, "the mesh does not move: lagrangian.enabled = false")]),
+    ("winter_basin_pack", {"rheology.healing_time_s": 2e5},
+     [("rheology.healing_time_s", 2e5, "healing.law = 'nextsim' sets the healing rate; healing_time_s is the "
+                                       "constant law's")]),
+    ("winter_basin_pack", {"rheology.cohesion_max_pa": 6e4},
+     [("rheology.cohesion_max_pa", 6e4, "rheology.strength_law = 'scaled' gives the cohesion")]),
+    ("winter_basin", {"initial.cohesion_pa": 3e4},  # its cohesion_min/max_pa (10 and 20 kPa) are not drawn
+     [("rheology.cohesion_min_pa", 10e3, "initial.cohesion_pa = 30000.0 gives the cohesion"),
+      ("rheology.cohesion_max_pa", 20e3, "initial.cohesion_pa = 30000.0 gives the cohesion")]),
+    ("shear_box", {"rheology.max_pressure_thickness_exponent": 2.0},
+     [("rheology.max_pressure_thickness_exponent", 2.0, "no compressive term: rheology.max_pressure_pa is not set")]),
+    ("shear_box", {"rheology.max_pressure_thickness_exponent": 2.0, "rheology.max_pressure_pa": 1e4,
+                   "solver.name": "explicit"}, []),
+    ("winter_basin", {"domain.kind": "rectangle", "domain.width_m": 500e3, "domain.height_m": 500e3},
+     [("domain.file", "data_stubs/winter_basin_coast.geojson", "domain.kind = 'rectangle'; it is a key of kind "
+                                                               "'file'")]),
+    ("wind_square", {"domain.kind": "polygon", "domain.vertices": [[0, 0], [4e5, 0], [0, 4e5]]},
+     [("domain.width_m", 500e3, "domain.kind = 'polygon'; it is a key of kind 'rectangle'"),
+      ("domain.height_m", 500e3, "domain.kind = 'polygon'; it is a key of kind 'rectangle'")]),
+    ("shear_channel", {"domain.kind": "rectangle", "domain.width_m": 200e3, "domain.height_m": 200e3},
+     [("domain.function", "lagice.scenes.hooks.shear_channel:annulus", "domain.kind = 'rectangle'; it is a key "
+                                                                        "of kind 'function'"),
+      ("domain.params", {"radius_m": 100e3, "inner_radius_m": 30e3, "vertex_spacing_m": 10e3},
+       "domain.kind = 'rectangle'; it is a key of kind 'function'")]),
+    ("shear_box", {"forcing.grid_spacing_m": 10e3, "forcing.wind": {"kind": "expression", "u": 5.0}},
+     [("forcing.grid_spacing_m", 10e3, "no [forcing.*] table has a kind drawn on the forcing grid; expression, "
+                                       "function, file, constant and rest are not")]),
+    ("shear_box", {"forcing.grid_spacing_m": 10e3, "forcing.wind": {"kind": "uniform"}}, []),
+    ("shear_box", {"forcing.drag": {"water_drag": 4e-3}},
+     [("forcing.drag.water_drag", 4e-3, "no external forces: no [forcing.wind], [forcing.ocean] or "
+                                        "[forcing.coriolis]")]),
+    ("winter_basin_pack", {"forcing.wind": None, "forcing.drag": {"air_drag": 2e-3, "coriolis_f": 1e-4}},
+     [("forcing.drag.air_drag", 2e-3, "no wind stress: no [forcing.wind]"),
+      ("forcing.drag.coriolis_f", 1e-4, "[forcing.coriolis] sets the Coriolis parameter")]),
+    ("winter_basin", {"thermo.enabled": False, "healing.law": "constant"},
+     [("forcing.air_temperature", {"kind": "synthetic", "start_day_of_year": 15.0},
+       "nothing reads it: thermo.enabled = false, and healing.law = 'constant' is not one of the laws that do, "
+       "'thermodynamic', 'fdd', 'nextsim'")]),
+    ("winter_basin", {"thermo.enabled": False}, []),  # thermodynamic healing reads the air temperature
+])
+def test_unused_keys_of_each_component_and_kind(scene, override, expected, caplog, monkeypatch):
+    from lagice.scenes import builder
+    from lagice.scenes.builder import unused_keys, validate_config
+    from lagice.scenes.config import load_scene
+
+    cfg = load_scene(scene, {"run.duration": "1h", **override})
+    assert unused_keys(cfg) == expected
+    monkeypatch.setattr(builder, "_LOGGED_UNUSED", set())  # what earlier tests in this process logged
+    caplog.clear()
+    validate_config(cfg)
+    validate_config(cfg)  # the checks run twice per run (CLI, builder): one warning
+    warned = [r.getMessage() for r in caplog.records if "ignores these keys of the scene" in r.getMessage()]
+    assert len(warned) == (1 if expected else 0), warned
+
+
+def test_cpu_threading_on_the_gpu_is_named():
+    from lagice.scenes.builder import unused_keys
+    from lagice.scenes.config import load_scene
+
+    cfg = load_scene("wind_square", {"solver.name": "explicit", "solver.device": "cuda", "solver.parallel": True})
+    assert unused_keys(cfg) == [("solver.parallel", True, "solver.device = 'cuda': the CPU kernels' threading does "
+                                                         "not apply on the GPU")]
+    cfg = load_scene("wind_square", {"solver.name": "explicit", "solver.device": "cuda", "solver.parallel": "auto"})
+    assert unused_keys(cfg) == []
+
+
+def test_no_bundled_scene_or_ensemble_member_sets_an_unused_key():
+    from lagice.ensemble import Ensemble, load_spec
+    from lagice.scenes.builder import unused_keys
+    from lagice.scenes.config import list_scenes, load_scene
+
+    for name in list_scenes():
+        assert unused_keys(load_scene(name)) == [], name
+    for spec in sorted((ROOT / "examples" / "ensembles").glob("*.toml")):
+        for m in Ensemble(load_spec(spec), ROOT / "runs" / "never-made").members:
+            assert unused_keys(m.config) == [], (spec.name, m.id)
+
+
+def test_a_refused_setting_leaves_no_run_folder(tmp_path):
+    """A key that can never be read is refused (exit 2) before the run folder (and its lock)
+    is made, so the corrected command may use the same --out."""
+    out = tmp_path / "run"
+    one_line_error(run_cli("run", "shear_box", "--out", out, sets=[*QUICK, "remesh.params.rings=2"]),
+                   "remesh.params is set but remesh.enabled = false")
+    assert not out.exists()
+    r = run_cli("run", "shear_box", "--out", out, "--resume", sets=[*QUICK, "thermo.params.new_ice_thickness_m=0.2"])
+    one_line_error(r, "thermo.params is set but thermo.enabled = false")
+    assert not out.exists()
 
 
 @pytest.mark.parametrize("expr,fragments", [

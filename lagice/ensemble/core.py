@@ -41,6 +41,7 @@ class Ensemble:
         self.out_dir = Path(out_dir) if out_dir is not None else Path("runs") / self.spec.name
         self.last_run = {}
         self.stopped = None  # why the last run stopped early (a signal, DIR/STOP), else None
+        self._lock_failed = {}  # records of the last run's members that could not lock their run folder
 
     @classmethod
     def from_file(cls, path, out_dir=None, overrides=None) -> Ensemble:
@@ -160,6 +161,7 @@ class Ensemble:
 
     def _run_locked(self, old, client, workers, scheduler, serial, retry_failed, plot):
         self.stopped = None
+        self._lock_failed = {}
         self._write_ensemble_json(old)
         plan = self.plan(retry_failed)
         todo = [m for m in self.members if plan[m.id] in ("new", "resume", "retry")]
@@ -200,6 +202,7 @@ class Ensemble:
                 break
             prog.started(m.id)
             rec = run_member(self._task(m))  # in the main thread: the member's own SIGTERM/SIGINT clean stop
+            self._note_lock_failed(rec)
             prog.finished(rec)
             if rec["status"] == "stopped":
                 self.stopped = self.stopped or str(rec.get("error"))
@@ -265,6 +268,7 @@ class Ensemble:
                     write_json(mdir / "failed.json", rec)
                 else:
                     rec = f.result()
+                    self._note_lock_failed(rec)
                 prog.finished(rec)
             interrupted = False
         finally:
@@ -274,6 +278,12 @@ class Ensemble:
                 own_client.close()
             if own_cluster is not None:
                 own_cluster.close()
+
+    def _note_lock_failed(self, rec: dict) -> None:
+        """A member that could not lock its run folder (another process holds the lock) wrote
+        nothing there: its record of this run goes into the summary from here."""
+        if rec.get("lock_failed"):
+            self._lock_failed[rec["member"]] = rec
 
     # -- summary ----------------------------------------------------------------------------
     def records(self) -> list[dict]:
@@ -298,6 +308,8 @@ class Ensemble:
                 if info.get("status") == "stopped":
                     rec = {k: info.get(k) for k in ("member", "status", "error", "overrides", "resumed_from",
                                                     "wall_s", "cpu_s", "numba_threads")}
+            if m.id in self._lock_failed:  # this run could not lock its folder (another process writes it)
+                rec = {k: v for k, v in self._lock_failed[m.id].items() if k != "lock_failed"}
             if rec is None:
                 rec = {"member": m.id, "status": "not_run", "overrides": m.overrides,
                        "error": "not finished (interrupted or not started)"}

@@ -278,6 +278,24 @@ def _run_member(task: dict) -> dict:
     state = member_state(mdir, task["config_hash"])
     if state == "done":  # finished by an earlier run: nothing to do
         return json.loads((mdir / "done.json").read_text())
+    from ..errors import LagiceError
+    from ..rundir import RunLock
+
+    lock = RunLock(mdir)  # the member's run folder is this worker's until the member ends (lagice.rundir)
+    try:
+        lock.acquire()
+    except LagiceError as exc:  # e.g. a `lagice resume` of the member folder runs: leave its files alone
+        return {**rec, "status": "failed", "error": f"{type(exc).__name__}: {exc}", "finished": _now(),
+                "wall_s": time.perf_counter() - t_start, "cpu_s": time.process_time() - c_start,
+                "lock_failed": True}  # nothing written into the folder: the ensemble's summary takes it
+    try:
+        return _run_member_locked(task, rec, out, mdir, state, t_start, c_start)
+    finally:
+        lock.release()
+
+
+def _run_member_locked(task: dict, rec: dict, out: Path, mdir: Path, state: str, t_start: float,
+                       c_start: float) -> dict:
     for name in ("done.json", "failed.json"):  # the record of an earlier attempt (or a shorter run)
         (mdir / name).unlink(missing_ok=True)
     from .. import __version__

@@ -19,7 +19,7 @@ from shapely.geometry import LineString, Polygon, shape
 from ..errors import ConfigError, LagiceError, check_range
 from ..mesh import generate_mesh, rectangle_domain, renumber_for_locality, rotate_mesh
 from ..model import Model
-from ..params import MaxwellEBParams
+from ..params import DragParams, MaxwellEBParams
 from ..rheology import MaxwellEB, ViscousPlastic, ViscousPlasticParams, draw_cohesion
 from ..schedule import parse_duration, parse_schedule
 from ..simulation import Simulation
@@ -275,8 +275,8 @@ def strength_law(cfg: dict):
     return law if cfg["rheology"]["law"] == "maxwell_eb" else None
 
 
-#: messages of :func:`check_other_law_keys` already logged in this process (the checks run more
-#: than once per run: the CLI, then the builder)
+#: messages of :func:`check_other_law_keys` and :func:`check_unused_keys` already logged in this
+#: process (the checks run more than once per run: the CLI, then the builder)
 _LOGGED_UNUSED: set = set()
 
 
@@ -300,6 +300,115 @@ def check_other_law_keys(rp: dict) -> None:
                           f"{'it' if len(other) == 1 else 'them'} (keys of the viscous-plastic law); remove "
                           f"{'it' if len(other) == 1 else 'them'}, or set rheology.law = 'viscous_plastic'")
     msg = f"rheology.law = {law!r} ignores these Maxwell-EB keys of the scene: {shown}"
+    if msg not in _LOGGED_UNUSED:
+        _LOGGED_UNUSED.add(msg)
+        import logging
+
+        logging.getLogger("lagice").warning(msg)
+
+
+#: keys each ``domain.kind`` reads and no other kind does (``domain.file_crs``: refused
+#: outside ``kind = "file"``, :func:`validate_config`)
+DOMAIN_KIND_KEYS = {"rectangle": ("width_m", "height_m", "x0_m", "y0_m"), "polygon": ("vertices", "islands"),
+                    "file": ("file",), "function": ("function", "params")}
+#: forcing kinds whose generators sample the forcing grid (``forcing.grid_spacing_m``)
+GRID_KINDS = {"wind": ("uniform", "random", "cyclones", "climatology"), "ocean": ("uniform", "gyre", "eddies"),
+              "air_temperature": ("synthetic",)}
+#: ``[forcing.drag]`` keys of the wind stress (read only with a ``[forcing.wind]``)
+AIR_DRAG_KEYS = ("rho_air", "air_drag")
+#: healing laws that read the air temperature (as thermodynamics does)
+AIR_HEALING_LAWS = ("thermodynamic", "fdd", "nextsim")
+
+
+def _shown(v) -> str:
+    """A value as the scene file writes it (true/false, strings quoted)."""
+    return str(v).lower() if isinstance(v, bool) else repr(v)
+
+
+def unused_keys(cfg: dict) -> list[tuple[str, object, str]]:
+    """``(key, value, why)`` of every key set away from its schema default that the run
+    does not read because its component is off or another kind is chosen: remeshing off,
+    mesh motion off, a healing law other than "constant" (``rheology.healing_time_s``), a
+    cohesion from the strength law or from ``initial.cohesion_pa`` (``cohesion_min/max_pa``),
+    no compressive term (its exponent), ``solver.parallel`` on the GPU, keys of another
+    ``domain.kind``, a forcing grid no forcing kind samples, drag without the forces it
+    belongs to, an air temperature nothing reads. Keys that are refused instead
+    (``remesh.params``, ``thermo.params``, ``healing.params``, the strength-law keys under
+    "uniform", keys of the other rheology law...) are checked where they are refused;
+    Maxwell-EB keys under the viscous-plastic law by :func:`check_other_law_keys`."""
+    out = []
+
+    def away(table: str, key: str) -> bool:
+        return cfg[table][key] != SCHEMA[table][key][1]
+
+    def add(table: str, keys, why: str) -> None:
+        out.extend((f"{table}.{k}", cfg[table][k], why) for k in keys if away(table, k))
+
+    if not cfg["remesh"]["enabled"]:  # remesh.params: refused (components.validate)
+        add("remesh", ("min_angle_deg",), "remeshing is off: remesh.enabled = false")
+    if not cfg["lagrangian"]["enabled"]:
+        add("lagrangian", ("min_area_ratio", "max_halvings"), "the mesh does not move: lagrangian.enabled = false")
+    rp = cfg["rheology"]
+    if rp["law"] == "maxwell_eb":  # under viscous_plastic: check_other_law_keys names them
+        heal = cfg["healing"]["law"]
+        if heal != "constant":
+            add("rheology", ("healing_time_s",),
+                "healing.law = 'none': no healing" if heal == "none" else
+                f"healing.law = {heal!r} sets the healing rate; healing_time_s is the constant law's")
+        coh = cfg["initial"]["cohesion_pa"]
+        if rp["strength_law"] != "uniform":
+            add("rheology", ("cohesion_min_pa", "cohesion_max_pa"),
+                f"rheology.strength_law = {rp['strength_law']!r} gives the cohesion")
+        elif coh != "random":
+            add("rheology", ("cohesion_min_pa", "cohesion_max_pa"), f"initial.cohesion_pa = {coh!r} gives the cohesion")
+        if not rp["max_pressure_pa"]:
+            add("rheology", ("max_pressure_thickness_exponent",),
+                "no compressive term: rheology.max_pressure_pa is not set")
+    sv = cfg["solver"]
+    if sv["device"] == "cuda" and sv["parallel"] not in (None, "auto"):
+        out.append(("solver.parallel", sv["parallel"], "solver.device = 'cuda': the CPU kernels' threading does not "
+                    "apply on the GPU"))
+    d = cfg["domain"]
+    if d["kind"] in DOMAIN_KIND_KEYS:
+        for kind, keys in DOMAIN_KIND_KEYS.items():
+            if kind != d["kind"]:
+                add("domain", keys, f"domain.kind = {d['kind']!r}; it is a key of kind {kind!r}")
+    fc = cfg["forcing"]
+    if not any(isinstance(fc[k], dict) and fc[k].get("kind") in kinds for k, kinds in GRID_KINDS.items()):
+        add("forcing", ("grid_spacing_m",), "no [forcing.*] table has a kind drawn on the forcing grid; expression, "
+            "function, file, constant and rest are not")
+    dflt = DragParams()  # [forcing.drag] keys at DragParams' defaults change nothing either way
+    drag = {k: v for k, v in (fc["drag"] or {}).items() if v != getattr(dflt, k, None)}
+    if drag and fc["wind"] is None and fc["ocean"] is None and fc["coriolis"] is None:
+        out.extend((f"forcing.drag.{k}", v, "no external forces: no [forcing.wind], [forcing.ocean] or "
+                    "[forcing.coriolis]") for k, v in drag.items())
+    else:
+        if fc["wind"] is None:
+            out.extend((f"forcing.drag.{k}", drag[k], "no wind stress: no [forcing.wind]") for k in AIR_DRAG_KEYS
+                       if k in drag)
+        cor = fc["coriolis"] or {}
+        if "coriolis_f" in drag and ("f_s" in cor or isinstance(cor.get("latitude_deg"), (int, float))):
+            out.append(("forcing.drag.coriolis_f", drag["coriolis_f"],
+                        "[forcing.coriolis] sets the Coriolis parameter"))
+    if (fc["air_temperature"] is not None and not cfg["thermo"]["enabled"]
+            and cfg["healing"]["law"] not in AIR_HEALING_LAWS):
+        out.append(("forcing.air_temperature", fc["air_temperature"],
+                    f"nothing reads it: thermo.enabled = false, and healing.law = {cfg['healing']['law']!r} is not "
+                    f"one of the laws that do, {', '.join(map(repr, AIR_HEALING_LAWS))}"))
+    return out
+
+
+def check_unused_keys(cfg: dict) -> None:
+    """One warning (logged once per distinct message) naming every key of :func:`unused_keys`:
+    such keys are not refused, because scene files carry them legitimately when a ``--set``
+    (or an ``extends``) switches their component off or picks another kind (the EVP comparison,
+    tests that switch remeshing off), and because a resumed run's stored configuration may hold
+    them; but nothing that is set is dropped in silence."""
+    keys = unused_keys(cfg)
+    if not keys:
+        return
+    msg = ("this run ignores these keys of the scene: "
+           + "; ".join(f"{k} = {_shown(v)} ({why})" for k, v, why in keys))
     if msg not in _LOGGED_UNUSED:
         _LOGGED_UNUSED.add(msg)
         import logging
@@ -429,6 +538,7 @@ def validate_config(cfg: dict) -> None:
                 raise ConfigError(f"drifters.positions_m[{k}] = {p!r} lies outside the domain (bounds "
                                   f"{tuple(round(b) for b in poly.bounds)} m in domain.crs)")
     components.check_forcing_files(cfg, _domain_points(poly), duration)
+    check_unused_keys(cfg)  # keys of components that are off, or of another kind: one warning
 
 
 def check_whole_steps(key: str, value, dt: float) -> None:
@@ -812,15 +922,21 @@ def _simulation(cfg: dict, out: Path, progress) -> Simulation:
 
 
 def run_scene(name_or_path, out_dir=None, overrides=None, progress=None, overwrite: bool = False) -> dict:
-    """Run a scene into a new folder (or ``out_dir``: empty, or replaced with ``overwrite``)."""
+    """Run a scene into a new folder (or ``out_dir``: empty, or replaced with ``overwrite``),
+    holding the folder's lock (:class:`lagice.rundir.RunLock`) for the whole run."""
     from .. import rundir
 
     cfg = load_scene(name_or_path, overrides)
-    if out_dir is not None:
-        validate_config(cfg)
-        rundir.claim(out_dir, overwrite)
-    sim = build_simulation(cfg, out_dir, progress)
-    return finish(sim)
+    validate_config(cfg)
+    default = out_dir is None
+    out = rundir.make_run_dir(cfg["scene"]["name"]) if default else Path(out_dir)
+    with rundir.RunLock(out, created=default):
+        if not default:
+            rundir.claim(out, overwrite)
+        sim = build_simulation(cfg, out, progress)
+        if default:
+            rundir.update_latest(out, cfg["scene"]["name"])
+        return finish(sim)
 
 
 # -- extend and branch ---------------------------------------------------------------
