@@ -1120,3 +1120,22 @@ def test_plot_draws_the_drifters_of_the_drifter_file(base_run, tmp_path, monkeyp
     for k, tr in enumerate(seen["trajectories"]):
         assert np.array_equal(tr[:, 0], d["x"].values[k]) and tr.shape == (61, 2)
     assert all(np.array_equal(a, b) for a, b in zip(seen["trajectories"], read_trajectories(run / "drifters.nc")))
+
+
+def test_coriolis_from_the_crs_is_applied_once_beside_a_drag_coriolis_f(tmp_path, caplog):
+    """``[forcing.coriolis] latitude_deg = "crs"`` with ``forcing.drag.coriolis_f`` set: the
+    Coriolis term was added twice (the table's per-node f and the drag's constant f). The table
+    decides, once, and the drag key is named as unused."""
+    import logging
+
+    from lagice.forces import Coriolis
+
+    from helpers import scene_sim
+
+    with caplog.at_level(logging.WARNING, logger="lagice"):
+        sim = scene_sim("wind_square", tmp_path / "a",
+                        {"domain.resolution_m": 100e3, "domain.crs": "EPSG:3413",
+                         "forcing.coriolis": {"latitude_deg": "crs"}, "forcing.drag.coriolis_f": 1.0e-4})
+    cor = [f for f in sim.model.forces if isinstance(f, Coriolis)]
+    assert len(cor) == 1 and cor[0].crs is not None
+    assert "forcing.drag.coriolis_f = 0.0001 ([forcing.coriolis] sets the Coriolis parameter)" in caplog.text

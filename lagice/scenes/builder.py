@@ -386,8 +386,7 @@ def unused_keys(cfg: dict) -> list[tuple[str, object, str]]:
         if fc["wind"] is None:
             out.extend((f"forcing.drag.{k}", drag[k], "no wind stress: no [forcing.wind]") for k in AIR_DRAG_KEYS
                        if k in drag)
-        cor = fc["coriolis"] or {}
-        if "coriolis_f" in drag and ("f_s" in cor or isinstance(cor.get("latitude_deg"), (int, float))):
+        if "coriolis_f" in drag and fc["coriolis"] is not None:
             out.append(("forcing.drag.coriolis_f", drag["coriolis_f"],
                         "[forcing.coriolis] sets the Coriolis parameter"))
     if (fc["air_temperature"] is not None and not cfg["thermo"]["enabled"]

@@ -596,7 +596,12 @@ def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
 
         cor = fc["coriolis"] or {}
         lat = cor.get("latitude_deg")
-        parts["forces"] = standard_forces(wind=wind, current=ocean, drag=DragParams(**(fc["drag"] or {})),
+        drag = DragParams(**(fc["drag"] or {}))
+        if fc["coriolis"] is not None:  # [forcing.coriolis] sets f; drag.coriolis_f is named as unused
+            import dataclasses
+
+            drag = dataclasses.replace(drag, coriolis_f=0.0)
+        parts["forces"] = standard_forces(wind=wind, current=ocean, drag=drag,
                                           coriolis_f=cor.get("f_s"), latitude_deg=None if lat == "crs" else lat)
         if lat == "crs":
             from ..forces import Coriolis
