@@ -1569,13 +1569,18 @@ for _tag, _th in (("th5d", "432000"), ("th1d", "86400")):
 # Predicted: with P_max, the floes slow (wind factor 0.008-0.011), beta 0.12-0.18, the rate
 # 0.01-0.02 per day, the tails still light (above 3): 2 bands inside, not a lead; without P_max
 # the pack locks (wind factor below 0.004, rate below 0.005 per day).
-# Result (12:32 UTC): not a lead (2 bands inside: the |divergence| tail, 2.63, and the rate, 0.0166 per
-# day). beta 0.152 (inside the widened band, outside the observed one), shear tail 4.34, half-shear
-# area 13.8 %, R2 0.18. The prediction was wrong on the drift: the floes do not slow, they stop (wind
-# factor 0.0018, drift R2 0.27; mean drift 21 km against 143), while the pack deforms in place: the
-# whole interior is broken (area above damage 0.5: 1.00 at days 1, 10 and 28) and the shear spreads
-# over half the basin (docs/figures/crack_closure_screen.png). Without P_max (B20-hthick-effC) the
-# pack locks, as predicted: rate 3e-5 per day, wind factor 0.0000, no remesh.
+# Result (12:32 UTC), first run: 2 bands inside, beta 0.152, rate 0.0166 per day, wind factor 0.0018,
+# with the whole interior broken. Not a valid run: the sub-step count still followed the damaged
+# E_max, while closed cracks respond with E0 (from day 14 every element was damaged, max (1-d) g
+# 0.29-0.34, so the sub-steps were up to 1.9x too long and the pack rang in place). Fixed in 8ae340a
+# (explicit.stability_modulus, with a test); the first run is kept as B20-hthick-effCP-first.
+# Result (12:40 UTC), the same rule rerun with the fix: not a lead, 0 bands inside. The pack locks:
+# rate 0.0015 per day, wind factor 0.0010 (drift R2 0.17; mean drift 12 km against 143), beta 0.078,
+# tails 4.53 / 3.12, half-shear area 15.7 %, R2 0.14; the interior stays broken (area above damage
+# 0.5: 0.97, 1.00, 0.96 at days 1, 10, 28) and its slow shear is spread, not localised
+# (docs/figures/crack_closure_screen.png). The prediction was wrong on the drift (0.008-0.011
+# predicted). Without P_max (B20-hthick-effC, stable: its pack keeps intact elements) the pack locks
+# too, as predicted: rate 3e-5 per day, wind factor 0.0000, no remesh.
 CLOSURE = ["rheology.crack_closure=true"] + KEEPMEAN
 SPINUPS["H20-effCP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + CLOSURE + PMAX,
                         OUT / "spinup-H20-effCP.npz", 20e3)
