@@ -670,6 +670,12 @@ def test_keys_of_components_that_are_off_are_named_once_and_change_nothing(tmp_p
        "nothing reads it: thermo.enabled = false, and healing.law = 'constant' is not one of the laws that do, "
        "'thermodynamic', 'fdd', 'nextsim'")]),
     ("winter_basin", {"thermo.enabled": False}, []),  # thermodynamic healing reads the air temperature
+    # the flagship switched to fewer components: its [remesh.params] and a [thermo.params] are named, not refused
+    ("winter_basin_pack", {"remesh.enabled": False},
+     [("remesh.params", {"algorithm": 5}, "remeshing is off: remesh.enabled = false")]),
+    ("winter_basin_pack", {"thermo.enabled": False, "healing.law": "constant", "forcing.air_temperature": None,
+                           "thermo.params": {"new_ice_thickness_m": 0.2}},
+     [("thermo.params", {"new_ice_thickness_m": 0.2}, "thermodynamics is off: thermo.enabled = false")]),
 ])
 def test_unused_keys_of_each_component_and_kind(scene, override, expected, caplog, monkeypatch):
     from lagice.scenes import builder
@@ -713,11 +719,11 @@ def test_a_refused_setting_leaves_no_run_folder(tmp_path):
     """A key that can never be read is refused (exit 2) before the run folder (and its lock)
     is made, so the corrected command may use the same --out."""
     out = tmp_path / "run"
-    one_line_error(run_cli("run", "shear_box", "--out", out, sets=[*QUICK, "remesh.params.rings=2"]),
-                   "remesh.params is set but remesh.enabled = false")
+    one_line_error(run_cli("run", "shear_box", "--out", out, sets=[*QUICK, "rheology.p_star=30000"]),
+                   "rheology.p_star = 30000")
     assert not out.exists()
-    r = run_cli("run", "shear_box", "--out", out, "--resume", sets=[*QUICK, "thermo.params.new_ice_thickness_m=0.2"])
-    one_line_error(r, "thermo.params is set but thermo.enabled = false")
+    r = run_cli("run", "shear_box", "--out", out, "--resume", sets=[*QUICK, "healing.params.rate=2"])
+    one_line_error(r, "healing.params is set but healing.law")
     assert not out.exists()
 
 

@@ -332,8 +332,9 @@ def unused_keys(cfg: dict) -> list[tuple[str, object, str]]:
     cohesion from the strength law or from ``initial.cohesion_pa`` (``cohesion_min/max_pa``),
     no compressive term (its exponent), ``solver.parallel`` on the GPU, keys of another
     ``domain.kind``, a forcing grid no forcing kind samples, drag without the forces it
-    belongs to, an air temperature nothing reads. Keys that are refused instead
-    (``remesh.params``, ``thermo.params``, ``healing.params``, the strength-law keys under
+    belongs to, an air temperature nothing reads, ``[remesh.params]`` and ``[thermo.params]``
+    with their component off. Keys that are refused instead
+    (``thermo.new_ice_undamaged`` without thermodynamics, ``healing.params``, the strength-law keys under
     "uniform", keys of the other rheology law...) are checked where they are refused;
     Maxwell-EB keys under the viscous-plastic law by :func:`check_other_law_keys`."""
     out = []
@@ -344,8 +345,12 @@ def unused_keys(cfg: dict) -> list[tuple[str, object, str]]:
     def add(table: str, keys, why: str) -> None:
         out.extend((f"{table}.{k}", cfg[table][k], why) for k in keys if away(table, k))
 
-    if not cfg["remesh"]["enabled"]:  # remesh.params: refused (components.validate)
+    if not cfg["remesh"]["enabled"]:
         add("remesh", ("min_angle_deg",), "remeshing is off: remesh.enabled = false")
+        if cfg["remesh"]["params"]:  # a scene's [remesh.params] with remeshing switched off by --set
+            out.append(("remesh.params", cfg["remesh"]["params"], "remeshing is off: remesh.enabled = false"))
+    if not cfg["thermo"]["enabled"] and cfg["thermo"]["params"]:
+        out.append(("thermo.params", cfg["thermo"]["params"], "thermodynamics is off: thermo.enabled = false"))
     if not cfg["lagrangian"]["enabled"]:
         add("lagrangian", ("min_area_ratio", "max_halvings"), "the mesh does not move: lagrangian.enabled = false")
     rp = cfg["rheology"]

@@ -248,8 +248,6 @@ def validate(cfg: dict, duration_s: float) -> None:
         from ..params import DragParams
 
         checks.check_dataclass_params("forcing.drag", DragParams, fc["drag"])
-    if cfg["thermo"]["params"] and not cfg["thermo"]["enabled"]:
-        raise ConfigError("thermo.params is set but thermo.enabled = false: the parameters would not be used")
     if cfg["thermo"]["new_ice_undamaged"] and not cfg["thermo"]["enabled"]:
         raise ConfigError("thermo.new_ice_undamaged = true but thermo.enabled = false: without thermodynamics no "
                           "new ice forms, so the setting would not be used")
@@ -258,8 +256,6 @@ def validate(cfg: dict, duration_s: float) -> None:
 
         checks.check_dataclass_params("thermo.params", ThermoParams, cfg["thermo"]["params"])
     _check_healing(cfg)
-    if cfg["remesh"]["params"] and not cfg["remesh"]["enabled"]:
-        raise ConfigError("remesh.params is set but remesh.enabled = false: the parameters would not be used")
     if cfg["remesh"]["enabled"]:
         _check_remesh(cfg["remesh"])
     if cfg["lagrangian"]["enabled"]:
