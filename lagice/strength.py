@@ -66,7 +66,9 @@ from .errors import ConfigError, check_range
 
 #: keys of ``[rheology]`` handled here, not by MaxwellEBParams
 RHEOLOGY_KEYS = ("strength_law", "strength_lab_pa", "strength_lab_scale_m", "strength_disorder",
-                 "strength_correlation_m", "strength_correlated_amplitude")
+                 "strength_correlation_m", "strength_correlated_amplitude", "strength_after_remesh")
+#: which elements :meth:`StrengthLaw.apply` sets after a remesh (``rheology.strength_after_remesh``)
+AFTER_REMESH = ("all", "new")
 #: random Fourier modes of the correlated strength field (the sample variance of G at a
 #: point is 1 ± O(1/sqrt(N)) over the domain)
 N_MODES = 512
@@ -131,11 +133,20 @@ class StrengthLaw:
     seed: int = 0
     correlation_m: float = 0.0
     correlated_amplitude: float | None = None
+    #: ``"all"`` (the default since 2026-11-24): after a remesh every element's C is recomputed
+    #: from its current size, so kept elements jump to the strength of the size their
+    #: Lagrangian deformation gave them; ``"new"`` (2026-11-28): only the remesh's new
+    #: elements get the law's C, and kept elements keep theirs (a material property between
+    #: its creation and its replacement; docs/physics.md §2, "Disorder and remeshing")
+    after_remesh: str = "all"
 
     def __post_init__(self):
         check_range("rheology.strength_lab_pa", self.lab_cohesion_pa, 1e4, 1e8, unit="Pa")
         check_range("rheology.strength_lab_scale_m", self.lab_scale_m, 1e-3, 10.0, unit="m")
         check_range("rheology.strength_disorder", self.disorder, 0.0, 10.0)
+        if self.after_remesh not in AFTER_REMESH:
+            raise ConfigError(f"rheology.strength_after_remesh = {self.after_remesh!r}: expected one of "
+                              f"{list(AFTER_REMESH)}")
         if self.correlation_m != 0.0:
             check_range("rheology.strength_correlation_m", self.correlation_m, 1.0e3, 1.0e7, unit="m")
             check_range("rheology.strength_correlated_amplitude", self.amplitude, 0.0, 0.95)
@@ -192,14 +203,23 @@ class StrengthLaw:
              * self.disorder_factor(node_id, triangles))
         return c if factor is None else c * factor
 
-    def apply(self, state) -> None:
-        """Set ``state.cohesion`` of every element from its current size and factors
-        (after a remesh; ``state.strength_factor`` has been remapped with the ice)."""
+    def apply(self, state, event=None) -> None:
+        """Set ``state.cohesion`` from the elements' current size and factors after a remesh
+        (``state.strength_factor`` has been remapped with the ice): of every element
+        (``after_remesh = "all"``, or without ``event``), or of the remesh ``event``'s new
+        elements only (``"new"``: those stitched after its ``kept_elements``, through its
+        ``element_perm`` when the mesh was renumbered; a global remesh keeps none)."""
         m = state.mesh
         if self.correlated and state.strength_factor is None:
             raise ConfigError("rheology.strength_correlation_m > 0 but the state carries no strength_factor")
-        state.cohesion = self.cohesion(m.nodes, m.triangles, state.node_id,
-                                       state.strength_factor if self.correlated else None)
+        c = self.cohesion(m.nodes, m.triangles, state.node_id, state.strength_factor if self.correlated else None)
+        if self.after_remesh == "all" or event is None or event.kept_elements is None:
+            state.cohesion = c
+            return
+        new = np.arange(m.n_elements) >= len(event.kept_elements)  # stitched order
+        if event.element_perm is not None:
+            new = new[event.element_perm]  # new element k is stitched element perm[k]
+        state.cohesion = np.where(new, c, state.cohesion)
 
 
 def from_config(rheology: dict, seed: int) -> StrengthLaw | None:
@@ -218,7 +238,8 @@ def from_config(rheology: dict, seed: int) -> StrengthLaw | None:
     kw = {"seed": int(seed)}
     for key, name in (("strength_lab_pa", "lab_cohesion_pa"), ("strength_lab_scale_m", "lab_scale_m"),
                       ("strength_disorder", "disorder"), ("strength_correlation_m", "correlation_m"),
-                      ("strength_correlated_amplitude", "correlated_amplitude")):
+                      ("strength_correlated_amplitude", "correlated_amplitude"),
+                      ("strength_after_remesh", "after_remesh")):
         if rheology.get(key) is not None:
             kw[name] = rheology[key]
     return StrengthLaw(**kw)

@@ -115,6 +115,51 @@ def test_after_a_remesh_every_element_carries_the_strength_of_its_size():
     assert abs(new.std() - math.sqrt(1 / 12)) < 0.04
 
 
+def test_after_a_local_remesh_kept_elements_keep_their_strength_with_after_remesh_new():
+    """``rheology.strength_after_remesh = "new"``: a local remesh of the flagship mesh (30 km,
+    stretched by 10 %, one edge collapsed) gives its new elements C = C_lab sqrt(L/Δx_e) f_e of
+    their own size, and every kept element keeps the C it had, bit for bit (through the
+    renumbering the flagship applies after a remesh), although its size changed. The default
+    ("all") recomputes the kept elements too, so some of them differ by more than 1 %."""
+    from lagice.scenes.builder import build_model
+    from lagice.scenes.config import load_scene
+
+    out = {}
+    for mode in ("new", "all"):
+        model = build_model(load_scene("winter_basin_pack", {
+            "domain.resolution_m": 30e3, "run.duration": "1h", "solver.dt": "1h",
+            **({"rheology.strength_after_remesh": mode} if mode == "new" else {})}))
+        st = model.state
+        law = from_config(model.config["rheology"], model.config["run"]["seed"])
+        assert law.after_remesh == mode
+        m = st.mesh
+        x0 = np.median(m.nodes[:, 0])
+        m.nodes[:, 0] = x0 + 1.1 * (m.nodes[:, 0] - x0)  # every element stretched by 10 % (sizes +4.9 %)
+        interior = np.setdiff1d(np.arange(m.n_nodes), np.unique(m.boundary_edges))
+        v = interior[np.argmin(np.hypot(*(m.nodes[interior] - m.nodes.mean(axis=0)).T))]
+        nb = m.triangles[np.any(m.triangles == v, axis=1)]
+        other = nb[nb != v][0]
+        m.nodes[v] = 0.97 * m.nodes[other] + 0.03 * m.nodes[v]  # one edge nearly collapsed: a local remesh
+        key = {tuple(sorted(t)): k for k, t in enumerate(st.node_id[m.triangles])}
+        before = st.cohesion.copy()
+        ev = model.component("remeshing").advance(model, 3600.0)
+        assert ev is not None and ev.kind == "local" and ev.element_perm is not None  # renumbered after it
+        nm = st.mesh
+        ids = st.node_id[nm.triangles]
+        kept = np.array([tuple(sorted(t)) in key for t in ids])
+        assert 0 < (~kept).sum() < kept.sum()
+        old = np.array([before[key[tuple(sorted(t))]] for t in ids[kept]])
+        law_c = 2.8e6 * np.sqrt(0.1 / element_size(nm.nodes, nm.triangles)) * law.disorder_factor(st.node_id,
+                                                                                                   nm.triangles)
+        np.testing.assert_allclose(st.cohesion[~kept], law_c[~kept], rtol=1e-12)
+        out[mode] = (st.cohesion[kept], old, law_c[kept])
+    c_new, old_new, _ = out["new"]
+    assert np.array_equal(c_new, old_new)
+    c_all, old_all, law_all = out["all"]
+    np.testing.assert_allclose(c_all, law_all, rtol=1e-12)
+    assert np.abs(c_all / old_all - 1.0).max() > 0.01
+
+
 def test_correlated_factor_statistics():
     """g = 1 + a(2Φ(G) − 1): uniform on [1 − a, 1 + a] with mean 1 (the mean strength is
     kept), G's correlation at lag r follows exp(−r²/(2ℓ²)) and is gone at 4ℓ, and the

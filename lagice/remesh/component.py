@@ -43,8 +43,8 @@ class Remesher:
         #: events before the checkpoint this run resumed from (:meth:`restore`)
         self.n_events_before = 0
         self.renumber = bool(renumber)
-        #: callables ``f(state)`` run after each successful remesh, after the remap (e.g.
-        #: :meth:`lagice.strength.StrengthLaw.apply`: every element gets the strength of its size)
+        #: callables ``f(state, event)`` run after each successful remesh, after the remap (e.g.
+        #: :meth:`lagice.strength.StrengthLaw.apply`: elements get the strength of their size)
         self.after_remesh = []
 
     def advance(self, model, dt_s: float):
@@ -60,7 +60,7 @@ class Remesher:
             st.counters["remesh_count"] = st.counters.get("remesh_count", 0) + 1
             st.counters["mesh_epoch"] = st.counters.get("mesh_epoch", 0) + 1
             for f in self.after_remesh:
-                f(st)
+                f(st, ev)
         return ev
 
     @property

@@ -84,6 +84,9 @@ SCHEMA = {
         "strength_disorder": (NUM, None),
         # spatially correlated strength factor g = 1 + a(2Φ(G) − 1), G correlated over ℓ (0: none)
         "strength_correlation_m": (NUM, None), "strength_correlated_amplitude": (NUM, None),
+        # which elements get the law's C after a remesh: "all" (None: the default, recomputed from
+        # their current size) or "new" (kept elements keep theirs); StrengthLaw.after_remesh
+        "strength_after_remesh": (str, None),
     },
     "solver": {
         "name": (str, "implicit"), "dt": (EXPR, None), "substeps": (int, None),
@@ -156,6 +159,7 @@ LEGACY_VALUES = {
     "rheology.strength_lab_scale_m": (None,),
     "rheology.strength_disorder": (None,),
     "rheology.strength_correlation_m": (None, 0.0, 0),  # 2026-11-26: no correlated strength field
+    "rheology.strength_after_remesh": (None, "all"),   # 2026-11-28: every element recomputed at a remesh
     "rheology.strength_correlated_amplitude": (None,),
     "rheology.stress_correction": ("origin",),       # 2026-11-24: scaling towards the origin
     "rheology.stress_correction_mean_fraction": (None,),
