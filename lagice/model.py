@@ -92,6 +92,9 @@ class Model:
         self.components = [given[name] for name in ORDER if given[name] is not None]
         self.timings = dict.fromkeys(TIMING_KEYS, 0.0)
         self.last_report = {}
+        #: (transport velocity, strain rate) of the step that ended with a remesh, on the new
+        #: mesh (:meth:`set_remeshed_transport`): the stepper dropped its own with the old mesh
+        self._remeshed_transport = None
 
     # -- the pieces ----------------------------------------------------------------
     @property
@@ -123,7 +126,18 @@ class Model:
         over the step (docs/design.md, "Which velocity moves the mesh"). Before the
         first step, the state's velocity."""
         v = self.stepper.transport_velocity
+        if v is None and self._remeshed_transport is not None and len(self._remeshed_transport[0]) == \
+                self.mesh.n_nodes:
+            return self._remeshed_transport[0]
         return self.state.velocity if v is None else v
+
+    def set_remeshed_transport(self, velocity, strain_rate) -> None:
+        """The last step's transport velocity (n, 2) [m s-1] and its strain rate (m, 3)
+        [s-1] carried onto the mesh a remesh at the end of that step made (the remeshing
+        component: kept nodes keep theirs, new nodes interpolated, as the state's velocity
+        is). Only what is read after the step sees it (outputs, the NaN check): the stepper
+        dropped its own with the old mesh, and the next step replaces both."""
+        self._remeshed_transport = (velocity, strain_rate)
 
     def needs_host_state(self, fields=None) -> IceState:
         """The state, with the fields a device stepper keeps on its device between
@@ -157,6 +171,8 @@ class Model:
     def strain_rate(self) -> np.ndarray | None:
         """(m, 3) [s-1] strain rate of the transport velocity over the last step."""
         eps = self.stepper.last_strain_rate
+        if eps is None and self._remeshed_transport is not None:
+            eps = self._remeshed_transport[1]
         if eps is not None and len(eps) != self.mesh.n_elements:
             return None
         return eps

@@ -204,3 +204,45 @@ def test_patch_with_hole_and_island_domain(rng, tmp_path):
     rc = np.hypot(*st.mesh.nodes[st.mesh.coast_nodes()].T)
     assert np.all((np.abs(rc - 100e3) < 1e-6) | (np.abs(rc - 30e3) < 1e-6))
     assert np.all(st.mesh.areas() > 0)
+
+
+def test_a_snapshot_on_a_remesh_step_has_the_steps_transport_velocity_and_rates(tmp_path):
+    """A remesh at the end of a step drops the stepper's transport velocity and strain rate
+    with the old mesh. The model carries them onto the new mesh (kept nodes keep theirs, new
+    nodes interpolated), so a snapshot written on that step has the deformation rates, and its
+    velocity is the step's transport velocity, not the state's end-of-step velocity."""
+    from lagice.fem import shape_gradients, strain_rate
+    from lagice.io.snapshots import snapshot_dataset
+
+    from helpers import scene_sim
+
+    sim = scene_sim("winter_basin_pack", tmp_path, {"domain.resolution_m": 40e3, "run.duration": "1d"})
+    sim.run(n_steps=2)
+    model = sim.model
+    tv = model.transport_velocity.copy()
+    assert not np.allclose(tv, model.state.velocity)  # the two velocities differ
+    m = model.mesh
+    ids_before = {int(i): k for k, i in enumerate(model.state.node_id)}
+    interior = np.setdiff1d(np.arange(m.n_nodes), np.unique(m.boundary_edges))
+    v = interior[np.argmin(np.hypot(*(m.nodes[interior] - m.nodes.mean(axis=0)).T))]
+    nb = m.triangles[np.any(m.triangles == v, axis=1)]
+    other = nb[nb != v][0]
+    m.nodes[v] = 0.97 * m.nodes[other] + 0.03 * m.nodes[v]  # one edge nearly collapsed
+    ev = model.component("remeshing").advance(model, sim.dt)
+    assert ev is not None and ev.kind == "local"
+    assert model.stepper.transport_velocity is None  # dropped with the old mesh
+    nm = model.mesh
+    out = model.transport_velocity
+    assert out.shape == (nm.n_nodes, 2)
+    kept = np.array([int(i) in ids_before for i in model.state.node_id])
+    assert 0 < (~kept).sum() < kept.sum()
+    old_index = np.array([ids_before[int(i)] for i in model.state.node_id[kept]])
+    assert np.array_equal(out[kept], tv[old_index])
+    b, c, _ = shape_gradients(nm.nodes, nm.triangles)
+    np.testing.assert_array_equal(model.strain_rate, strain_rate(nm.triangles, b, c, out))
+    ds = snapshot_dataset(model)
+    for name in ("divergence_rate", "shear_rate", "total_deformation_rate"):
+        assert name in ds and np.isfinite(ds[name].values).all()
+    np.testing.assert_array_equal(ds["velocity_x"].values[0], out[:, 0])
+    sim.run(n_steps=1)  # the next step replaces both
+    assert model.stepper.transport_velocity is not None and model.transport_velocity is model.stepper.transport_velocity

@@ -10,6 +10,26 @@ from .trigger import TriggerParams
 REMESH_OPTIONS = ("rings", "max_retries", "max_patch_fraction", "algorithm", "remap_method", "damage_remap")
 
 
+def remeshed_transport(old_mesh, transport, mesh, ev):
+    """The step's transport velocity on the remeshed ``mesh`` and its strain rate: kept nodes
+    keep theirs, new nodes take it interpolated in ``old_mesh`` (as the state's velocity,
+    :func:`lagice.remesh.remesh_region`); ``ev.node_perm`` maps a renumbered mesh."""
+    import numpy as np
+
+    from ..fem import shape_gradients, strain_rate
+    from .remap import interpolate_nodal
+
+    transport = np.asarray(transport, np.float64)
+    n = mesh.n_nodes
+    stitched = np.arange(n) if ev.node_perm is None else np.asarray(ev.node_perm)
+    kept = stitched < len(ev.kept_nodes)
+    v = np.empty((n, 2))
+    v[kept] = transport[ev.kept_nodes[stitched[kept]]]
+    v[~kept] = interpolate_nodal(old_mesh.nodes, old_mesh.triangles, transport, mesh.nodes[~kept])
+    b, c, _ = shape_gradients(mesh.nodes, mesh.triangles)
+    return v, strain_rate(mesh.triangles, b, c, v)
+
+
 class Remesher:
     """Remesh check after each move; events are appended to :attr:`log` and counted in
     ``state.counters`` (``remesh_count``, ``mesh_epoch``).
@@ -52,6 +72,7 @@ class Remesher:
 
         st = model.state
         motion = model.component("mesh_motion")
+        old_mesh, transport = st.mesh, model.transport_velocity  # the step's, on the mesh it moved
         ev = remesh_if_needed(st, self.size_field, solver=model.stepper, params=self.trigger,
                               flagged=motion.last_flagged if motion is not None else None, log=self.log,
                               time_s=model.clock.time_s + dt_s, step=model.clock.iteration + 1,
@@ -61,6 +82,7 @@ class Remesher:
             st.counters["mesh_epoch"] = st.counters.get("mesh_epoch", 0) + 1
             for f in self.after_remesh:
                 f(st, ev)
+            model.set_remeshed_transport(*remeshed_transport(old_mesh, transport, st.mesh, ev))
         return ev
 
     @property
