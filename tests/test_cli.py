@@ -62,6 +62,16 @@ def test_cli_scenes_lists_every_bundled_scene_with_a_description():
         assert name in r.stdout and desc and desc in r.stdout
 
 
+
+def test_python_m_lagice_is_the_lagice_command(tmp_path):
+    """``python -m lagice`` runs the same CLI as ``python -m lagice.cli`` (the same scene list,
+    the same one-line error and exit status 2 for a bad key)."""
+    a = subprocess.run([sys.executable, "-m", "lagice", "scenes"], capture_output=True, text=True, timeout=300)
+    assert a.returncode == 0 and a.stdout == run_cli("scenes").stdout
+    bad = subprocess.run([sys.executable, "-m", "lagice", "run", "uniaxial_compression", "--out", str(tmp_path / "r"),
+                          "--set", "rheology.cohesion=3"], capture_output=True, text=True, timeout=300)
+    assert bad.returncode == 2 and "rheology.cohesion" in bad.stderr
+
 @pytest.mark.slow
 def test_cli_diagnose_real_output(tmp_path):
     """``lagice diagnose`` on the snapshots of a real (moving-mesh) run writes
