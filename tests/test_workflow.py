@@ -1145,3 +1145,22 @@ def test_coriolis_from_the_crs_is_applied_once_beside_a_drag_coriolis_f(tmp_path
     cor = [f for f in sim.model.forces if isinstance(f, Coriolis)]
     assert len(cor) == 1 and cor[0].crs is not None
     assert "forcing.drag.coriolis_f = 0.0001 ([forcing.coriolis] sets the Coriolis parameter)" in caplog.text
+
+
+@pytest.mark.parametrize("coriolis,warned", [({"latitude_deg": -70.0}, True), ({"f_s": -1.4e-4}, True),
+                                             ({"latitude_deg": 80.0}, False)])
+def test_a_counter_clockwise_ocean_turning_in_the_southern_hemisphere_is_named(coriolis, warned, caplog):
+    """``turning_angle_deg`` is counter-clockwise positive everywhere (the Northern Hemisphere's
+    Ekman turning); a positive value with a negative Coriolis parameter turns the drag the wrong
+    way for the Southern Hemisphere, and the warning says so, with the value to use."""
+    import logging
+
+    from lagice.scenes.builder import validate_config
+    from lagice.scenes.config import load_scene
+
+    cfg = load_scene("winter_basin_pack", {"run.duration": "1h", "forcing.coriolis": coriolis,
+                                           "forcing.drag": {"air_drag": 2e-3, "turning_angle_deg": 25.0}})
+    with caplog.at_level(logging.WARNING, logger="lagice"):
+        validate_config(cfg)
+    assert ("turning_angle_deg = 25 turns the ocean drag counter-clockwise" in caplog.text
+            and "use turning_angle_deg = -25" in caplog.text) is warned

@@ -248,6 +248,7 @@ def validate(cfg: dict, duration_s: float) -> None:
         from ..params import DragParams
 
         checks.check_dataclass_params("forcing.drag", DragParams, fc["drag"])
+        _check_turning_hemisphere(fc)
     if cfg["thermo"]["new_ice_undamaged"] and not cfg["thermo"]["enabled"]:
         raise ConfigError("thermo.new_ice_undamaged = true but thermo.enabled = false: without thermodynamics no "
                           "new ice forms, so the setting would not be used")
@@ -261,6 +262,28 @@ def validate(cfg: dict, duration_s: float) -> None:
     if cfg["lagrangian"]["enabled"]:
         from ..lagrangian import MeshMotion
         MeshMotion(cfg["lagrangian"]["min_area_ratio"], cfg["lagrangian"]["max_halvings"])
+
+
+def _check_turning_hemisphere(fc: dict) -> None:
+    """A warning when ``forcing.drag.turning_angle_deg`` turns the ocean drag counter-clockwise
+    while the Coriolis parameter is negative (Southern Hemisphere), where the Ekman turning is
+    clockwise: neXtSIM's 25° is a Northern-Hemisphere value (the convention of
+    :class:`lagice.forces.OceanDrag` is counter-clockwise positive everywhere)."""
+    theta = (fc["drag"] or {}).get("turning_angle_deg", 0.0) or 0.0
+    cor = fc["coriolis"] or {}
+    f = cor.get("f_s")
+    lat = cor.get("latitude_deg")
+    if f is None and isinstance(lat, (int, float)):
+        f = float(lat)  # the sign of f is the sign of the latitude
+    if f is None and not cor:
+        f = (fc["drag"] or {}).get("coriolis_f")
+    if isinstance(f, (int, float)) and f < 0.0 and theta > 0.0:
+        import logging
+
+        logging.getLogger("lagice").warning(
+            f"forcing.drag.turning_angle_deg = {theta:g} turns the ocean drag counter-clockwise, but the Coriolis "
+            f"parameter is negative (Southern Hemisphere), where the Ekman turning is clockwise: use "
+            f"turning_angle_deg = {-theta:g} (neXtSIM's 25 degrees is a Northern-Hemisphere value)")
 
 
 def _check_coriolis(c: dict) -> None:
