@@ -253,7 +253,8 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     keep_mean (params refuse the rest), quasi-unilateral damage: the mean normal stress m changes
     with the undamaged Δt_s E0 exp(−c*(1−A)) where m ≤ 0 (the cracks closed) and with the
     damaged e_dt where m ≥ 0; a sub-step that crosses m = 0 takes each modulus for its part of
-    the volumetric strain. Intact ice (d = 0) is unchanged.
+    the volumetric strain. Intact ice (d = 0) is unchanged to round-off (ed0/ed = 1 up to the
+    rounding of the two products).
     Returns the number of elements whose damage hit the cap.
     """
     m = tri.shape[0]
