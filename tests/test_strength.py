@@ -484,3 +484,26 @@ def test_a_branch_applies_its_strength_law_at_the_branch_point(tmp_path):
     so = off.model.state
     assert so.strength_factor is None
     np.testing.assert_allclose(so.cohesion, law.cohesion(so.mesh.nodes, so.mesh.triangles, so.node_id), rtol=1e-12)
+
+
+def test_nextsim_healing_takes_the_models_freezing_point_conductivities_and_c_star():
+    """The nextsim healing law's ΔT across the ice uses Tf, ki, ks and its e^(−c*(1−A)) uses c*:
+    where ``[healing.params]`` does not set them they are the model's own (``[thermo.params]``,
+    ``rheology.concentration_c``), so the healing and the ice it heals agree; a key set in
+    ``[healing.params]`` wins; under the defaults the values are the law's defaults."""
+    from lagice.scenes.builder import build_model
+    from lagice.scenes.config import load_scene
+
+    base = {"domain.resolution_m": 120e3, "run.duration": "1h", "solver.dt": "1h"}
+    law = build_model(load_scene("winter_basin_pack", base)).healing.law
+    assert (law.freezing_point_c, law.concentration_c) == (-1.8, 20.0)
+    k_default = law.ki
+    law = build_model(load_scene("winter_basin_pack", {
+        **base, "thermo.params": {"conductivity_ice_w_m_k": 1.5, "freezing_point_c": -1.9},
+        "rheology.concentration_c": 15.0})).healing.law
+    assert (law.ki, law.freezing_point_c, law.concentration_c) == (1.5, -1.9, 15.0)
+    assert k_default != 1.5
+    law = build_model(load_scene("winter_basin_pack", {
+        **base, "thermo.params": {"conductivity_ice_w_m_k": 1.5},
+        "healing.params": {"conductivity_ice_w_m_k": 2.2}})).healing.law
+    assert law.ki == 2.2

@@ -264,6 +264,29 @@ def validate(cfg: dict, duration_s: float) -> None:
         MeshMotion(cfg["lagrangian"]["min_area_ratio"], cfg["lagrangian"]["max_halvings"])
 
 
+#: keys of ``[healing.params]`` (law "nextsim") that, when the scene does not set them, follow the
+#: model's own values: the thermodynamics' Tf, ki, ks and the rheology's c*
+SHARED_HEALING_KEYS = {"freezing_point_c": "thermo", "conductivity_ice_w_m_k": "thermo",
+                       "conductivity_snow_w_m_k": "thermo", "concentration_c": "rheology"}
+
+
+def nextsim_healing_params(cfg: dict) -> dict:
+    """``[healing.params]`` of the nextsim law, with the keys it does not set taken from the
+    model it heals (:data:`SHARED_HEALING_KEYS`): the freezing point and conductivities of
+    ``[thermo.params]`` (when thermodynamics is on and sets them) and the rheology's
+    ``concentration_c``, so that the healing's ΔT across the ice and its e^(−c*(1−A)) are the
+    model's. A key set in ``[healing.params]`` wins. Under the defaults nothing changes."""
+    params = dict(cfg["healing"]["params"])
+    for key, table in SHARED_HEALING_KEYS.items():
+        if key in params:
+            continue
+        if table == "thermo" and cfg["thermo"]["enabled"] and key in cfg["thermo"]["params"]:
+            params[key] = cfg["thermo"]["params"][key]
+        elif table == "rheology" and cfg["rheology"].get(key) is not None:
+            params[key] = cfg["rheology"][key]
+    return params
+
+
 def _check_turning_hemisphere(fc: dict) -> None:
     """A warning when ``forcing.drag.turning_angle_deg`` turns the ocean drag counter-clockwise
     while the Coriolis parameter is negative (Southern Hemisphere), where the Ekman turning is
@@ -645,7 +668,7 @@ def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
     if law == "nextsim":
         from ..strength import NextsimHealing, NextsimHealingComponent
 
-        parts["healing"] = NextsimHealingComponent(NextsimHealing(air, **cfg["healing"]["params"]))
+        parts["healing"] = NextsimHealingComponent(NextsimHealing(air, **nextsim_healing_params(cfg)))
     if cfg["lagrangian"]["enabled"]:
         from ..lagrangian import MeshMotion
 
