@@ -1164,3 +1164,19 @@ def test_a_counter_clockwise_ocean_turning_in_the_southern_hemisphere_is_named(c
         validate_config(cfg)
     assert ("turning_angle_deg = 25 turns the ocean drag counter-clockwise" in caplog.text
             and "use turning_angle_deg = -25" in caplog.text) is warned
+
+
+@pytest.mark.parametrize("coriolis_lat,warned", [(70.0, True), (80.0, False)])
+def test_the_wind_climatologys_latitude_against_the_ices_is_named(coriolis_lat, warned, caplog):
+    """The climatology builds its geostrophic wind with f of its own ``latitude_deg`` (80° by
+    default); a ``[forcing.coriolis]`` latitude that differs is named in a warning."""
+    import logging
+
+    from lagice.scenes.builder import validate_config
+    from lagice.scenes.config import load_scene
+
+    cfg = load_scene("winter_basin_pack", {"run.duration": "1h", "forcing.coriolis": {"latitude_deg": coriolis_lat}})
+    with caplog.at_level(logging.WARNING, logger="lagice"):
+        validate_config(cfg)
+    assert ("forcing.wind.latitude_deg = 80 (the climatology's geostrophic wind) differs from "
+            f"forcing.coriolis.latitude_deg = {coriolis_lat:g}" in caplog.text) is warned

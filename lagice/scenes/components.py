@@ -229,8 +229,9 @@ def validate(cfg: dict, duration_s: float) -> None:
         elif key == "air_temperature":
             _check_air_kwargs(t, kind, cfg["run"]["start_date"])
         elif kind == "climatology":
-            _check_climatology_resolution(_climatology_kwargs(_generator_table(t, key, kind)),
-                                          fc["grid_spacing_m"])
+            ckw = _climatology_kwargs(_generator_table(t, key, kind))
+            _check_climatology_resolution(ckw, fc["grid_spacing_m"])
+            _check_climatology_latitude(ckw, fc["coriolis"])
         else:
             _check_kwargs(t, key, kind)
         if key == "ocean" and kind == "eddies":
@@ -359,6 +360,23 @@ def _check_remesh(rm: dict) -> None:
     for k, v in trig.items():
         checks.check_value(f"remesh.params.{k}", v, checks.Spec(checks.NUMBER))
     Remesher(1.0, rm["min_angle_deg"], **params)  # unknown keys and trigger ranges
+
+
+def _check_climatology_latitude(kw: dict, coriolis) -> None:
+    """A warning when the wind climatology's ``latitude_deg`` (its geostrophic wind's f) differs
+    from a numeric ``[forcing.coriolis] latitude_deg`` (the ice's f): the wind would be built for
+    another latitude than the ice drifts at."""
+    from forcing.climatology import ClimatologyParams
+
+    lat_w = float(kw.get("latitude_deg", ClimatologyParams.latitude_deg))
+    lat_i = (coriolis or {}).get("latitude_deg")
+    if isinstance(lat_i, (int, float)) and not isinstance(lat_i, bool) and abs(lat_i - lat_w) > 1e-9:
+        import logging
+
+        logging.getLogger("lagice").warning(
+            f"forcing.wind.latitude_deg = {lat_w:g} (the climatology's geostrophic wind) differs from "
+            f"forcing.coriolis.latitude_deg = {lat_i:g} (the ice's Coriolis parameter): set both to the scene's "
+            f"latitude")
 
 
 def _climatology_kwargs(t: dict) -> dict:
