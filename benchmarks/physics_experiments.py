@@ -132,6 +132,15 @@ def from_spinup(name: str) -> list:
     return [f"initial.state_file={SPINUPS[name][1].relative_to(ROOT)}"]
 
 
+def add_screen_20km(tag: str, changes: list, what: str) -> None:
+    """A 20 km screen in the closed basin's validation month from its own 20 km spin-up with
+    the same ``changes``: spin-up ``H20-{tag}`` (the thick-and-thin pack, 14 days) and run
+    ``B20-hthick-{tag}`` (28 days)."""
+    SPINUPS[f"H20-{tag}"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + changes, OUT / f"spinup-H20-{tag}.npz",
+                             20e3)
+    EXPERIMENTS[f"B20-hthick-{tag}"] = ("closed", changes + from_spinup(f"H20-{tag}"), 20e3, 28, what)
+
+
 def add_weather_ensemble(tag: str, overrides: list, what: str, group: str, seeds, suffix: str = "") -> None:
     """The 10 km, 28-day runs of one set-up in both basins: ``F10-hthick-{tag}`` /
     ``F10s-hthick-{tag}`` (the scene's wind seed) and ``...-w{seed}`` for ``seeds``, with the
@@ -1439,11 +1448,9 @@ for _seed in (2027, 2028):
 # the 20 km screen again through the committed code (its own 20 km spin-ups; the prototype's
 # numbers above must come back)
 SPINUPS["H20"] = ([f"initial.thickness_m={HETERO_THICKNESS}"], OUT / "spinup-H20.npz", 20e3)
-SPINUPS["H20-eff"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE, OUT / "spinup-H20-eff.npz", 20e3)
 EXPERIMENTS["B20-hthick-own"] = ("closed", from_spinup("H20"), 20e3, 28,
                                  "thick-and-thin pack at 20 km from its own 20 km spin-up (nominal criterion)")
-EXPERIMENTS["B20-hthick-eff"] = ("closed", EFFECTIVE + from_spinup("H20-eff"), 20e3, 28,
-                                 "20 km: the envelope judges the effective stress sigma/(1 - d), own spin-up")
+add_screen_20km("eff", EFFECTIVE, "20 km: the envelope judges the effective stress sigma/(1 - d), own spin-up")
 # Results (10:49 UTC): (a) holds: the closed basin's beta at 10 km is 0.189 (strait 0.171); (b) holds:
 # the area above damage 0.5 at day 10 is 0.46 and 0.45 (shipped 0.99, 1.00); (c) fails in the strait:
 # 2 bands inside in each basin (beta and the rate, 0.021 and 0.022 per day), against 2 and 3; the
@@ -1462,10 +1469,7 @@ EXPERIMENTS["B20-hthick-eff"] = ("closed", EFFECTIVE + from_spinup("H20-eff"), 2
 # Result (10:58 UTC): not a lead. B20-hthick-effP puts 1 band inside (the rate, 0.035 per day), against
 # 2: beta 0.285 leaves its band, both tails 5.1-5.3, half-shear area 15.8 %, R2 0.51. The prediction
 # was wrong in every part: the pack moves faster, not slower. The 10 km runs are not made.
-SPINUPS["H20-effP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + PMAX, OUT / "spinup-H20-effP.npz",
-                       20e3)
-EXPERIMENTS["B20-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H20-effP"), 20e3, 28,
-                                  "20 km: effective envelope and neXtSIM's compressive term, own spin-up")
+add_screen_20km("effP", EFFECTIVE + PMAX, "20 km: effective envelope and neXtSIM's compressive term, own spin-up")
 # Broken ice that keeps its mean stress with the effective criterion (rheology.relax_mean_stress =
 # false: the Maxwell relaxation acts on the deviator only, so a broken element keeps its pressure,
 # and the effective envelope caps its shear at friction times that pressure: a frictional rubble),
@@ -1478,10 +1482,8 @@ EXPERIMENTS["B20-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H20-
 # 2; beta 0.096, below its band, as predicted; but R2 falls to 0.11 and the half-shear area rises to
 # 27.7 % (tails 6.1 / 4.4): the deformation spreads, as with the mean stress kept on the shipped set.
 KEEPMEAN = ["rheology.relax_mean_stress=false"]
-SPINUPS["H20-effK"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + KEEPMEAN,
-                       OUT / "spinup-H20-effK.npz", 20e3)
-EXPERIMENTS["B20-hthick-effK"] = ("closed", EFFECTIVE + KEEPMEAN + from_spinup("H20-effK"), 20e3, 28,
-                                  "20 km: effective envelope, broken ice keeps its mean stress, own spin-up")
+add_screen_20km("effK", EFFECTIVE + KEEPMEAN,
+                "20 km: effective envelope, broken ice keeps its mean stress, own spin-up")
 # A residual strength of broken ice (a diagnostic of the mechanism, not a calibration to ship): the
 # damage cap rheology.max_damage (default 1 - 1e-6) at 0.99 and 0.9 with the effective criterion, so
 # broken ice keeps a cohesion (1 - cap) C and a relaxation time lambda0 (1 - cap)^3 (0.99: 10 s;
@@ -1495,11 +1497,8 @@ EXPERIMENTS["B20-hthick-effK"] = ("closed", EFFECTIVE + KEEPMEAN + from_spinup("
 # area 23.9 %, R2 0.48, tails 4.3 / 5.0): 1 band inside. The strength left in broken ice moves the
 # drift and beta in opposite directions.
 for _tag, _cap in (("cap99", "0.99"), ("cap90", "0.9")):
-    SPINUPS[f"H20-eff-{_tag}"] = ([f"initial.thickness_m={HETERO_THICKNESS}", f"rheology.max_damage={_cap}"]
-                                  + EFFECTIVE, OUT / f"spinup-H20-eff-{_tag}.npz", 20e3)
-    EXPERIMENTS[f"B20-hthick-eff-{_tag}"] = (
-        "closed", EFFECTIVE + [f"rheology.max_damage={_cap}"] + from_spinup(f"H20-eff-{_tag}"), 20e3, 28,
-        f"20 km: effective envelope, damage cap {_cap}, own spin-up")
+    add_screen_20km(f"eff-{_tag}", EFFECTIVE + [f"rheology.max_damage={_cap}"],
+                    f"20 km: effective envelope, damage cap {_cap}, own spin-up")
 # Refrozen leads that are intact again with the effective criterion (thermo.new_ice_undamaged, the
 # neXtSIM-DG form, sourced: "Undamaged new ice"), stated 2026-11-28 12:11 UTC before its runs. With
 # the effective criterion the broken network holds no stress at all (damage 0.986 in the storm
@@ -1521,10 +1520,7 @@ for _tag, _cap in (("cap99", "0.99"), ("cap90", "0.9")):
 # day 10, 0.69 at day 28; the effective criterion alone 0.50, 0.56, 0.68). The new ice of a 20 km
 # step is too small a part of an element to bring its cohesion back. The 10 km runs are not made.
 NEWICE = ["thermo.new_ice_undamaged=true"]
-SPINUPS["H20-effN"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + NEWICE,
-                       OUT / "spinup-H20-effN.npz", 20e3)
-EXPERIMENTS["B20-hthick-effN"] = ("closed", EFFECTIVE + NEWICE + from_spinup("H20-effN"), 20e3, 28,
-                                  "20 km: effective envelope, refrozen leads undamaged, own spin-up")
+add_screen_20km("effN", EFFECTIVE + NEWICE, "20 km: effective envelope, refrozen leads undamaged, own spin-up")
 # How fast a fault must heal with the effective criterion (a diagnostic of the mechanism, not a value
 # to ship: neXtSIM's th0 = 25 days is sourced), stated 2026-11-28 12:18 UTC before its runs. With the
 # effective criterion a broken band keeps no cohesion, and neXtSIM's healing (25 days at dT = 20 K)
@@ -1546,11 +1542,9 @@ EXPERIMENTS["B20-hthick-effN"] = ("closed", EFFECTIVE + NEWICE + from_spinup("H2
 # it: a band that heals is broken again at once, since its damage grows on the elastic time scale
 # (td = dx/cs, 40 s at 20 km) and any load exceeds its healed cohesion C (1 - d).
 for _tag, _th in (("th5d", "432000"), ("th1d", "86400")):
-    SPINUPS[f"H20-eff-{_tag}"] = ([f"initial.thickness_m={HETERO_THICKNESS}", f"healing.params.th0_s={_th}"]
-                                  + EFFECTIVE, OUT / f"spinup-H20-eff-{_tag}.npz", 20e3)
-    EXPERIMENTS[f"B20-hthick-eff-{_tag}"] = (
-        "closed", EFFECTIVE + [f"healing.params.th0_s={_th}"] + from_spinup(f"H20-eff-{_tag}"), 20e3, 28,
-        f"20 km: effective envelope, neXtSIM healing th0 = {int(_th) // 86400} days (a diagnostic), own spin-up")
+    add_screen_20km(f"eff-{_tag}", EFFECTIVE + [f"healing.params.th0_s={_th}"],
+                    f"20 km: effective envelope, neXtSIM healing th0 = {int(_th) // 86400} days (a diagnostic), own "
+                    f"spin-up")
 # Broken ice whose cracks close (rheology.crack_closure, new: quasi-unilateral damage, Ladeveze and
 # Lemaitre 1984) with the effective criterion, stated 2026-11-28 12:28 UTC before its runs. The
 # healing screens above show that a loaded band stays broken whatever its healing: what would lock
@@ -1582,14 +1576,10 @@ for _tag, _th in (("th5d", "432000"), ("th1d", "86400")):
 # predicted). Without P_max (B20-hthick-effC, stable: its pack keeps intact elements) the pack locks
 # too, as predicted: rate 3e-5 per day, wind factor 0.0000, no remesh.
 CLOSURE = ["rheology.crack_closure=true"] + KEEPMEAN
-SPINUPS["H20-effCP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + CLOSURE + PMAX,
-                        OUT / "spinup-H20-effCP.npz", 20e3)
-EXPERIMENTS["B20-hthick-effCP"] = ("closed", EFFECTIVE + CLOSURE + PMAX + from_spinup("H20-effCP"), 20e3, 28,
-                                   "20 km: effective envelope, cracks close, neXtSIM's P_max, own spin-up")
-SPINUPS["H20-effC"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + CLOSURE,
-                       OUT / "spinup-H20-effC.npz", 20e3)
-EXPERIMENTS["B20-hthick-effC"] = ("closed", EFFECTIVE + CLOSURE + from_spinup("H20-effC"), 20e3, 28,
-                                  "20 km: effective envelope, cracks close, no P_max (a diagnostic), own spin-up")
+add_screen_20km("effCP", EFFECTIVE + CLOSURE + PMAX,
+                "20 km: effective envelope, cracks close, neXtSIM's P_max, own spin-up")
+add_screen_20km("effC", EFFECTIVE + CLOSURE,
+                "20 km: effective envelope, cracks close, no P_max (a diagnostic), own spin-up")
 # Eight months of weather at 20 km for the effective criterion and the nominal one (a diagnostic of
 # the only parameter-free change that lifts beta), stated 2026-11-28 12:50 UTC before the runs. At 10 km
 # beta was 0.189, 0.122 and 0.093 in three months (closed basin), so one month decides little. The
