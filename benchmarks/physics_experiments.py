@@ -1629,6 +1629,19 @@ EXPERIMENTS["F10-hthick-newc"] = ("closed", NEWC + from_spinup("H1125-newc"), 10
                                   "kept elements keep their strength at a remesh, own spin-up")
 EXPERIMENTS["F10s-hthick-newc"] = ("strait", NEWC + from_spinup("H1125-newc"), 10e3, 28,
                                    "strait: kept elements keep their strength at a remesh, own spin-up")
+# --- 2026-11-28 (twenty-eighth session): the eight months with kept elements keeping their C ---
+# Written 2026-11-28 13:58 UTC, before the runs. strength_after_remesh = "new" corrects the code's
+# behaviour (kept elements no longer jump by -15 % to +14 % at unrelated remeshes), so it becomes the
+# default on that ground, not on the statistics. These 14 runs (seeds 2027-2033, both basins, from
+# the spin-up made with "new", H1125-newc, which becomes the shipped state) remake the eight-month
+# ensembles the validation report and README quote. Prediction, against the shipped set's eight-month
+# medians (closed / strait: beta 0.047 / 0.055, tails 2.32 / 2.24 and 2.11 / 2.16, half-shear area
+# 4.9 % / 5.1 %, R2 0.76 / 0.73, rate 0.0018 / 0.0022 per day, wind factor 0.0033 / 0.0038, 3 bands
+# inside in each): each median within the spread of a disorder draw (beta within 0.03, each tail
+# within 0.4, the half-shear area within 1.5 points, R2 within 0.05, the rate and the wind factor
+# within x1.3), and the count of bands inside within one. Whatever the result, the default switches.
+add_weather_ensemble("newc", NEWC + from_spinup("H1125-newc"), "with kept elements keeping their strength",
+                     "kept elements keep their strength", ENSEMBLE_SEEDS + MORE_SEEDS, suffix=", eight months")
 SPINUPS["H1125-effP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + PMAX,
                          OUT / "spinup-H1125-effP.npz", 10e3)
 EXPERIMENTS["F10-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H1125-effP"), 10e3, 28,
