@@ -1642,6 +1642,12 @@ EXPERIMENTS["F10s-hthick-newc"] = ("strait", NEWC + from_spinup("H1125-newc"), 1
 # within x1.3), and the count of bands inside within one. Whatever the result, the default switches.
 add_weather_ensemble("newc", NEWC + from_spinup("H1125-newc"), "with kept elements keeping their strength",
                      "kept elements keep their strength", ENSEMBLE_SEEDS + MORE_SEEDS, suffix=", eight months")
+# The EVP control of the validation report from the same spin-up (EVP does not use the strength law;
+# only its starting pack changes with the shipped spin-up state).
+EXPERIMENTS["E10h-newc"] = ("closed", from_spinup("H1125-newc") + EVP, 10e3, 28,
+                            "EVP control, from the spin-up made with kept elements keeping their strength")
+EXPERIMENTS["E10hs-newc"] = ("strait", from_spinup("H1125-newc") + EVP, 10e3, 28,
+                             "EVP control, strait, from the spin-up made with kept elements keeping their strength")
 SPINUPS["H1125-effP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + PMAX,
                          OUT / "spinup-H1125-effP.npz", 10e3)
 EXPERIMENTS["F10-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H1125-effP"), 10e3, 28,
