@@ -1658,6 +1658,11 @@ EXPERIMENTS["E10hs-newc"] = ("strait", from_spinup("H1125-newc") + EVP, 10e3, 28
 # and beta in 0.14-0.23. Predicted: no. If both move smoothly with the cap, when the wind factor
 # reaches 0.010 beta is about 0.11 (linear in log(1 - cap) between the two runs), so neither cap
 # meets both; 0.97 is the likelier to come close.
+# Result (14:46 UTC): not a lead, as predicted. 0.95: wind factor 0.0104 (just above its band), beta
+# 0.068, rate 0.018 per day, half-shear area 22.9 %, R2 0.28, 1 band inside. 0.97: beta 0.154, wind
+# factor 0.0117, rate 0.023, 17.3 %, R2 0.53, 1 band inside. Over the four caps (0.9, 0.95, 0.97,
+# 0.99) the wind factor rises 0.0072, 0.0104, 0.0117, 0.0133 and beta 0.049, 0.068, 0.154, 0.178:
+# beta jumps between 0.95 and 0.97, where the wind factor is already above its band.
 for _tag, _cap in (("cap95", "0.95"), ("cap97", "0.97")):
     add_screen_20km(f"eff-{_tag}", EFFECTIVE + [f"rheology.max_damage={_cap}"],
                     f"20 km: effective envelope, damage cap {_cap}, own spin-up")
