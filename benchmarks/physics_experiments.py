@@ -1678,6 +1678,25 @@ EXPERIMENTS["F10s-hthick-effP"] = ("strait", EFFECTIVE + PMAX + from_spinup("H11
                                    "strait: effective envelope and neXtSIM's compressive term, own spin-up")
 
 
+# --- 2026-11-28 (twenty-eighth session): rheology.strength_after_remesh became "new" by default ----
+# Every experiment and spin-up defined above ran with "all", the default of its day, unless it set
+# the key: they keep "all", so that running one again reproduces its record. "shipped" is the
+# flagship's own spin-up (data_stubs/winter_basin_spinup.npz) and follows the default. Experiments
+# defined below this line get the default unless they set the key.
+AFTER_REMESH_KEY = "rheology.strength_after_remesh="
+
+
+def _pin_all(overrides: list) -> list:
+    return overrides if any(o.startswith(AFTER_REMESH_KEY) for o in overrides) else overrides + [
+        AFTER_REMESH_KEY + "all"]
+
+
+for _n, (_scene, _o, *_rest) in list(EXPERIMENTS.items()):
+    EXPERIMENTS[_n] = (_scene, _pin_all(_o), *_rest)
+for _n, (_o, *_rest) in list(SPINUPS.items()):
+    if _n != "shipped" and _o is not None:
+        SPINUPS[_n] = (_pin_all(_o), *_rest)
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]

@@ -104,7 +104,7 @@ LABELS = {
 #: Maxwell-EB sensitivity runs (``--sensitivity``): the closed basin with one parameter
 #: changed, reported apart from the headline and not used to pick any value
 SENSITIVITY = {
-    "base": ("closed", [], "recommended set at 10 km (the flagship, F10-hthick-1125: the reference of the ±50 % runs)"),
+    "base": ("closed", [], "recommended set at 10 km (the reference of the ±50 % runs)"),
     "strength-50": ("closed", ["rheology.strength_lab_pa=1.4e6"], "strength −50 % (C_lab 1.4 MPa)"),
     "strength+50": ("closed", ["rheology.strength_lab_pa=4.2e6"], "strength +50 % (C_lab 4.2 MPa)"),
     "drag-50": ("closed", ["forcing.drag.air_drag=1.0e-3"], "air drag −50 % (1.0e-3)"),
@@ -123,8 +123,13 @@ SENSITIVITY_RESOLUTION_M = 10e3
 #: docs/figures/physics_experiments.json
 #: the winter wind factor of Thorndike and Colony (1982), about 0.008; the band is ours
 WIND_FACTOR_BAND = THORNDIKE_COLONY_WINTER["factor"]
-PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-1125", "strait_maxwell_eb": "F10s-hthick-1125",
-                "closed_evp": "E{evp}h", "strait_evp": "E{evp}hs", "sensitivity_base": "F10-hthick-1125",
+#: Since 2026-11-28 kept elements keep their strength at a remesh (rheology.strength_after_remesh =
+#: "new", the default), and the shipped spin-up state is the one made so (spinup-H1125-newc.npz):
+#: the Maxwell-EB runs are F10-hthick-newc / F10s-hthick-newc, EVP E10h-newc / E10hs-newc. The ±50 %
+#: runs were made with the set before (X10h-*, every element recomputed at a remesh) and are not
+#: remade: their rows are carried from the previous report, labelled (carry_sensitivity).
+PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-newc", "strait_maxwell_eb": "F10s-hthick-newc",
+                "closed_evp": "E{evp}h-newc", "strait_evp": "E{evp}hs-newc", "sensitivity_base": "F10-hthick-1125",
                 "sensitivity_strength-50": "X10h-str-50", "sensitivity_strength+50": "X10h-str+50",
                 "sensitivity_drag-50": "X10h-drag-50", "sensitivity_drag+50": "X10h-drag+50",
                 "sensitivity_wind-50": "X10h-wind-50", "sensitivity_wind+50": "X10h-wind+50"}
@@ -135,8 +140,12 @@ PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-1125", "strait_maxwell_eb": "F1
 #: weather: whether a metric is inside its band is read from how many members are inside.
 #: The pack shipped before 2026-11-25 (F10-1125...) is the comparison.
 PHYSICS_ENSEMBLE = {
-    "closed": ["F10-hthick-1125"] + [f"F10-hthick-1125-w{y}" for y in range(2027, 2034)],
-    "strait": ["F10s-hthick-1125"] + [f"F10s-hthick-1125-w{y}" for y in range(2027, 2034)],
+    "closed": ["F10-hthick-newc"] + [f"F10-hthick-newc-w{y}" for y in range(2027, 2034)],
+    "strait": ["F10s-hthick-newc"] + [f"F10s-hthick-newc-w{y}" for y in range(2027, 2034)],
+    "closed, strength recomputed at every remesh (before 2026-11-28)":
+        ["F10-hthick-1125"] + [f"F10-hthick-1125-w{y}" for y in range(2027, 2034)],
+    "strait, strength recomputed at every remesh (before 2026-11-28)":
+        ["F10s-hthick-1125"] + [f"F10s-hthick-1125-w{y}" for y in range(2027, 2034)],
     "closed, pack shipped before 2026-11-25": ["F10-1125"] + [f"F10-1125-w{y}" for y in (2027, 2028, 2029)],
     "strait, pack shipped before 2026-11-25": ["F10s-1125"] + [f"F10s-1125-w{y}" for y in (2027, 2028, 2029)]}
 RHEOLOGIES = {
@@ -800,12 +809,20 @@ def write_report(res: dict, md: Path, figs: dict):
         lines += [f"## Sensitivity of Maxwell-EB to strength, air drag and wind scale (±50 %, closed basin, "
                   f"{SENSITIVITY_RESOLUTION_M / 1e3:g} km; not a calibration)", "",
                   "Each run changes one value of the recommended set by ±50 %; they are reported for what they show "
-                  "and no value was chosen from them.",
+                  "and no value was chosen from them."
+                  + "".join(f" Rows marked † were made on {c['date']} with the code of commit "
+                            f"`{str(c['git_commit'])[:10]}` "
+                            "and the set of that day (the strength of every element recomputed at each remesh, the "
+                            "default until 2026-11-28), from the spin-up state made with it; they were not remade, and "
+                            "their reference is that set's own validation month (the first row)."
+                            for c in {json.dumps(r["carried_from"], sort_keys=True): r["carried_from"]
+                                      for r in res["sensitivity"].values() if r.get("carried_from")}.values()),
                   "", "| run | " + " | ".join(LABELS[k] for k in TARGETS)
                   + " | remesh events | mean speed (m s⁻¹) |",
                   "|---|" + "---|" * (len(TARGETS) + 2)]
         for n, r in res["sensitivity"].items():
-            lines.append(f"| {SENSITIVITY[n][2]} | " + " | ".join(
+            lines.append(f"| {r.get('label', SENSITIVITY[n][2])}{' †' if r.get('carried_from') else ''} | "
+                         + " | ".join(
                 f"{_fmt(k, r['median'][k])} ({_inside(k, r['median'][k])})" for k in TARGETS)
                 + f" | {r['remesh_events']} | {np.mean(r['mean_speed_m_s'][1:]):.2g} |")
         lines.append("")
@@ -860,6 +877,40 @@ def analyse_ensemble(physics: Path, days: float, buffer_m: float, basin: dict) -
     return out
 
 
+def _carried(previous: dict) -> dict:
+    return {"git_commit": previous.get("git_commit"), "date": previous.get("date")}
+
+
+def carry_sensitivity(previous: dict, names: list) -> dict:
+    """The sensitivity runs among ``names`` whose folders are gone, from the ``previous``
+    report's JSON, each marked ``carried_from`` (its commit and date), so that the report says
+    they were not remade. Printed, never silent."""
+    out = {}
+    for n in names:
+        r = (previous.get("sensitivity") or {}).get(n)
+        if r is not None:
+            out[n] = {**r, "carried_from": r.get("carried_from") or _carried(previous)}
+            print(f"validate: sensitivity run {n}: not in the runs folder; carried from the report of "
+                  f"{out[n]['carried_from']['date']} (commit {str(out[n]['carried_from']['git_commit'])[:10]})")
+        else:
+            print(f"validate: sensitivity run {n}: not run and not in the previous report: left out")
+    return out
+
+
+def carry_ensembles(previous: dict, groups: list) -> dict:
+    """The groups of :data:`PHYSICS_ENSEMBLE` among ``groups`` whose member runs are gone but
+    whose members, by name, are a group of the ``previous`` report (under any group name), from
+    that report, marked ``carried_from``."""
+    out = {}
+    old = previous.get("weather_ensemble") or {}
+    for g in groups:
+        hit = [e for e in old.values() if list(e.get("members", {})) == PHYSICS_ENSEMBLE[g]]
+        if hit:
+            out[g] = {**hit[0], "carried_from": hit[0].get("carried_from") or _carried(previous)}
+            print(f"validate: weather ensemble {g}: carried from the report of {out[g]['carried_from']['date']}")
+    return out
+
+
 def _member_stats(members: dict, part: str) -> dict:
     """Per metric over the members' ``part`` medians: median, min, max and how many are inside the band."""
     stats = {}
@@ -887,7 +938,10 @@ def ensemble_lines(ens: dict) -> list[str]:
              "the median over the members and how many members are inside the band.", ""]
     for scene, e in ens.items():
         names = list(e["members"])
-        lines += [f"**{scene}**", "", "| metric | observed | " + " | ".join(names)
+        c = e.get("carried_from")
+        lines += [f"**{scene}**", ""] + ([f"(From the report of {c['date']}, commit `{str(c['git_commit'])[:10]}`: "
+                                          "these runs were not remade.)", ""] if c else []) + [
+                  "| metric | observed | " + " | ".join(names)
                   + " | median of members | members inside |", "|---|---|" + "---|" * (len(names) + 2)]
         for k, (lo, hi, _src, _n) in TARGETS.items():
             st = e["metrics"][k]
@@ -1131,6 +1185,13 @@ def main(argv=None):
         run = run_dir(out, f"sensitivity_{name}", physics, args.evp_km)
         if done(run):
             sens[name] = analyse_run(run, days, args.coast_buffer_km * 1e3)
+    previous_json = args.fig_dir / "validation.json"
+    previous = json.loads(previous_json.read_text()) if physics is not None and previous_json.exists() else None
+    if previous is not None:
+        sens.update(carry_sensitivity(previous, [n for n in SENSITIVITY if n not in sens]))
+    if physics is not None and "base" in sens and PHYSICS_RUNS["sensitivity_base"] != PHYSICS_RUNS["closed_maxwell_eb"]:
+        sens["base"]["label"] = (f"the set of the ±50 % runs at 10 km ({PHYSICS_RUNS['sensitivity_base']}: not the "
+                                 f"validation run above)")
     comp = None if args.no_compression or not comp_path.exists() else analyse_compression(comp_path)
     figs = {s: figures_basin(basin[s], args.fig_dir, s) for s in basin}
     if comp is not None:
@@ -1145,6 +1206,8 @@ def main(argv=None):
         figs.setdefault("strait", []).append(figure_rate_map(Path(basin["strait"]["maxwell_eb"]["run_dir"]), days,
                                                              args.fig_dir, "strait"))
     ensemble = analyse_ensemble(physics, days, args.coast_buffer_km * 1e3, basin) if physics is not None else {}
+    if previous is not None:
+        ensemble.update(carry_ensembles(previous, [g for g in PHYSICS_ENSEMBLE if g not in ensemble]))
     mi_json = args.fig_dir / "mesh_imprint.json"
     if mi_json.exists():
         imprint["rotation_test"] = rotation_test_summary(json.loads(mi_json.read_text()))

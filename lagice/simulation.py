@@ -260,7 +260,10 @@ class Simulation:
                 raise RestartError(f"checkpoint {path} names no builder; pass model= to resume it")
             if "out_dir" not in builder_kw:  # the run folder the checkpoint lives in
                 builder_kw["out_dir"] = run_folder_of(path)
-            sim = _call_builder(spec, meta["config"] if config is None else config, **builder_kw)
+            from .scenes.config import with_legacy_values
+
+            stored = with_legacy_values(meta["config"]) if isinstance(meta.get("config"), dict) else meta["config"]
+            sim = _call_builder(spec, stored if config is None else config, **builder_kw)
         else:
             sim = cls(model, dt=meta["simulation"]["dt_s"], stop=meta["simulation"]["stop_s"])
         sim._check_fingerprint(path, meta)

@@ -133,12 +133,13 @@ class StrengthLaw:
     seed: int = 0
     correlation_m: float = 0.0
     correlated_amplitude: float | None = None
-    #: ``"all"`` (the default since 2026-11-24): after a remesh every element's C is recomputed
-    #: from its current size, so kept elements jump to the strength of the size their
-    #: Lagrangian deformation gave them; ``"new"`` (2026-11-28): only the remesh's new
-    #: elements get the law's C, and kept elements keep theirs (a material property between
-    #: its creation and its replacement; docs/physics.md §2, "Disorder and remeshing")
-    after_remesh: str = "all"
+    #: ``"new"`` (the default since 2026-11-28): only the remesh's new elements get the law's
+    #: C, and kept elements keep theirs (a material property between its creation and its
+    #: replacement; docs/physics.md §2, "Disorder and remeshing"); ``"all"`` (the behaviour
+    #: from 2026-11-24 to 2026-11-28): after a remesh every element's C is recomputed from its
+    #: current size, so kept elements jump to the strength of the size their Lagrangian
+    #: deformation gave them
+    after_remesh: str = "new"
 
     def __post_init__(self):
         check_range("rheology.strength_lab_pa", self.lab_cohesion_pa, 1e4, 1e8, unit="Pa")
@@ -231,7 +232,9 @@ def from_config(rheology: dict, seed: int) -> StrengthLaw | None:
         raise ConfigError(f"rheology.strength_law = {law!r}: expected one of {list(LAWS)}")
     if law == "uniform":
         for k in RHEOLOGY_KEYS[1:]:
-            if rheology.get(k) is not None:
+            # "new" is the schema's default and what the uniform law does anyway (its C is a
+            # remapped element field, never recomputed); "all" would be ignored, so it is refused
+            if rheology.get(k) is not None and not (k == "strength_after_remesh" and rheology[k] == "new"):
                 raise ConfigError(f"rheology.{k} is set but rheology.strength_law = 'uniform'; "
                                   "set strength_law = 'scaled' to use it")
         return None
@@ -242,6 +245,11 @@ def from_config(rheology: dict, seed: int) -> StrengthLaw | None:
                       ("strength_after_remesh", "after_remesh")):
         if rheology.get(key) is not None:
             kw[name] = rheology[key]
+    # A configuration whose strength_after_remesh is None or absent was written before the
+    # default became "new" (2026-11-28): a scene validated since then always holds the value
+    # (the schema's default is "new"), so None is a checkpoint of the code that recomputed
+    # every element, and it resumes doing so (LEGACY_FILL of lagice.scenes.config).
+    kw.setdefault("after_remesh", "all")
     return StrengthLaw(**kw)
 
 

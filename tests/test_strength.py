@@ -115,12 +115,13 @@ def test_after_a_remesh_every_element_carries_the_strength_of_its_size():
     assert abs(new.std() - math.sqrt(1 / 12)) < 0.04
 
 
-def test_after_a_local_remesh_kept_elements_keep_their_strength_with_after_remesh_new():
+def test_after_a_local_remesh_kept_elements_keep_their_strength_by_default():
     """``rheology.strength_after_remesh = "new"``: a local remesh of the flagship mesh (30 km,
     stretched by 10 %, one edge collapsed) gives its new elements C = C_lab sqrt(L/Δx_e) f_e of
     their own size, and every kept element keeps the C it had, bit for bit (through the
-    renumbering the flagship applies after a remesh), although its size changed. The default
-    ("all") recomputes the kept elements too, so some of them differ by more than 1 %."""
+    renumbering the flagship applies after a remesh), although its size changed. "new" is the
+    default (since 2026-11-28); "all" recomputes the kept elements too, so some of them differ
+    by more than 1 %."""
     from lagice.scenes.builder import build_model
     from lagice.scenes.config import load_scene
 
@@ -128,7 +129,7 @@ def test_after_a_local_remesh_kept_elements_keep_their_strength_with_after_remes
     for mode in ("new", "all"):
         model = build_model(load_scene("winter_basin_pack", {
             "domain.resolution_m": 30e3, "run.duration": "1h", "solver.dt": "1h",
-            **({"rheology.strength_after_remesh": mode} if mode == "new" else {})}))
+            **({"rheology.strength_after_remesh": mode} if mode == "all" else {})}))
         st = model.state
         law = from_config(model.config["rheology"], model.config["run"]["seed"])
         assert law.after_remesh == mode
@@ -507,3 +508,56 @@ def test_nextsim_healing_takes_the_models_freezing_point_conductivities_and_c_st
         **base, "thermo.params": {"conductivity_ice_w_m_k": 1.5},
         "healing.params": {"conductivity_ice_w_m_k": 2.2}})).healing.law
     assert law.ki == 2.2
+
+
+def _after_remesh_of(sim) -> str:
+    """The ``after_remesh`` of the strength law hooked into a simulation's remeshing."""
+    laws = [f.__self__ for f in sim.model.component("remeshing").after_remesh
+            if isinstance(getattr(f, "__self__", None), StrengthLaw)]
+    assert len(laws) == 1
+    return laws[0].after_remesh
+
+
+def test_checkpoints_of_the_code_before_the_new_default_resume_recomputing_every_element(tmp_path):
+    """``strength_after_remesh`` became "new" by default on 2026-11-28. A new run stores "new";
+    a checkpoint of the code before (its configuration holds None, or lacks the key, with the
+    fingerprint hashed without it) resumes with "all", what that code did, through both resume
+    paths and a branch; a resume that asked for "new" would change the physics and is refused."""
+    from lagice.errors import RestartError
+    from lagice.io.checkpoint import list_checkpoints, read_checkpoint, write_checkpoint
+    from lagice.scenes.builder import branch_simulation, build_simulation, resume_simulation
+    from lagice.scenes.config import load_scene, physics_view
+    from lagice.simulation import Simulation
+    from tests.test_simulation import _as_written_without
+
+    sim = build_simulation(load_scene("winter_basin_pack", {
+        "domain.resolution_m": 80e3, "run.duration": "4h", "solver.dt": "1h", "checkpoint.every": "1h",
+        "output.every": "4h", "output.plot": False}), tmp_path / "run")
+    assert _after_remesh_of(sim) == "new"
+    sim.run(n_steps=2)
+    ck = list_checkpoints(tmp_path / "run" / "checkpoints")[-1]
+    assert read_checkpoint(ck)[1]["config"]["rheology"]["strength_after_remesh"] == "new"
+    assert _after_remesh_of(Simulation.resume(ck)) == "new"
+
+    # the code of 2026-11-28 before the switch stored None (its default, meaning "all")
+    import hashlib
+    import json
+
+    arrays, meta = read_checkpoint(ck)
+    meta["config"]["rheology"]["strength_after_remesh"] = None
+    view = {k: v for k, v in physics_view(meta["config"]).items() if not k.startswith("_")}
+    meta["scene_fingerprint"] = hashlib.sha256(json.dumps(view, sort_keys=True, default=str).encode()).hexdigest()[:16]
+    for k in ("format_version", "sha256", "step"):
+        meta.pop(k)
+    none_ck = write_checkpoint(tmp_path / "none", 2, arrays, meta, keep=10)
+    assert _after_remesh_of(Simulation.resume(none_ck)) == "all"
+    assert _after_remesh_of(resume_simulation(none_ck)) == "all"
+
+    # older code had no such key at all
+    _as_written_without(ck, ["rheology.strength_after_remesh"])
+    assert "strength_after_remesh" not in read_checkpoint(ck)[1]["config"]["rheology"]
+    assert _after_remesh_of(Simulation.resume(ck)) == "all"
+    assert _after_remesh_of(resume_simulation(ck)) == "all"
+    assert _after_remesh_of(branch_simulation(ck, tmp_path / "branch", ["run.duration=5h"])) == "all"
+    with pytest.raises(RestartError, match="strength_after_remesh"):
+        resume_simulation(ck, ["rheology.strength_after_remesh=new"])

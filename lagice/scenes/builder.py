@@ -949,10 +949,11 @@ BRANCH_FIXED = ("domain", "initial", "solver.dt", "run.start_date")
 
 
 def override_config_of(meta: dict) -> dict:
-    """The configuration of a checkpoint (``meta``), with the defaults of keys added since."""
-    from .config import override_config
+    """The configuration of a checkpoint (``meta``), with the defaults of keys added since, but
+    the legacy value of a key whose default changed since (:data:`~.config.LEGACY_FILL`)."""
+    from .config import override_config, with_legacy_values
 
-    return override_config(meta["config"], {})
+    return override_config(with_legacy_values(meta["config"]), {})
 
 
 def resume_simulation(checkpoint, overrides=None, progress: bool | None = None, config: dict | None = None

@@ -84,9 +84,11 @@ SCHEMA = {
         "strength_disorder": (NUM, None),
         # spatially correlated strength factor g = 1 + a(2Φ(G) − 1), G correlated over ℓ (0: none)
         "strength_correlation_m": (NUM, None), "strength_correlated_amplitude": (NUM, None),
-        # which elements get the law's C after a remesh: "all" (None: the default, recomputed from
-        # their current size) or "new" (kept elements keep theirs); StrengthLaw.after_remesh
-        "strength_after_remesh": (str, None),
+        # which elements get the law's C after a remesh: "new" (the default since 2026-11-28: kept
+        # elements keep theirs) or "all" (every element recomputed from its current size, as from
+        # 2026-11-24 to 2026-11-28; None, in the configurations of that code's checkpoints, means
+        # "all"); StrengthLaw.after_remesh
+        "strength_after_remesh": (str, "new"),
     },
     "solver": {
         "name": (str, "implicit"), "dt": (EXPR, None), "substeps": (int, None),
@@ -159,7 +161,7 @@ LEGACY_VALUES = {
     "rheology.strength_lab_scale_m": (None,),
     "rheology.strength_disorder": (None,),
     "rheology.strength_correlation_m": (None, 0.0, 0),  # 2026-11-26: no correlated strength field
-    "rheology.strength_after_remesh": (None, "all"),   # 2026-11-28: every element recomputed at a remesh
+    "rheology.strength_after_remesh": (None, "all"),   # before 2026-11-28: every element recomputed at a remesh
     "rheology.strength_correlated_amplitude": (None,),
     "rheology.stress_correction": ("origin",),       # 2026-11-24: scaling towards the origin
     "rheology.stress_correction_mean_fraction": (None,),
@@ -190,6 +192,26 @@ def absent_keys(view: dict, stored: dict | None) -> list[str]:
             out.append(table)
         elif isinstance(val, dict) and isinstance(stored[table], dict):
             out += [f"{table}.{k}" for k in val if k not in stored[table]]
+    return out
+
+
+#: keys whose default changed after they existed (or were added with a new default): a
+#: checkpoint's stored configuration that lacks one is read with this value, which makes the
+#: code do what the code that wrote it did (:func:`with_legacy_values`, used by every resume and
+#: branch), instead of the schema's new default. ``rheology.strength_after_remesh``: None
+#: means "all" (:func:`lagice.strength.from_config`), the behaviour before 2026-11-28.
+LEGACY_FILL = {"rheology.strength_after_remesh": None}
+
+
+def with_legacy_values(stored: dict) -> dict:
+    """A copy of a checkpoint's stored configuration with each key of :data:`LEGACY_FILL` that
+    it lacks set to its legacy value (tables it lacks are left alone: a component that was off
+    or did not exist). The copy is one level deep: ``stored`` is not changed."""
+    out = {k: (dict(v) if isinstance(v, dict) else v) for k, v in stored.items()}
+    for key, value in LEGACY_FILL.items():
+        table, _, name = key.partition(".")
+        if isinstance(out.get(table), dict) and name not in out[table]:
+            out[table][name] = value
     return out
 
 
