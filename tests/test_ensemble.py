@@ -478,12 +478,22 @@ def test_a_second_ensemble_on_the_same_folder_is_refused(ensemble_run, tmp_path)
     out = tmp_path / "out"
     shutil.copytree(ensemble_run["out"], out)
     lock = out / "ensemble.lock"
-    lock.write_text(json.dumps({"host": __import__("socket").gethostname(), "pid": os.getppid()}))  # alive
-    with pytest.raises(LagiceError, match="another lagice ensemble is running in this folder"):
-        Ensemble(spec_dict(), out).run(serial=True, retry_failed=False)
-    done = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True,
-                          check=True)
-    lock.write_text(json.dumps({"host": __import__("socket").gethostname(), "pid": int(done.stdout)}))  # stale
+    # another process holds the folder's lock (flock), as a running `lagice ensemble` does
+    holder = subprocess.Popen([sys.executable, "-c", "import sys; from pathlib import Path; "
+                               "from lagice.ensemble.core import _FolderLock; "
+                               "_FolderLock(Path(sys.argv[1])).__enter__(); "
+                               "print('held', flush=True); sys.stdin.read()", str(lock)],
+                              stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        with pytest.raises(LagiceError, match=rf"another lagice ensemble is running in this folder \(pid "
+                                              rf"{holder.pid} on "):
+            Ensemble(spec_dict(), out).run(serial=True, retry_failed=False)
+    finally:
+        holder.communicate("")  # its end drops the lock, as a killed process's does
+    assert lock.exists()  # left by the holder, which never released it: it blocks nothing
+    # a file naming a live pid but not locked (pid reuse, or a file copied from elsewhere) blocks nothing either
+    lock.write_text(json.dumps({"host": __import__("socket").gethostname(), "pid": os.getppid()}))
     s = Ensemble(spec_dict(), out).run(serial=True, retry_failed=False, plot=False)
     assert list(s["status"].values) == ["done", "done", "done", "failed"] and not lock.exists()
 

@@ -377,39 +377,65 @@ class _StopOnSignal:
 
 
 class _FolderLock:
-    """``DIR/ensemble.lock`` (host, pid) while an ensemble runs in DIR: a second
-    ``lagice ensemble`` on the same folder is refused instead of mixing runs. A
-    lock left by a process that no longer exists on this host is replaced."""
+    """``DIR/ensemble.lock`` while an ensemble runs in DIR: an exclusive ``flock`` on the
+    file, which holds the holder's host, pid and start time as JSON. A second ``lagice
+    ensemble`` on the same folder is refused at once, naming that process, instead of mixing
+    runs. The kernel drops the lock when its process ends, so a file left by a killed run
+    (or one naming a pid that this host has since given to another process) never blocks
+    the next one. The file is removed on release, while the lock is still held; a process
+    that locked the file just before it was removed sees that it holds a lock on a file no
+    longer in the folder and tries again."""
 
     def __init__(self, path: Path):
         self.path = path
         self.held = False
+        self._fd = None
 
     def __enter__(self):
-        me = {"host": socket.gethostname(), "pid": os.getpid()}
-        for _ in range(2):
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover - not a POSIX system
+            raise LagiceError(f"{self.path}: this system has no flock (fcntl); lagice does not run an ensemble "
+                              "unlocked") from None
+        me = {"host": socket.gethostname(), "pid": os.getpid(),
+              "started": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")}
+        for _ in range(10):
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
             try:
-                fd = os.open(self.path, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
-            except FileExistsError:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
                 try:
-                    other = json.loads(self.path.read_text())
-                except (OSError, json.JSONDecodeError):
+                    other = json.loads(os.read(fd, 4096).decode() or "{}")
+                except (OSError, ValueError):
                     other = {}
-                if other.get("host") == me["host"] and not _alive(other.get("pid")):
-                    self.path.unlink(missing_ok=True)  # stale: its process is gone
-                    continue
+                os.close(fd)
                 raise LagiceError(f"{self.path.parent}: another lagice ensemble is running in this folder "
-                                  f"(pid {other.get('pid')} on {other.get('host')}); wait for it, or delete "
-                                  f"{self.path} if that run is gone") from None
-            with os.fdopen(fd, "w") as f:
-                json.dump(me, f)
+                                  f"(pid {other.get('pid')} on {other.get('host')}, since {other.get('started')}); "
+                                  "wait for it to end, or stop it (SIGTERM to that process, or touch "
+                                  f"{self.path.parent / STOP_FILE})") from None
+            except OSError as exc:
+                os.close(fd)
+                raise LagiceError(f"{self.path}: cannot take the ensemble lock: {exc.strerror}") from None
+            try:
+                same = os.fstat(fd).st_ino == os.stat(self.path).st_ino
+            except FileNotFoundError:
+                same = False
+            if not same:  # removed by the holder that released it just now: lock the new file
+                os.close(fd)
+                continue
+            os.ftruncate(fd, 0)
+            os.write(fd, json.dumps(me).encode())
+            self._fd = fd
             self.held = True
             return self
-        raise LagiceError(f"{self.path}: cannot take the ensemble lock")
+        raise LagiceError(f"{self.path}: cannot take the ensemble lock (the file kept being replaced)")
 
     def __exit__(self, *exc):
         if self.held:
             self.path.unlink(missing_ok=True)
+            os.close(self._fd)  # drops the flock
+            self._fd = None
+            self.held = False
         return False
 
 
@@ -422,18 +448,6 @@ def _kill_local_workers(cluster) -> None:
         if isinstance(pid, int) and pid > 0:
             with contextlib.suppress(ProcessLookupError, PermissionError):
                 os.kill(pid, signal.SIGKILL)
-
-
-def _alive(pid) -> bool:
-    if not isinstance(pid, int) or pid <= 0:
-        return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
 
 
 class _Progress:
