@@ -939,8 +939,9 @@ def ensemble_lines(ens: dict) -> list[str]:
     for scene, e in ens.items():
         names = list(e["members"])
         c = e.get("carried_from")
-        lines += [f"**{scene}**", ""] + ([f"(From the report of {c['date']}, commit `{str(c['git_commit'])[:10]}`: "
-                                          "these runs were not remade.)", ""] if c else []) + [
+        lines += [f"**{scene}**", ""] + ([f"(Numbers from the report of {c['date']}, commit "
+                                          f"`{str(c['git_commit'])[:10]}`: the runs' folders are not kept, so they "
+                                          "were not analysed again.)", ""] if c else []) + [
                   "| metric | observed | " + " | ".join(names)
                   + " | median of members | members inside |", "|---|---|" + "---|" * (len(names) + 2)]
         for k, (lo, hi, _src, _n) in TARGETS.items():
