@@ -1697,6 +1697,16 @@ for _n, (_o, *_rest) in list(SPINUPS.items()):
     if _n != "shipped" and _o is not None:
         SPINUPS[_n] = (_pin_all(_o), *_rest)
 
+# --- 2026-11-28 (twenty-eighth session): the ±50 % runs with the shipped set --------------------
+# The sensitivity table of docs/validation.md for the set shipped since the switch: the closed basin's
+# validation month from the spin-up made with kept elements keeping their strength, one value changed
+# by ±50 %. Reported for what it shows; no value is chosen from it.
+for _key, _lo, _hi, _what in SENSITIVITY_CHANGES:
+    for _sign, _change in (("-50", _lo), ("+50", _hi)):
+        EXPERIMENTS[f"X10h-{_key}{_sign}-newc"] = (
+            "closed", NEWC + from_spinup("H1125-newc") + [_change], 10e3, 28,
+            f"{_what} {_sign.replace('-', '−')} %, 10 km, kept elements keep their strength (the shipped set)")
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
