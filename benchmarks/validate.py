@@ -125,14 +125,14 @@ SENSITIVITY_RESOLUTION_M = 10e3
 WIND_FACTOR_BAND = THORNDIKE_COLONY_WINTER["factor"]
 #: Since 2026-11-28 kept elements keep their strength at a remesh (rheology.strength_after_remesh =
 #: "new", the default), and the shipped spin-up state is the one made so (spinup-H1125-newc.npz):
-#: the Maxwell-EB runs are F10-hthick-newc / F10s-hthick-newc, EVP E10h-newc / E10hs-newc. The ±50 %
-#: runs were made with the set before (X10h-*, every element recomputed at a remesh) and are not
-#: remade: their rows are carried from the previous report, labelled (carry_sensitivity).
+#: the Maxwell-EB runs are F10-hthick-newc / F10s-hthick-newc, EVP E10h-newc / E10hs-newc, the ±50 %
+#: runs X10h-*-newc. A run whose folder is gone is carried from the previous report, labelled
+#: (carry_sensitivity, carry_ensembles).
 PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-newc", "strait_maxwell_eb": "F10s-hthick-newc",
-                "closed_evp": "E{evp}h-newc", "strait_evp": "E{evp}hs-newc", "sensitivity_base": "F10-hthick-1125",
-                "sensitivity_strength-50": "X10h-str-50", "sensitivity_strength+50": "X10h-str+50",
-                "sensitivity_drag-50": "X10h-drag-50", "sensitivity_drag+50": "X10h-drag+50",
-                "sensitivity_wind-50": "X10h-wind-50", "sensitivity_wind+50": "X10h-wind+50"}
+                "closed_evp": "E{evp}h-newc", "strait_evp": "E{evp}hs-newc", "sensitivity_base": "F10-hthick-newc",
+                "sensitivity_strength-50": "X10h-str-50-newc", "sensitivity_strength+50": "X10h-str+50-newc",
+                "sensitivity_drag-50": "X10h-drag-50-newc", "sensitivity_drag+50": "X10h-drag+50-newc",
+                "sensitivity_wind-50": "X10h-wind-50-newc", "sensitivity_wind+50": "X10h-wind+50-newc"}
 #: the weather ensemble of the flagship Maxwell-EB runs (--from-physics): the validation run
 #: (wind seed 2026, the scene's) and the same set-up under the winds of seeds 2027-2033 for
 #: the shipped pack (eight months since 2026-11-26), 2027-2029 for the pack shipped before
