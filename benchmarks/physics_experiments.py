@@ -141,6 +141,17 @@ def add_screen_20km(tag: str, changes: list, what: str) -> None:
     EXPERIMENTS[f"B20-hthick-{tag}"] = ("closed", changes + from_spinup(f"H20-{tag}"), 20e3, 28, what)
 
 
+def add_month_own_spinup(tag: str, changes: list, what: str) -> None:
+    """The 10 km validation month in both basins from its own 10 km spin-up with the same
+    ``changes``: spin-up ``H1125-{tag}`` (the thick-and-thin pack, 14 days) and runs
+    ``F10-hthick-{tag}`` / ``F10s-hthick-{tag}`` (28 days; the strait's ``what`` is prefixed
+    "strait: ")."""
+    SPINUPS[f"H1125-{tag}"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + changes, OUT / f"spinup-H1125-{tag}.npz",
+                               10e3)
+    EXPERIMENTS[f"F10-hthick-{tag}"] = ("closed", changes + from_spinup(f"H1125-{tag}"), 10e3, 28, what)
+    EXPERIMENTS[f"F10s-hthick-{tag}"] = ("strait", changes + from_spinup(f"H1125-{tag}"), 10e3, 28, f"strait: {what}")
+
+
 def add_weather_ensemble(tag: str, overrides: list, what: str, group: str, seeds, suffix: str = "") -> None:
     """The 10 km, 28-day runs of one set-up in both basins: ``F10-hthick-{tag}`` /
     ``F10s-hthick-{tag}`` (the scene's wind seed) and ``...-w{seed}`` for ``seeds``, with the
@@ -1416,11 +1427,7 @@ for _basin, _p in (("closed", "F10"), ("strait", "F10s")):
 # Predicted: (a) and (b) hold (beta 0.15-0.22, area 0.55-0.75); (c) fails: the half-shear area
 # above 8 % and both tails lighter than observed, 2 bands inside or fewer in each basin.
 EFFECTIVE = ["rheology.failure_stress=effective"]
-SPINUPS["H1125-eff"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE, OUT / "spinup-H1125-eff.npz", 10e3)
-EXPERIMENTS["F10-hthick-eff"] = ("closed", EFFECTIVE + from_spinup("H1125-eff"), 10e3, 28,
-                                 "the envelope judges the effective stress sigma/(1 - d), own spin-up")
-EXPERIMENTS["F10s-hthick-eff"] = ("strait", EFFECTIVE + from_spinup("H1125-eff"), 10e3, 28,
-                                  "strait: the envelope judges the effective stress sigma/(1 - d), own spin-up")
+add_month_own_spinup("eff", EFFECTIVE, "the envelope judges the effective stress sigma/(1 - d), own spin-up")
 # Two more months for the effective criterion (closed basin, the same spin-up H1125-eff, wind seeds
 # 2027, the windy month, and 2028, the calm one), stated 2026-11-28 11:03 UTC before their runs,
 # after the validation month (beta 0.189, rate 0.021 per day): beta is the criterion's, not the
@@ -1624,11 +1631,7 @@ ENSEMBLES["20 km, nominal criterion, closed, eight months"] = ["B20-hthick-own"]
 # against 3 (the |divergence| tail in, the shear tail out by 0.03). The prediction holds for the tails
 # and the rate, and fails by 0.004 on the strait's beta (+0.034) and by one band in the closed basin.
 NEWC = ["rheology.strength_after_remesh=new"]
-SPINUPS["H1125-newc"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + NEWC, OUT / "spinup-H1125-newc.npz", 10e3)
-EXPERIMENTS["F10-hthick-newc"] = ("closed", NEWC + from_spinup("H1125-newc"), 10e3, 28,
-                                  "kept elements keep their strength at a remesh, own spin-up")
-EXPERIMENTS["F10s-hthick-newc"] = ("strait", NEWC + from_spinup("H1125-newc"), 10e3, 28,
-                                   "strait: kept elements keep their strength at a remesh, own spin-up")
+add_month_own_spinup("newc", NEWC, "kept elements keep their strength at a remesh, own spin-up")
 # --- 2026-11-28 (twenty-eighth session): the eight months with kept elements keeping their C ---
 # Written 2026-11-28 13:58 UTC, before the runs. strength_after_remesh = "new" corrects the code's
 # behaviour (kept elements no longer jump by -15 % to +14 % at unrelated remeshes), so it becomes the
@@ -1670,12 +1673,7 @@ EXPERIMENTS["E10hs-newc"] = ("strait", from_spinup("H1125-newc") + EVP, 10e3, 28
 for _tag, _cap in (("cap95", "0.95"), ("cap97", "0.97")):
     add_screen_20km(f"eff-{_tag}", EFFECTIVE + [f"rheology.max_damage={_cap}"],
                     f"20 km: effective envelope, damage cap {_cap}, own spin-up")
-SPINUPS["H1125-effP"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + EFFECTIVE + PMAX,
-                         OUT / "spinup-H1125-effP.npz", 10e3)
-EXPERIMENTS["F10-hthick-effP"] = ("closed", EFFECTIVE + PMAX + from_spinup("H1125-effP"), 10e3, 28,
-                                  "effective envelope and neXtSIM's compressive term, own spin-up")
-EXPERIMENTS["F10s-hthick-effP"] = ("strait", EFFECTIVE + PMAX + from_spinup("H1125-effP"), 10e3, 28,
-                                   "strait: effective envelope and neXtSIM's compressive term, own spin-up")
+add_month_own_spinup("effP", EFFECTIVE + PMAX, "effective envelope and neXtSIM's compressive term, own spin-up")
 
 
 # --- 2026-11-28 (twenty-eighth session): rheology.strength_after_remesh became "new" by default ----
