@@ -377,6 +377,55 @@ def test_node_kernel_matches_general_2x2_solve():
     assert np.array_equal(vsum, vel)
 
 
+def test_fused_node_setup_equals_the_separate_passes_bit_for_bit():
+    """The stepper's one-pass set-up (``NODE_SETUP``, serial and parallel builds) gives the
+    adjacency weights, the per-node constants and the lumped mass of
+    ``NodeSystem.setup`` + ``node_constants`` bit for bit, on a gmsh mesh with a non-uniform
+    thickness, wind stress, Coriolis parameter, drag and current: the published runs stay
+    reproducible by the code that ships."""
+    from lagice.fem import NodeSystem
+    from lagice.forces import ExplicitTerms
+    from lagice.solvers.explicit import NODE_SETUP, node_constants
+
+    poly, _ = rectangle_domain(60e3, 40e3)
+    mesh = generate_mesh(poly, 5e3)
+    nodes = mesh.nodes.copy()
+    rng = np.random.default_rng(3)
+    mesh.nodes[:] = nodes + rng.normal(0, 300.0, nodes.shape)  # non-uniform geometry
+    ns = NodeSystem(mesh)
+    n, m = mesh.n_nodes, mesh.n_elements
+    h = rng.uniform(0.1, 3.0, m)
+    terms = ExplicitTerms(rng.normal(0, 0.2, (n, 2)), rng.uniform(4.0, 6.0, n), rng.normal(0, 0.1, (n, 2)),
+                          rng.uniform(1.2e-4, 1.45e-4, n))
+    rho, dt_sub = 917.0, 3.7
+    su = ns.setup(h, terms, rho, dt_sub, True)
+    nc_ref = node_constants(su.m_dt, su.cda, su.mass, terms.coriolis, su.fext, terms.current)
+    ptr, elems, local = mesh.node_elements
+    for build in NODE_SETUP:
+        w, nc, mass = build(ptr, elems, local, ns.area, h, ns.b, ns.c, rho, dt_sub, terms.tau, terms.drag_coef,
+                            terms.coriolis, terms.current)
+        assert np.array_equal(w, su.w)
+        assert np.array_equal(nc, nc_ref)
+        assert np.array_equal(mass, su.mass)
+    assert np.ptp(su.mass) > 0 and np.ptp(nc_ref[:, 2]) > 0  # the inputs did vary
+
+
+def test_moduli_from_a_shared_concentration_factor_equal_the_rheology_functions():
+    """``MaxwellEB.moduli`` with the stepper's shared exp(−c*(1−A)) equals the moduli
+    computed with their own exponentials (``young_modulus``, ``relaxation_time``) bit for
+    bit, for α = 4 and 5."""
+    from lagice.params import MaxwellEBParams
+
+    rng = np.random.default_rng(4)
+    d, a = rng.uniform(0, 0.99, 5000), rng.uniform(0.5, 1.0, 5000)
+    for alpha in (4.0, 5.0):
+        rh = MaxwellEB(MaxwellEBParams(alpha=alpha))
+        E, lam = rh.moduli(d, a)
+        E2, lam2 = rh.moduli(d, a, rh.concentration_factor(a))
+        assert np.array_equal(E, E2) and np.array_equal(lam, lam2)
+        assert np.ptp(E) > 0
+
+
 def test_patch_uniform_strain_rate(plate_mesh):
     """Linear velocity prescribed on the whole boundary of an irregular mesh:
     interior forces cancel, velocity stays linear, stress follows the sub-step

@@ -309,11 +309,23 @@ class MaxwellEB:
     def E0(self) -> float:
         return self.params.E0
 
-    def moduli(self, damage, concentration):
-        """(E [Pa], λ [s]) per element."""
+    def concentration_factor(self, concentration):
+        """g = exp(−c*(1−A)) [-] per element, as :func:`young_modulus` computes it."""
+        return np.exp(-self.params.concentration_c * (1.0 - np.asarray(concentration, np.float64)))
+
+    def moduli(self, damage, concentration, conc_factor=None):
+        """(E [Pa], λ [s]) per element. ``conc_factor``: g of :meth:`concentration_factor`
+        when the caller has it (the explicit stepper: one exponential per step instead of
+        three); the same numbers bit for bit as :func:`young_modulus` and
+        :func:`relaxation_time`, which evaluate the same expression for g."""
         p = self.params
-        E = young_modulus(p.E0, damage, concentration, p.concentration_c)
-        lam = relaxation_time(p.relaxation_time_s, damage, concentration, p.concentration_c, p.alpha)
+        if conc_factor is None:
+            E = young_modulus(p.E0, damage, concentration, p.concentration_c)
+            lam = relaxation_time(p.relaxation_time_s, damage, concentration, p.concentration_c, p.alpha)
+            return E, lam
+        x = 1.0 - damage
+        E = p.E0 * x * conc_factor
+        lam = p.relaxation_time_s * (x * conc_factor) ** (p.alpha - 1.0)
         return E, lam
 
     def damage_time(self, element_size_m):

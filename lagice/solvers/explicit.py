@@ -119,6 +119,55 @@ def node_constants(m_dt, cda, mass, coriolis, fext, current):
     return nc
 
 
+def _node_setup(ptr, elems, local, area, h, b, c, rho, dt_sub, tau, drag_coef, coriolis, current):
+    """The per-node set-up of one outer step in one pass over the node→element adjacency:
+    the adjacency weights ``w`` (nnz, 2) of :func:`lagice.fem._adjacency_weights` (thickness
+    weighted), the per-node constants ``nc`` (n, 8) of :func:`node_constants` and the lumped
+    mass [kg] (n,), from thickness h [m], ρ [kg m-3], the sub-step Δt_s [s], the wind stress
+    τ [N m-2] (n, 2), ρw Cw (n,), f [s-1] (n,) and the current [m s-1] (n, 2).
+
+    Every value is computed with the same operations, in the same order, as the separate
+    passes it replaces (:meth:`lagice.fem.NodeSystem.setup`: two lumped masses, the weights,
+    m/Δt_s, a τ, a ρw Cw; then :func:`node_constants`), so the results are the same bit for
+    bit (compiled without ``fastmath``: no fused multiply-adds); a test checks it. One pass
+    reads the adjacency once instead of three times and writes no temporary arrays:
+    docs/benchmarks.md, "2026-11-28, twenty-ninth session"."""
+    n = ptr.shape[0] - 1
+    w = np.empty((elems.shape[0], 2))
+    nc = np.empty((n, 8))
+    mass = np.empty(n)
+    for i in prange(n):
+        sm = 0.0
+        sa = 0.0
+        for p in range(ptr[i], ptr[i + 1]):
+            e = elems[p]
+            k = local[p]
+            ae = area[e]
+            sm += (rho * h[e]) * ae
+            sa += 1.0 * ae
+            a = ae * h[e]
+            w[p, 0] = a * b[e, k]
+            w[p, 1] = a * c[e, k]
+        mi = sm / 3.0
+        na = sa / 3.0
+        mass[i] = mi
+        nc[i, 0] = mi / dt_sub
+        nc[i, 1] = drag_coef[i] * na
+        nc[i, 2] = 0.5 * mi * coriolis[i]
+        nc[i, 3] = tau[i, 0] * na
+        nc[i, 4] = tau[i, 1] * na
+        nc[i, 5] = current[i, 0]
+        nc[i, 6] = current[i, 1]
+        nc[i, 7] = 0.0
+    return w, nc, mass
+
+
+node_setup_kernel = njit(cache=True, parallel=True)(_node_setup)
+node_setup_kernel_serial = serial_copy(_node_setup)
+#: (serial, parallel) builds of :func:`_node_setup`
+NODE_SETUP = (node_setup_kernel_serial, node_setup_kernel)
+
+
 def _node_velocity(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, w_time):
     """One semi-implicit momentum sub-step in place on ``vel`` (n, 2) (module doc, step 1).
 
@@ -788,7 +837,9 @@ class ExplicitSolver:
         ns = self.nodes
         mesh, p = ns.mesh, self.rheology.params
         t0 = time.perf_counter()
-        E, lam = self.rheology.moduli(state.damage, state.concentration)
+        # g = exp(−c*(1−A)) once: the moduli and the element kernel share it
+        conc_factor = self.rheology.concentration_factor(state.concentration)
+        E, lam = self.rheology.moduli(state.damage, state.concentration, conc_factor)
         E_stab = stability_modulus(p, E, state.concentration)
         E_max = float(E_stab.max()) if len(E) else p.E0
         self.dx_eff = (effective_dx(self.dx_min, E_max, float((E_stab / ns.area).max()))
@@ -804,9 +855,13 @@ class ExplicitSolver:
         kt["forcing"] = t1 - t0
 
         tri = mesh.triangles
-        su = ns.setup(state.thickness, terms, p.rho_ice, dt_s, True)
-        par = su.parallel
-        nc = node_constants(su.m_dt, su.cda, su.mass, terms.coriolis, su.fext, terms.current)
+        par = ns.parallel_for(mesh)
+        ptr, elems, local = mesh.node_elements
+        # NodeSystem.setup and node_constants in one pass, bit for bit (_node_setup)
+        w_adj, nc, _mass = NODE_SETUP[int(par)](ptr, elems, local, ns.area,
+                                                np.ascontiguousarray(state.thickness, np.float64), ns.b, ns.c,
+                                                float(p.rho_ice), dt_s, terms.tau, terms.drag_coef, terms.coriolis,
+                                                terms.current)
         e_dt = dt_s * E
         gamma = lam / (lam + dt_s)
         rh = self.rheology
@@ -825,7 +880,6 @@ class ExplicitSolver:
         vel = np.ascontiguousarray(state.velocity, np.float64).copy()
         sigma = np.array(state.stress, np.float64, order="C")  # copies: the state is left
         damage = np.array(state.damage, np.float64)  # untouched if the step fails
-        conc_factor = np.exp(-p.concentration_c * (1.0 - np.asarray(state.concentration, np.float64)))
         coh = np.ascontiguousarray(state.cohesion, np.float64)
         k_c, k_t = envelope_factors(rh)
         flag = np.zeros(mesh.n_elements, np.int8)
@@ -834,7 +888,7 @@ class ExplicitSolver:
         kt["setup"] = t2 - t1
 
         ptr32, elems32, tri32 = self._indices(mesh)
-        args = (vel, vel_sum, sigma, ptr32, elems32, su.w, nc, terms.cos_turn, terms.sin_turn, ns.fixed, pres0,
+        args = (vel, vel_sum, sigma, ptr32, elems32, w_adj, nc, terms.cos_turn, terms.sin_turn, ns.fixed, pres0,
                 pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, k_c, k_t, self.td, heal, e_dt, gamma, pmax,
                 keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0,
                 p.relaxation_time_s, float(p.alpha), flag)
@@ -849,7 +903,7 @@ class ExplicitSolver:
         if self.nonlocal_weights is not None:
             nl_ptr, nl_idx, nl_w = self.nonlocal_weights.update(tri, mesh.nodes, ns.area)
             n_capped = SUBSTEPS_NONLOCAL[int(par)](
-                n_sub, vel, vel_sum, sigma, ptr32, elems32, su.w, nc, terms.cos_turn, terms.sin_turn, ns.fixed,
+                n_sub, vel, vel_sum, sigma, ptr32, elems32, w_adj, nc, terms.cos_turn, terms.sin_turn, ns.fixed,
                 pres0, pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, self.td, heal, e_dt, gamma, dt_s, kxx,
                 kxy, kss, rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), flag, nl_ptr,
                 nl_idx, nl_w, np.empty(mesh.n_elements, np.float64), np.empty(mesh.n_elements, np.int8))
