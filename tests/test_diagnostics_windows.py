@@ -252,3 +252,36 @@ def test_beta_components_count_folded_elements_apart_from_remeshed_ones(eddy_run
     ref = window_statistics(eddy_run, window_days=3.0, coast_buffer_km=60.0, start_day=0.0)
     assert row["folded_elements"] == ref["n_elements_folded"] > 0
     assert row["remeshed_elements"] == 0 and row["interior_area_remeshed_fraction"] == 0.0
+
+
+def test_ensemble_member_statistics_are_those_of_lagice_diagnose(eddy_run, shear_run):
+    """An ensemble member's statistics (``lagice.ensemble.member.member_diagnostics``: windows
+    ending at the last snapshot) go through the windows of ``lagice diagnose --window-days``:
+    the same numbers for the same windows. On the eddy, whose ring folds in the mid-window
+    geometry, they leave the folded elements out and count them (the ensemble's own path
+    used to fail there with a diagnostics error and NaN statistics)."""
+    from lagice.ensemble.member import DIAG_KEYS, member_diagnostics
+
+    def medians(res):
+        return {k: float(np.median([np.nan if w["interior"][k] is None else w["interior"][k]
+                                    for w in res["windows"]])) for k in DIAG_KEYS}
+
+    d = member_diagnostics(eddy_run, {"window_s": 3 * DAY, "windows": 1, "coast_buffer_km": 60.0})
+    res = window_statistics(eddy_run, window_days=3.0, coast_buffer_km=60.0, start_day=0.0)
+    assert d["diag_status"] == "ok"
+    assert d["diag_n_folded"] == res["n_interior_folded"] > 0
+    assert d["diag_n_elements"] == res["windows"][0]["n_elements"]
+    for k, v in medians(res).items():
+        assert d[k] == pytest.approx(v, rel=1e-12, abs=0.0), k
+    # two 3-day windows ending at day 7 are days 1-4 and 4-7: window_statistics from day 1
+    d2 = member_diagnostics(shear_run, {"window_s": 3 * DAY, "windows": 2, "coast_buffer_km": 60.0})
+    res2 = window_statistics(shear_run, window_days=3.0, coast_buffer_km=60.0, start_day=1.0)
+    assert d2["diag_n_windows"] == 2 and d2["diag_n_folded"] == 0
+    m2 = medians(res2)
+    nan_keys = [k for k in DIAG_KEYS if not np.isfinite(m2[k])]  # a uniform shear has no PDF tail, no R²
+    assert nan_keys and d2["diag_status"] == f"partial: not computable: {', '.join(nan_keys)}"
+    for k, v in m2.items():
+        assert d2[k] == pytest.approx(v, rel=1e-12, abs=0.0, nan_ok=True), k
+    # a buffer that leaves too few elements is a status, not an exception
+    d3 = member_diagnostics(shear_run, {"window_s": 3 * DAY, "windows": 1, "coast_buffer_km": 500.0})
+    assert d3["diag_status"].startswith("too_few_elements:") and "coast_buffer_km = 500" in d3["diag_status"]

@@ -154,15 +154,23 @@ def member_diagnostics(run_dir, analysis: dict) -> dict:
     """Deformation statistics (``lagice.diagnostics.summarise``) of the run's last
     window(s): medians over ``analysis["windows"]`` back-to-back windows of
     ``analysis["window_s"]`` (default: the span of the last two snapshots) ending
-    at the last snapshot. Keys: :data:`DIAG_KEYS` (NaN when not computable) and
-    ``diag_status`` ("ok" or why not), ``diag_window_s``, ``diag_n_windows``,
-    ``diag_n_elements``."""
+    at the last snapshot. Each window goes through
+    :func:`lagice.diagnostics.windows.window_arrays`, the path of ``lagice diagnose`` and
+    ``benchmarks/validate.py``: the elements a remesh replaced during the window and those
+    whose mid-window geometry is inverted are left out (and counted), and the coast buffer
+    is measured on the window's first mesh, so a member's statistics are those
+    ``lagice diagnose --window-days`` gives for the same windows. Keys: :data:`DIAG_KEYS`
+    (NaN when not computable) and ``diag_status`` ("ok" or why not), ``diag_window_s``,
+    ``diag_n_windows``, ``diag_n_elements`` (the fewest elements in a window),
+    ``diag_n_folded`` (inverted mid-window elements left out, summed over the windows)."""
     from ..diagnostics import summarise
-    from ..diagnostics.faults import interior_triangles
-    from ..io.snapshots import load_window, read_index
+    from ..diagnostics.windows import WindowError, window_arrays
+    from ..errors import ConfigError
+    from ..io.snapshots import read_index
 
     out = {k: math.nan for k in DIAG_KEYS}
-    out.update({"diag_status": "ok", "diag_window_s": math.nan, "diag_n_windows": 0, "diag_n_elements": 0})
+    out.update({"diag_status": "ok", "diag_window_s": math.nan, "diag_n_windows": 0, "diag_n_elements": 0,
+                "diag_n_folded": 0})
     try:
         idx = read_index(run_dir)
     except Exception as exc:  # noqa: BLE001 - reported, not raised
@@ -190,21 +198,17 @@ def member_diagnostics(run_dir, analysis: dict) -> dict:
     out["diag_window_s"] = window
     buffer_m = 1e3 * float(analysis.get("coast_buffer_km", 0.0))
     per = {k: [] for k in DIAG_KEYS}
-    n_el = []
+    n_el, n_folded = [], 0
     try:
         for t0, t1 in zip(starts, ends):
-            w = load_window(run_dir, t0, t1)
-            xy0, xy1, tri = w["xy0"], w["xy1"], w["triangles"]
-            if w["fixed_mesh"]:  # a fixed (Eulerian) mesh: displacement from the mean velocity
-                xy1 = xy0 + 0.5 * (w["velocity0"] + w["velocity1"]) * w["dt_s"]
-            if buffer_m > 0:
-                keep = interior_triangles(*w["start_mesh"], buffer_m)[w["kept_elements"]]
-                tri = tri[keep]
-            if tri.shape[0] < 10:
-                out["diag_status"] = (f"too_few_elements: {tri.shape[0]} element(s) in the window "
-                                      f"(coast buffer {buffer_m / 1e3:g} km)")
+            try:
+                xy0, xy1, tri, dt, info = window_arrays(run_dir, t0, t1, buffer_m)
+            except (ConfigError, WindowError) as exc:  # too few elements (inside the buffer, or followable)
+                out["diag_status"] = f"too_few_elements: {exc}"
                 return out
-            s = summarise(xy0, xy1, tri, w["dt_s"])
+            n_folded += info["n_interior_folded"]
+            tri = tri[info["interior"]]
+            s = summarise(xy0, xy1, tri, dt)
             s.pop("_arrays", None)
             for k in DIAG_KEYS:
                 v = s.get(k)
@@ -221,6 +225,7 @@ def member_diagnostics(run_dir, analysis: dict) -> dict:
         out["diag_status"] = f"partial: not computable: {', '.join(missing)}"
     out["diag_n_windows"] = n
     out["diag_n_elements"] = int(min(n_el))
+    out["diag_n_folded"] = int(n_folded)
     return out
 
 

@@ -87,6 +87,10 @@ def summary_dataset(records: list[dict], spec_info: dict) -> xr.Dataset:
                            {"units": "s", "long_name": "length of each analysis window"})
     ds["diag_n_windows"] = ("member", np.array([int(d.get("diag_n_windows", 0)) for d in diag], np.int32),
                             {"units": "1", "long_name": "number of analysis windows"})
+    ds["diag_n_folded"] = ("member", np.array([int(d.get("diag_n_folded", 0)) for d in diag], np.int32),
+                           {"units": "1", "long_name": "elements inside the coast buffer left out of the statistics "
+                                                       "because their mid-window geometry is inverted, summed over "
+                                                       "the analysis windows (as lagice diagnose does)"})
     ds["overrides"] = ("member", np.array([json.dumps(r.get("overrides", {}), sort_keys=True, default=str)
                                            for r in records], dtype=object),
                        {"long_name": "the member's own overrides (JSON, dotted keys)"})
