@@ -231,16 +231,36 @@ def _plot(args) -> int:
 
     snaps = snapshot_dir(args.output)
     run_dir = snaps.parent if snaps.name == "snapshots" else snaps
+    _note_if_running(run_dir, snaps, "figure", "the run draws its own figure again when it ends")
     summary = None
     if (run_dir / "summary.json").exists():
         summary = json.loads((run_dir / "summary.json").read_text())
     cfg = _run_config(snaps)
     png = plot_scene(cfg, run_dir, summary)
     if args.png and png is not None:
-        Path(png).replace(args.png)
+        try:
+            Path(png).replace(args.png)
+        except OSError as exc:
+            raise LagiceError(f"cannot write --png {args.png}: {exc.strerror}") from None
         png = Path(args.png)
     print(f"  plot: {Path(png).resolve() if png else '(this scene has no plot)'}")
     return 0
+
+
+def _note_if_running(run_dir: Path, snaps: Path, what: str, after: str) -> None:
+    """Say so when a process still runs into ``run_dir`` (its lock is held: a run or a resume
+    still going): the commands that read a run folder work beside it, on the snapshots
+    written so far (each snapshot and the index are written whole, by atomic renames), and
+    what they write is written whole too (:func:`lagice.io.cf.save_figure_atomic`)."""
+    from .io.snapshots import read_index
+    from .rundir import running_holder
+
+    holder = running_holder(run_dir)
+    if holder is None:
+        return
+    last = read_index(snaps)[-1]
+    log.info(f"the run in {run_dir}/ is still going ({holder}): this {what} covers its snapshots up to day "
+             f"{last['time_s'] / 86400:.3f} (step {last['step']}); {after}")
 
 
 def _run_config(snaps: Path) -> dict:
@@ -312,6 +332,8 @@ def _diagnose(args) -> int:
     index = read_index(snaps)
     if len(index) < 2:
         raise LagiceError(f"{snaps}: need two snapshots to diagnose deformation (found {len(index)})")
+    _note_if_running(snaps.parent if snaps.name == "snapshots" else snaps, snaps, "diagnosis",
+                     "run it again after the run ends for the whole run")
     out = Path(args.out or snaps.parent / "diagnostics")
     if args.window_days is not None:
         return _diagnose_windows(args, snaps, out, window_statistics)
@@ -349,13 +371,21 @@ def _diagnose_drift(args) -> int:
     """``--wind-factor``: the drifters' daily velocities fitted to the wind along their tracks
     (Thorndike and Colony 1982; docs/diagnostics.md §13) -> ``drift_response.json``."""
     from .diagnostics.drift import run_drift_response
+    from .io.cf import write_text_atomic
+    from .io.snapshots import snapshot_dir
 
     run = Path(args.output)
+    try:
+        snaps = snapshot_dir(run)
+    except LagiceError:
+        snaps = None  # run_drift_response names what is missing
+    if snaps is not None:
+        _note_if_running(run, snaps, "fit", "run it again after the run ends for the whole run")
     res = run_drift_response(run)
     out = Path(args.out or run / "diagnostics")
     out.mkdir(parents=True, exist_ok=True)
     path = out / "drift_response.json"
-    path.write_text(json.dumps(res, indent=1))
+    write_text_atomic(path, json.dumps(res, indent=1))
     f = res["fit"]
     sp = res["factor_5_95_over_drifters"]
     side = "left" if f["angle_deg"] > 0 else "right"
@@ -372,11 +402,13 @@ def _diagnose_drift(args) -> int:
 
 
 def _diagnose_windows(args, snaps, out, window_statistics) -> int:
+    from .io.cf import write_text_atomic
+
     res = window_statistics(snaps, args.window_days, args.coast_buffer_km, args.start_day, args.end_day,
                             rgps_tracking_error_m=args.rgps_error_m)
     out.mkdir(parents=True, exist_ok=True)
     path = out / "window_statistics.json"
-    path.write_text(json.dumps(res, indent=1, default=_json_default))
+    write_text_atomic(path, json.dumps(res, indent=1, default=_json_default))
     print(f"  {len(res['windows'])} back-to-back windows of {args.window_days:g} days from day {args.start_day:g}, "
           f"elements >= {args.coast_buffer_km:g} km from the boundary -> {path.resolve()}")
     for w in res["skipped"]:

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .io.cf import save_figure_atomic
+
 
 def _tri(ds):
     import matplotlib.tri as mtri
@@ -80,5 +82,5 @@ def plot_run(snap_dir, png_path, summary: dict | None = None, trajectories=None)
     lines.append(f"snapshots: {len(index)} (mesh epochs {index[0]['mesh_epoch']}–{index[-1]['mesh_epoch']})")
     ax.text(0.0, 1.0, "\n".join(lines), va="top", family="monospace", fontsize=9)
     fig.tight_layout()
-    fig.savefig(png_path, dpi=100)
+    save_figure_atomic(fig, png_path, dpi=100)
     return Path(png_path)

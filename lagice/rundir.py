@@ -45,7 +45,8 @@ RUN_ENTRIES = ("snapshots", "checkpoints", "summary.json", "timeseries.nc")
 #: what a run writes into its folder besides RUN_ENTRIES and the marker (``{scene}``: the scene name)
 RUN_OUTPUTS = ("drifters.nc", "{scene}.png")
 #: temporary files of the atomic writers (``*.tmp`` then ``os.replace``)
-TEMP_GLOBS = ("*.tmp", "snapshots/*.tmp", "snapshots/*.tmp.vtu", "checkpoints/*.tmp-*")
+TEMP_GLOBS = ("*.tmp", ".*.tmp.png", "snapshots/*.tmp", "snapshots/*.tmp.vtu", "diagnostics/*.tmp",
+              "diagnostics/.*.tmp.png", "checkpoints/*.tmp-*")
 
 log = logging.getLogger("lagice")
 
@@ -442,6 +443,35 @@ class RunLock:
         except OSError:
             return False
         return True
+
+
+def running_holder(folder) -> str | None:
+    """'pid P on host H, since T' of the process that holds the run lock of ``folder`` now
+    (a run still going, or a resume), else None (no lock file, or a lock left by a run that
+    ended or was killed: the kernel dropped it). For the commands that only read a run
+    folder (``lagice plot``, ``lagice diagnose``), which may run beside the run: they say
+    that their figure covers the run so far. The probe is a non-blocking *shared* flock
+    that is released at once: it never waits, and a run that starts in the same
+    microseconds is the only one that can see it (it is then refused as locked, with
+    nothing written)."""
+    import fcntl
+
+    path = Path(folder) / LOCK
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_CLOEXEC)
+    except OSError:
+        return None
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        except BlockingIOError:
+            return _lock_holder(fd)
+        except OSError:
+            return None  # a file system without locks: no run can hold one there either
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        return None
+    finally:
+        os.close(fd)
 
 
 def _lock_holder(fd) -> str:

@@ -115,3 +115,38 @@ def test_cli_diagnose_real_output(tmp_path):
     assert res40["n_elements"] == int(np.sum(dist >= 40e3)) < res["n_elements"]
     bad = run_cli("diagnose", str(out), "--coast-buffer-km", "500")
     assert bad.returncode == 2 and "use a smaller buffer" in bad.stderr
+
+
+def test_plot_and_diagnose_beside_a_run_that_is_still_going(tmp_path):
+    """``lagice plot`` and ``lagice diagnose`` only read a run folder: beside a process that
+    holds its lock (here a real holder process of ``lagice.rundir.RunLock``, the lock a run
+    holds while it runs) they work on the snapshots written so far, say that the run is
+    still going (naming its pid), and write their files whole (through a temporary file and
+    a rename: none is left behind). Once the holder is gone they say nothing of it."""
+    out = tmp_path / "run"
+    r = run_cli("run", "shear_box", "--out", str(out), "--set", "run.duration=3000.0",
+                "--set", "solver.dt=100.0", "--set", "output.every=1500.0",
+                "--set", "domain.resolution_m=25e3", "--set", "lagrangian.enabled=true",
+                "--set", 'boundary.top.u="2.0*minimum(1.0, t/600.0)"')
+    assert r.returncode == 0, r.stderr
+    holder = subprocess.Popen([sys.executable, "-c", "import sys; from lagice.rundir import RunLock; "
+                               "RunLock(sys.argv[1]).acquire(); print('held', flush=True); sys.stdin.read()",
+                               str(out)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        p = run_cli("plot", str(out))
+        assert p.returncode == 0, p.stderr
+        assert "still going" in p.stdout and f"pid {holder.pid}" in p.stdout and "day 0.035" in p.stdout
+        png = out / "shear_box.png"
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 10_000
+        d = run_cli("diagnose", str(out))
+        assert d.returncode == 0, d.stderr
+        assert "still going" in d.stdout and f"pid {holder.pid}" in d.stdout
+        assert json.loads((out / "diagnostics" / "diagnostics.json").read_text())["dt_s"] == 1500.0
+        assert not [q for q in out.rglob("*") if ".tmp" in q.name]
+    finally:
+        holder.stdin.close()
+        holder.wait(timeout=60)
+    again = run_cli("plot", str(out))
+    assert again.returncode == 0, again.stderr
+    assert "still going" not in again.stdout

@@ -8,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
+from lagice.io.cf import save_figure_atomic
+
 
 def _figure(width_in=6.0, height_in=4.5, ncols=1):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -47,7 +49,7 @@ def plot_scaling(x, mean, fit, path, xlabel, title):
     ax.legend()
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
-    fig.savefig(Path(path), dpi=120)
+    save_figure_atomic(fig, path, dpi=120)
     return Path(path)
 
 
@@ -78,7 +80,7 @@ def plot_pdfs(pdfs, tails, path):
         ax.legend()
         ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
-    fig.savefig(Path(path), dpi=120)
+    save_figure_atomic(fig, path, dpi=120)
     return Path(path)
 
 
@@ -105,5 +107,5 @@ def plot_map(nodes_xy, triangles, values_s, path, title="log10 total deformation
     ax.set_ylabel("y (km)")
     ax.set_title(title)
     fig.tight_layout()
-    fig.savefig(Path(path), dpi=120)
+    save_figure_atomic(fig, path, dpi=120)
     return Path(path)

@@ -21,6 +21,7 @@ from lagice.diagnostics.statistics import (
 )
 from lagice.diagnostics.strain import GEOMETRIES, _lagrangian
 from lagice.errors import ConfigError
+from lagice.io.cf import write_text_atomic
 
 SCHEMA_VERSION = 1
 
@@ -243,7 +244,7 @@ def write_json(summary, path):
     clean = {k: v for k, v in summary.items() if not k.startswith("_")}
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(_jsonable(clean), indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
+    write_text_atomic(path, json.dumps(_jsonable(clean), indent=2, ensure_ascii=False) + "\n")
     return path
 
 

@@ -101,6 +101,30 @@ def write_netcdf_atomic(ds: xr.Dataset, path: Path) -> Path:
     return path
 
 
+def write_text_atomic(path, text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` through a temporary file and an atomic rename: a
+    reader (or a second writer: ``lagice diagnose`` beside a run) sees the old file or the
+    new one, never a part."""
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    with atomic_write_errors(path, tmp):
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, path)
+    return path
+
+
+def save_figure_atomic(fig, path, **savefig_kw) -> Path:
+    """``fig.savefig(path)`` through a temporary file (named ``.NAME.tmp.SUFFIX``, so that
+    matplotlib keeps the format of ``path``) and an atomic rename: a run that redraws its
+    figure at its end and ``lagice plot`` beside it never leave a half-written PNG."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
+    with atomic_write_errors(path, tmp):
+        fig.savefig(tmp, **savefig_kw)
+        os.replace(tmp, path)
+    return path
+
+
 class atomic_write_errors:
     """Context manager for a write through ``tmp``: on failure the temporary file is
     removed and the error becomes an :class:`~lagice.errors.OutputError` naming

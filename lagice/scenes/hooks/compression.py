@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...io.cf import save_figure_atomic
 from ...io.timeseries import diagnostic
 
 _EDGE_CACHE = {}
@@ -129,5 +130,5 @@ def plot(run_dir, png_path, summary=None) -> Path:
         b.set_yticks([])
         col += 2
     fig.tight_layout()
-    fig.savefig(png_path, dpi=110)
+    save_figure_atomic(fig, png_path, dpi=110)
     return Path(png_path)
