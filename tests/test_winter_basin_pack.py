@@ -196,14 +196,13 @@ def test_new_ice_undamaged_through_the_scene(tmp_path):
 
 
 @pytest.mark.parametrize("sets,fragment", [
-    ({"thermo.enabled": False, "healing.law": "constant", "forcing.air_temperature": None},
-     "thermo.new_ice_undamaged = true but thermo.enabled = false"),
     ({"solver.name": "evp", "rheology.law": "viscous_plastic", "healing.law": "none"},
      "thermo.new_ice_undamaged = true: rheology.law = 'viscous_plastic' has no damage"),
 ])
 def test_new_ice_undamaged_refused_where_it_would_do_nothing(monkeypatch, sets, fragment):
-    """Without thermodynamics no new ice forms, and the viscous-plastic rheology has no damage:
-    the setting is refused before meshing, with the key named."""
+    """The viscous-plastic rheology has no damage: the setting is refused before meshing, with
+    the key named. (With thermodynamics off it is named in the unused-keys warning instead:
+    tests/test_workflow.py::test_unused_keys_of_each_component_and_kind.)"""
     from lagice.errors import ConfigError
     from lagice.scenes import builder, config
 

@@ -332,10 +332,10 @@ def unused_keys(cfg: dict) -> list[tuple[str, object, str]]:
     cohesion from the strength law or from ``initial.cohesion_pa`` (``cohesion_min/max_pa``),
     no compressive term (its exponent), ``solver.parallel`` on the GPU, keys of another
     ``domain.kind``, a forcing grid no forcing kind samples, drag without the forces it
-    belongs to, an air temperature nothing reads, ``[remesh.params]`` and ``[thermo.params]``
-    with their component off. Keys that are refused instead
-    (``thermo.new_ice_undamaged`` without thermodynamics, ``healing.params``, the strength-law keys under
-    "uniform", keys of the other rheology law...) are checked where they are refused;
+    belongs to, an air temperature nothing reads, ``[remesh.params]``, ``[thermo.params]`` and
+    ``thermo.new_ice_undamaged`` with their component off, ``[healing.params]`` under a healing law
+    that takes none ("constant", "none"). Keys that are refused instead (the strength-law keys
+    under "uniform", keys of the other rheology law...) are checked where they are refused;
     Maxwell-EB keys under the viscous-plastic law by :func:`check_other_law_keys`."""
     out = []
 
@@ -349,8 +349,15 @@ def unused_keys(cfg: dict) -> list[tuple[str, object, str]]:
         add("remesh", ("min_angle_deg",), "remeshing is off: remesh.enabled = false")
         if cfg["remesh"]["params"]:  # a scene's [remesh.params] with remeshing switched off by --set
             out.append(("remesh.params", cfg["remesh"]["params"], "remeshing is off: remesh.enabled = false"))
-    if not cfg["thermo"]["enabled"] and cfg["thermo"]["params"]:
-        out.append(("thermo.params", cfg["thermo"]["params"], "thermodynamics is off: thermo.enabled = false"))
+    if not cfg["thermo"]["enabled"]:
+        if cfg["thermo"]["params"]:
+            out.append(("thermo.params", cfg["thermo"]["params"], "thermodynamics is off: thermo.enabled = false"))
+        add("thermo", ("new_ice_undamaged",), "thermodynamics is off (thermo.enabled = false): no new ice forms")
+    if cfg["healing"]["law"] in ("constant", "none") and cfg["healing"]["params"]:
+        law = cfg["healing"]["law"]
+        out.append(("healing.params", cfg["healing"]["params"],
+                    f"healing.law = {law!r} takes no parameters" + (" (it uses rheology.healing_time_s)"
+                                                                      if law == "constant" else "")))
     if not cfg["lagrangian"]["enabled"]:
         add("lagrangian", ("min_area_ratio", "max_halvings"), "the mesh does not move: lagrangian.enabled = false")
     rp = cfg["rheology"]

@@ -250,9 +250,6 @@ def validate(cfg: dict, duration_s: float) -> None:
 
         checks.check_dataclass_params("forcing.drag", DragParams, fc["drag"])
         _check_turning_hemisphere(fc)
-    if cfg["thermo"]["new_ice_undamaged"] and not cfg["thermo"]["enabled"]:
-        raise ConfigError("thermo.new_ice_undamaged = true but thermo.enabled = false: without thermodynamics no "
-                          "new ice forms, so the setting would not be used")
     if cfg["thermo"]["enabled"]:
         from thermo.zero_layer import ThermoParams
 
@@ -333,10 +330,7 @@ def _check_healing(cfg: dict) -> None:
         check_nextsim_healing_params(params)
         return
     if law not in ("thermodynamic", "fdd"):
-        if params:
-            raise ConfigError(f"healing.params is set but healing.law = {law!r} takes no parameters "
-                              f"(the constant law uses rheology.healing_time_s)")
-        return
+        return  # "constant" and "none" read no [healing.params]: named by builder.unused_keys
     from thermo.healing import FreezingDegreeDayHealing, ThermodynamicHealing
 
     cls = ThermodynamicHealing if law == "thermodynamic" else FreezingDegreeDayHealing
