@@ -732,8 +732,8 @@ def test_a_refused_setting_leaves_no_run_folder(tmp_path):
     one_line_error(run_cli("run", "shear_box", "--out", out, sets=[*QUICK, "rheology.p_star=30000"]),
                    "rheology.p_star = 30000")
     assert not out.exists()
-    r = run_cli("run", "shear_box", "--out", out, "--resume", sets=[*QUICK, "healing.params.rate=2"])
-    one_line_error(r, "healing.params is set but healing.law")
+    r = run_cli("run", "shear_box", "--out", out, "--resume", sets=[*QUICK, 'domain.file_crs="EPSG:3413"'])
+    one_line_error(r, "domain.file_crs applies to domain.kind = 'file' only")
     assert not out.exists()
 
 
