@@ -80,10 +80,22 @@ PMAX_PA = 2000.0
 
 #: the optional rheology terms of the CPU kernel, one variant each (the explicit CPU stepper's
 #: combinations): the relaxation that keeps the mean stress, alone and with the compressive
-#: term; the return towards θ m I (θ = 1.5: a dilatant return); the dilatant viscous flow
+#: term; the return towards θ m I (θ = 1.5: a dilatant return); the dilatant viscous flow; the
+#: effective failure stress, alone and with the return towards θ m I; closed cracks (with the mean
+#: kept), alone and with the compressive term
 OPTIONAL_VARIANTS = {"keep_mean": {"relax_mean_stress": False}, "keep_mean_pmax": {"relax_mean_stress": False},
                      "mean_stress": {"stress_correction": "mean_stress", "stress_correction_mean_fraction": 1.5},
-                     "dilatancy": {"dilatancy_angle_deg": 20.0}}
+                     "dilatancy": {"dilatancy_angle_deg": 20.0},
+                     "effective": {"failure_stress": "effective"},
+                     "effective_mean_stress": {"failure_stress": "effective", "stress_correction": "mean_stress",
+                                               "stress_correction_mean_fraction": 1.5},
+                     "closure": {"relax_mean_stress": False, "crack_closure": True},
+                     "closure_pmax": {"relax_mean_stress": False, "crack_closure": True}}
+#: the run each optional variant is compared with to show that it changed something (default: the
+#: problem without optional terms; the variants with the compressive term against the same problem
+#: with it, closed cracks against the mean kept without them)
+VARIANT_BASE = {"keep_mean_pmax": "pmax", "closure": "keep_mean", "closure_pmax": "keep_mean_pmax",
+                "effective_mean_stress": "mean_stress"}
 
 
 def problem(variant="records"):
@@ -101,7 +113,7 @@ def problem(variant="records"):
     forces = [WindStress(wind), OceanDrag(current, turning_angle_deg=25.0), Coriolis(latitude_deg=75.0)]
     bcs = [VelocityBC("top", u=top_edge_u, v=-0.02)]
     rheo = MaxwellEB(cohesion_min_pa=1e3, cohesion_max_pa=3e3, healing_time_s=2e3, max_damage=0.3,
-                     max_pressure_pa=PMAX_PA if variant in ("pmax", "keep_mean_pmax") else None,
+                     max_pressure_pa=PMAX_PA if variant in ("pmax", "keep_mean_pmax", "closure_pmax") else None,
                      **OPTIONAL_VARIANTS.get(variant, {}))
     c = mesh.centroids()
     st = IceState.uniform(mesh, thickness_m=1.0 + 0.3 * np.sin(c[:, 0] / 2e4),
@@ -402,11 +414,12 @@ def main():
     sn = -0.5 * (st.stress[:, 0] + st.stress[:, 1])
     pm = cpu_pmax.rheology.max_pressure(st.thickness, st.concentration)
     rep["pmax_elements_below_above"] = [int(np.sum((sn > 0) & (sn < pm))), int(np.sum(sn > pm))]
+    cpu_runs = {"records": ref, "pmax": res_pmax}
     for variant in OPTIONAL_VARIANTS:
-        res_v = run(model("cpu", variant=variant))
+        res_v = cpu_runs[variant] = run(model("cpu", variant=variant))
         rep[f"{variant}_explicit_sync"] = compare(res_v, run(model("cuda", variant=variant, sync="explicit")))
         rep[f"{variant}_launches"] = compare(res_v, run(model("cuda", variant=variant, launch="launches")))
-        rep[f"{variant}_vs_without"] = rel_diff(res_pmax["stress"] if variant == "keep_mean_pmax" else ref["stress"],
+        rep[f"{variant}_vs_without"] = rel_diff(cpu_runs[VARIANT_BASE.get(variant, "records")]["stress"],
                                                 res_v["stress"])
     host = model("cuda", variant="host", sync="explicit")
     rep["host_fields"] = compare(run(model("cpu", variant="host")), run(host))

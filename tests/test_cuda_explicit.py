@@ -113,6 +113,14 @@ def test_device_option_schema_and_checks(monkeypatch):
     check_solver_device({"device": "cpu", "name": "implicit"})  # default: nothing to check
     monkeypatch.setattr(cuda_explicit, "require_cuda", lambda key="solver.device": "a GPU")
     check_solver_device({"device": "cuda", "name": "explicit"})
+    # closed cracks run on the GPU, but not with the element-wise sub-step limit: refused before meshing
+    closure = {"solver.name": "explicit", "solver.device": "cuda", "rheology.crack_closure": True,
+               "rheology.relax_mean_stress": False}
+    builder.validate_config(load_scene("wind_square", closure))
+    with pytest.raises(ConfigError, match=r"solver\.substep_limit = 'element' with rheology\.crack_closure = true"):
+        builder.validate_config(load_scene("wind_square", {**closure, "solver.substep_limit": "element"}))
+    builder.validate_config(load_scene("wind_square", {**closure, "solver.device": "cpu",
+                                                       "solver.substep_limit": "element"}))
 
 
 def test_device_and_parallel_do_not_change_the_fingerprint():
@@ -209,9 +217,11 @@ def test_cpu_serial_parallel_and_gpu_agree_on_a_damaging_run(sim_report):
     below, above = r["pmax_elements_below_above"]
     assert below > 0 and above > 0 and r["pmax_vs_without"] > 1e-3
     # the optional terms of the CPU kernel (the mean kept, alone and with the compressive term; the
-    # return towards 1.5 m I; the dilatant flow), both launch modes: each changed the result, and
-    # the device gives the CPU result
-    for variant in ("keep_mean", "keep_mean_pmax", "mean_stress", "dilatancy"):
+    # return towards 1.5 m I; the dilatant flow; the effective failure stress, alone and with that
+    # return; closed cracks, alone and with the compressive term), both launch modes: each changed
+    # the result, and the device gives the CPU result
+    for variant in ("keep_mean", "keep_mean_pmax", "mean_stress", "dilatancy", "effective", "effective_mean_stress",
+                    "closure", "closure_pmax"):
         _agree(f"{variant}_explicit_sync", r[f"{variant}_explicit_sync"])
         _agree(f"{variant}_launches", r[f"{variant}_launches"])
         assert r[f"{variant}_vs_without"] > 1e-3, (variant, r[f"{variant}_vs_without"])

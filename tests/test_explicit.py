@@ -174,9 +174,9 @@ def test_effective_failure_stress(kernel):
     assert np.array_equal(dc < 1.0, a[2].astype(bool))
     assert np.allclose(si, a[0], rtol=1e-13, atol=1e-13 * np.abs(si).max())
     assert np.allclose(di, a[1], rtol=1e-13, atol=1e-15)
-    # (3) refused where it is not implemented
-    with pytest.raises(ConfigError, match="failure_stress = 'effective'"):
-        rheo.require_stepper("explicit_cuda")
+    # (3) implemented in the CPU and CUDA steppers and the implicit solver (the CUDA kernel against
+    # this one: tests/test_cuda_explicit.py, simulator variants "effective*"), not with the nonlocal damage
+    rheo.require_stepper("explicit_cuda")
     rheo.require_stepper("explicit")
     rheo.require_stepper("implicit")
     with pytest.raises(ConfigError, match="failure_stress = 'effective' is implemented with the local damage"):
@@ -256,8 +256,13 @@ def test_crack_closure_builds_the_mean_stress_of_compressed_broken_ice_with_the_
     # (5) refusals
     with pytest.raises(ConfigError, match="crack_closure = true needs rheology.relax_mean_stress = false"):
         MaxwellEB(crack_closure=True)
-    with pytest.raises(ConfigError, match="crack_closure"):
-        rheo.require_stepper("explicit_cuda")
+    rheo.require_stepper("explicit_cuda")  # the CUDA kernel against this one: simulator variants "closure*"
+    from lagice.solvers.cuda_explicit import check_cuda_substep_limit
+
+    assert check_cuda_substep_limit("element", False) == "element" and check_cuda_substep_limit("mesh", True) == "mesh"
+    with pytest.raises(ConfigError, match=r"solver\.substep_limit = 'element' with rheology\.crack_closure = true: "
+                                          r"the CUDA stepper does not implement"):
+        check_cuda_substep_limit("element", True)
     with pytest.raises(ConfigError, match=r"implicit solver .* does not implement"):  # names its first term
         rheo.require_stepper("implicit")
     rheo.require_stepper("explicit")

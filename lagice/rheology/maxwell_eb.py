@@ -271,7 +271,8 @@ CORRECTION_PATHS = {"implicit": STRESS_CORRECTIONS, "explicit": ("origin", "mean
 OPTIONAL_TERMS = {"implicit": ("failure_stress",),
                   "explicit": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg",
                                "damage_nonlocal_radius_m", "failure_stress", "crack_closure"),
-                  "explicit_cuda": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg"), "prescribed": ()}
+                  "explicit_cuda": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg", "failure_stress",
+                                    "crack_closure"), "prescribed": ()}
 STEPPER_LABELS = {"implicit": "the implicit solver (solver.name = 'implicit')",
                   "prescribed": "the prescribed-velocity stepper (solver.name = 'prescribed', no damage update)",
                   "explicit": "the explicit CPU stepper (solver.name = 'explicit', solver.device = 'cpu')",

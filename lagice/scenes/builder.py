@@ -654,6 +654,10 @@ def solver_options(cfg: dict) -> dict:
             from ..solvers.explicit import check_substep_limit
 
             check_substep_limit(sv[k])
+            if sv["device"] != "cpu":
+                from ..solvers.cuda_explicit import check_cuda_substep_limit
+
+                check_cuda_substep_limit(sv[k], bool(cfg["rheology"]["crack_closure"]))
         opts[k] = sv[k]
     if sv["velocity"] is not None or sv["velocity_params"]:
         if "velocity" not in accepted:

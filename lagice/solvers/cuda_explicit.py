@@ -56,7 +56,7 @@ from ..rheology import MaxwellEB
 from ..stability import effective_dx
 from .base import StepInfo
 from .cuda_host import HostPath, fast_host_wanted
-from .explicit import ExplicitSolver, check_substep_limit
+from .explicit import ExplicitSolver, check_substep_limit, stability_modulus
 
 #: values of ``[solver] device``
 DEVICES = ("cpu", "cuda")
@@ -276,6 +276,20 @@ class _NodeField:
 # ----------------------------------------------------------------------------
 # the stepper
 # ----------------------------------------------------------------------------
+def check_cuda_substep_limit(substep_limit, crack_closure: bool) -> str:
+    """``solver.substep_limit`` for the CUDA stepper: as the CPU stepper's
+    (:func:`lagice.solvers.explicit.check_substep_limit`), but ``"element"`` with
+    ``rheology.crack_closure`` is refused (ConfigError naming both keys): its element-wise
+    bound needs max E0 exp(−c*(1−A))/area, and the element areas live on the device (the
+    CPU stepper implements it)."""
+    limit = check_substep_limit(substep_limit)
+    if limit == "element" and crack_closure:
+        raise ConfigError("solver.substep_limit = 'element' with rheology.crack_closure = true: the CUDA stepper "
+                          "does not implement the element-wise limit of closed cracks; use substep_limit = 'mesh' "
+                          "(the default) or solver.device = 'cpu'")
+    return limit
+
+
 class CudaExplicitSolver:
     """Explicit Maxwell-EB time stepper on a CUDA GPU (``[solver] device = "cuda"``).
 
@@ -353,7 +367,7 @@ class CudaExplicitSolver:
             raise ConfigError(f"max_registers = {max_registers!r} must be an integer in [16, 255] or None")
         from . import cuda_kernels as K
 
-        self.substep_limit = check_substep_limit(substep_limit)
+        self.substep_limit = check_cuda_substep_limit(substep_limit, rheology.params.crack_closure)
         self.rheology = rheology
         self.bcs = list(bcs)
         self.forces = list(forces)
@@ -717,6 +731,11 @@ class CudaExplicitSolver:
         cnt = self._io.d2h(d["counters"])
         scal = self._io.d2h(d["scalars"])
         E_max = float(scal[K.S_E_MAX]) if m else float(p.E0)
+        if p.crack_closure and m:
+            # closed cracks respond with the undamaged modulus: the limit takes E0 exp(−c*(1−A)), on
+            # the host from the host's concentration (thermodynamics keeps it there), with the CPU
+            # stepper's expression (explicit.stability_modulus), so both take the same sub-steps
+            E_max = float(stability_modulus(p, None, state.concentration).max())
         self.dx_eff = (effective_dx(self.dx_min, E_max, float(scal[K.S_STIFF_MAX]))
                        if m and self.substep_limit == "element" else self.dx_min)
         n_sub = self.substeps_for(dt_s, E_max)
@@ -740,7 +759,10 @@ class CudaExplicitSolver:
                      d["fext"], d["cda"], d["current"], self._cos_t, self._sin_t, d["half_mf"], d["fixed"],
                      d["pres0"], d["pres1"])
         # the CPU kernel's optional terms; its None is 0 here (a CUDA launch cannot pass None)
-        keep_mean = 0 if p.relax_mean_stress else 1
+        # bit flags (cuda_kernels.element_update): 1 keep the mean stress, 2 the effective failure
+        # stress, 4 closed cracks
+        keep_mean = ((0 if p.relax_mean_stress else 1) | (2 if p.failure_stress != "nominal" else 0)
+                     | (4 if p.crack_closure else 0))
         theta = float(p.mean_fraction) if p.stress_correction == "mean_stress" else 0.0
         dilat = float(p.dilatancy_factor or 0.0)
         mat = (d["conc_factor"], d["coh"], d["sig_c"], d["sig_t"], d["td"], d["heal"], d["e_dt"], d["gamma"],

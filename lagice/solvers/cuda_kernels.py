@@ -179,10 +179,14 @@ def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigm
     CPU kernel scales the cohesion since 2026-11-26; both only shortcut ``_dcrit``, which
     decides, so the results are the same).
 
-    ``keep_mean`` (int, 1: the relaxation keeps the mean stress), ``theta`` (θ of the return
-    towards θ m I; 0: the origin path) and ``dilat`` (k_ψ of the dilatant viscous flow; 0: off)
-    are the CPU kernel's optional terms (its None is 0 here: numba's CUDA launch cannot pass
-    None), with its expressions in its order. Their code is compiled only into the copies of
+    ``keep_mean`` (int, bit flags: 1 the relaxation keeps the mean stress, 2 the envelope judges
+    the effective stress σ/(1 − d) (``failure_stress = "effective"``), 4 closed cracks build the
+    mean stress with the undamaged modulus (``crack_closure``, with bit 1)), ``theta`` (θ of the
+    return towards θ m I; 0: the origin path) and ``dilat`` (k_ψ of the dilatant viscous flow;
+    0: off) are the CPU kernel's optional terms (its None is 0 here: numba's CUDA launch cannot
+    pass None; ``keep_mean``, ``eff`` and ``closure`` share one integer, so the default kernels'
+    signature and PTX stay those from before the last two existed), with its expressions in its
+    order. Their code is compiled only into the copies of
     :func:`optional_kernels` (:data:`_OPTIONAL_TERMS`); the default launch ignores them."""
     exx, eyy, exy = strain_rate_dev(tri, b, c, vel, e)
     ed = e_dt[e]
@@ -193,7 +197,7 @@ def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigm
         if sn > 0.0:
             pt = min2(1.0, pmax[e] / sn)
             gp = g / (g + (1.0 - g) * (1.0 - pt))
-    if not (_OPTIONAL_TERMS and keep_mean != 0):
+    if not (_OPTIONAL_TERMS and (keep_mean & 1) != 0):
         sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * gp
         syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * gp
         sxy = (sigma[e, 2] + ed * (kss * exy)) * gp
@@ -205,6 +209,22 @@ def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigm
         axx = sigma[e, 0] + ed * (kxx * exx + kxy * eyy)
         ayy = sigma[e, 1] + ed * (kxy * exx + kxx * eyy)
         am = 0.5 * (axx + ayy)
+        if _OPTIONAL_TERMS and (keep_mean & 4) != 0:
+            # closed cracks: the mean m0 + Δm with the undamaged ed0 wherever m ≤ 0, the damaged
+            # ed where m ≥ 0, split where the step crosses 0 (the CPU kernel's ``closure``)
+            m0 = 0.5 * (sigma[e, 0] + sigma[e, 1])
+            ed0 = dt_s * E0 * conc_factor[e]
+            if m0 < 0.0:
+                mc = m0 + (ed0 / ed) * (am - m0)
+                if mc > 0.0:
+                    mc *= ed / ed0
+            elif am < 0.0:
+                mc = am * (ed0 / ed)
+            else:
+                mc = am
+            axx += mc - am
+            ayy += mc - am
+            am = mc
         gm = gp if use_pmax else 1.0
         sxx = (axx - am) * g + am * gm
         syy = (ayy - am) * g + am * gm
@@ -212,7 +232,13 @@ def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigm
     mm = 0.5 * (sxx + syy)
     rr = math.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
     s1 = mm + rr
-    if s1 < sigma_t[e] and q * s1 - (mm - rr) < sigma_c[e]:
+    if _OPTIONAL_TERMS and (keep_mean & 2) != 0:  # the effective stress: C (1 − d), d at the sub-step's start
+        fe = 1.0 - damage[e]
+        if s1 < sigma_t[e] * fe and q * s1 - (mm - rr) < sigma_c[e] * fe:
+            dc = 1.0
+        else:
+            dc = dcrit_dev(sxx, syy, sxy, cohesion[e] * fe, q, denom)
+    elif s1 < sigma_t[e] and q * s1 - (mm - rr) < sigma_c[e]:
         dc = 1.0
     else:
         dc = dcrit_dev(sxx, syy, sxy, cohesion[e], q, denom)
@@ -220,7 +246,8 @@ def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigm
     pm = 0.0
     if _OPTIONAL_TERMS and theta > 0.0:
         if dc < 1.0:
-            fm = _dcrit_towards(sxx, syy, sxy, cohesion[e], q, denom, theta)
+            ce = cohesion[e] * (1.0 - damage[e]) if (keep_mean & 2) != 0 else cohesion[e]
+            fm = _dcrit_towards(sxx, syy, sxy, ce, q, denom, theta)
             if fm >= 0.0:
                 dc = fm
                 pm = theta * mm
