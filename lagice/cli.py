@@ -236,13 +236,8 @@ def _plot(args) -> int:
     if (run_dir / "summary.json").exists():
         summary = json.loads((run_dir / "summary.json").read_text())
     cfg = _run_config(snaps)
-    png = plot_scene(cfg, run_dir, summary)
-    if args.png and png is not None:
-        try:
-            Path(png).replace(args.png)
-        except OSError as exc:
-            raise LagiceError(f"cannot write --png {args.png}: {exc.strerror}") from None
-        png = Path(args.png)
+    # --png: drawn there, and the run's own figure stays (it used to be moved to --png)
+    png = plot_scene(cfg, run_dir, summary, png_path=args.png or None)
     print(f"  plot: {Path(png).resolve() if png else '(this scene has no plot)'}")
     return 0
 

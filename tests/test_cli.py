@@ -139,6 +139,11 @@ def test_plot_and_diagnose_beside_a_run_that_is_still_going(tmp_path):
         assert "still going" in p.stdout and f"pid {holder.pid}" in p.stdout and "day 0.035" in p.stdout
         png = out / "shear_box.png"
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 10_000
+        before = png.read_bytes()
+        other = run_cli("plot", str(out), "--png", str(tmp_path / "elsewhere.png"))
+        assert other.returncode == 0, other.stderr
+        assert (tmp_path / "elsewhere.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert png.exists() and png.read_bytes() == before  # --png leaves the run's own figure in place
         d = run_cli("diagnose", str(out))
         assert d.returncode == 0, d.stderr
         assert "still going" in d.stdout and f"pid {holder.pid}" in d.stdout

@@ -1144,14 +1144,15 @@ def _write_summary(out: Path, summary: dict) -> None:
         (out / "summary.json.tmp").replace(out / "summary.json")
 
 
-def plot_scene(cfg: dict, out: Path, summary: dict | None = None, drifters=None):
+def plot_scene(cfg: dict, out: Path, summary: dict | None = None, drifters=None, png_path=None):
     """The scene's own figure: ``output.plot`` true (the standard run plot), false
     (none) or a ``module:function`` hook ``f(run_dir, png_path, summary)``. Drifter
-    trajectories come from the run's drifter file (``drifters.nc``) unless given."""
+    trajectories come from the run's drifter file (``drifters.nc``) unless given. The
+    figure goes to ``png_path`` (``lagice plot --png``), by default ``out/SCENE.png``."""
     spec = cfg["output"]["plot"]
     if spec is False:
         return None
-    png = Path(out) / f"{cfg['scene']['name']}.png"
+    png = Path(png_path) if png_path is not None else Path(out) / f"{cfg['scene']['name']}.png"
     if isinstance(spec, str):
         return resolve_hook(spec, "output.plot")(Path(out), png, summary)
     from ..plotting import plot_run
