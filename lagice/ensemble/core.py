@@ -164,7 +164,7 @@ class Ensemble:
         self._lock_failed = {}
         self._write_ensemble_json(old)
         plan = self.plan(retry_failed)
-        todo = [m for m in self.members if plan[m.id] in ("new", "resume", "retry")]
+        todo = largest_first([m for m in self.members if plan[m.id] in ("new", "resume", "retry")])
         counts = {k: sum(v == k for v in plan.values()) for k in ("done", "resume", "new", "retry", "skip_failed")}
         _say(f"ensemble {self.spec.name!r}: {len(self.members)} members -> {self.out_dir}/ "
              f"({counts['done']} done, {counts['resume']} to resume, {counts['new']} to start, "
@@ -248,9 +248,10 @@ class Ensemble:
             self.last_run["setup_s"] = time.perf_counter() - t_setup
             token = uuid.uuid4().hex[:8]
             futures = {}
-            for m in todo:
+            for rank, m in enumerate(todo):  # largest first: dask runs the higher priority first
                 kw = {"resources": {"member": 1}} if resource else {}
-                f = client.submit(run_member, self._task(m), key=f"lagice-member-{m.id}-{token}", pure=False, **kw)
+                f = client.submit(run_member, self._task(m), key=f"lagice-member-{m.id}-{token}", pure=False,
+                                  priority=len(todo) - rank, **kw)
                 futures[f] = m.id
             prog = _Progress(len(todo), slots=max(1, slots), client=client)
             interrupted = True  # until the loop ends normally: Ctrl-C / SIGTERM stop the workers promptly
@@ -335,6 +336,52 @@ class Ensemble:
             except Exception as exc:  # noqa: BLE001 - a plot failure must not hide the summary
                 _say(f"ensemble: warning: no spread plot ({type(exc).__name__}: {exc})")
         return ds
+
+
+def estimated_cost(cfg: dict) -> float:
+    """A member's relative cost, for the order in which members start (:func:`largest_first`):
+    elements × outer steps × sub-steps per step. Elements from the domain's area over the area
+    of an equilateral triangle of edge ``domain.resolution_m``; outer steps ``run.duration`` /
+    ``solver.dt``; sub-steps ``solver.substeps`` when fixed, for the explicit Maxwell-EB stepper
+    otherwise ``solver.dt`` over the stability limit at that resolution and the undamaged
+    modulus (:func:`lagice.stability.explicit_substep_limit`, times ``solver.safety``), 300 for
+    mEVP (its default), and 1 for the implicit solver (its Newton iterations are not known
+    before it runs, so against members of a sub-stepped solver its members count low). Only an
+    estimate, for the order: nothing is meshed, and a member whose estimate fails (its domain
+    cannot be built here) gets +inf, so it starts first rather than last."""
+    from ..scenes.builder import domain_polygon
+    from ..scenes.components import time_step_s
+    from ..schedule import parse_duration
+
+    try:
+        res = float(cfg["domain"]["resolution_m"])
+        elements = domain_polygon(cfg).area / (math.sqrt(3.0) / 4.0 * res * res)
+        dt = time_step_s(cfg)
+        steps = parse_duration(cfg["run"]["duration"], "run.duration") / dt
+        sv = cfg["solver"]
+        per_step = 1.0
+        if sv.get("substeps"):
+            per_step = float(sv["substeps"])
+        elif sv["name"] == "evp":
+            per_step = 300.0
+        elif sv["name"] == "explicit":
+            from ..scenes.builder import build_rheology
+            from ..stability import explicit_substep_limit
+
+            p = build_rheology(cfg).params
+            per_step = math.ceil(dt / ((sv.get("safety") or 0.7) * explicit_substep_limit(res, p.E0, p)))
+        return elements * steps * per_step
+    except Exception:  # noqa: BLE001 - an estimate only: the member's own checks report real problems
+        return math.inf
+
+
+def largest_first(members: list) -> list:
+    """``members`` sorted by :func:`estimated_cost`, largest first (spec order among equal
+    costs): with fewer workers than members, the longest members do not start last and
+    leave the other workers idle while they finish (the makespan of a sweep over resolution
+    or duration)."""
+    cost = {m.id: estimated_cost(m.config) for m in members}
+    return sorted(members, key=lambda m: -cost[m.id])
 
 
 class _StopOnSignal:
