@@ -573,7 +573,11 @@ def test_members_start_largest_first(tmp_path, monkeypatch):
         return real(task)
 
     monkeypatch.setattr(core, "run_member", spy)
-    summary = Ensemble(spec, tmp_path / "ens").run(serial=True, plot=False)
+    said = io.StringIO()
+    with contextlib.redirect_stdout(said):
+        summary = Ensemble(spec, tmp_path / "ens").run(serial=True, plot=False)
     assert order == ["fine", "long", "coarse", "coarse2"]
+    assert "members start largest first (estimated elements x steps x sub-steps): fine, long, coarse, coarse2" \
+        in said.getvalue()
     assert list(summary["member"].values) == ["coarse", "fine", "long", "coarse2"]  # the summary keeps spec order
     assert set(summary["status"].values) == {"done"}

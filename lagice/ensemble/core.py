@@ -164,12 +164,17 @@ class Ensemble:
         self._lock_failed = {}
         self._write_ensemble_json(old)
         plan = self.plan(retry_failed)
-        todo = largest_first([m for m in self.members if plan[m.id] in ("new", "resume", "retry")])
+        listed = [m for m in self.members if plan[m.id] in ("new", "resume", "retry")]
+        todo = largest_first(listed)
         counts = {k: sum(v == k for v in plan.values()) for k in ("done", "resume", "new", "retry", "skip_failed")}
         _say(f"ensemble {self.spec.name!r}: {len(self.members)} members -> {self.out_dir}/ "
              f"({counts['done']} done, {counts['resume']} to resume, {counts['new']} to start, "
              f"{counts['retry']} failed to retry" + (f", {counts['skip_failed']} failed kept" if counts["skip_failed"]
                                                       else "") + ")")
+        if todo != listed:  # say so: the members do not start in the spec's order
+            ids = [m.id for m in todo]
+            _say(f"ensemble {self.spec.name!r}: members start largest first (estimated elements x steps x sub-steps): "
+                 + ", ".join(ids[:12]) + (f", ... ({len(ids) - 12} more)" if len(ids) > 12 else ""))
         t0 = time.perf_counter()
         self.last_run = {"plan": plan, "setup_s": 0.0, "cluster": None}
         try:
