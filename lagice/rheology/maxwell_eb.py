@@ -132,6 +132,25 @@ def damage_step(d, dc, dt, td, heal_rate, max_damage):
 
 
 @njit(cache=True, inline="always")
+def closed_crack_mean(m0, am, ed, ed0):
+    """The mean normal stress after one sub-step with closed cracks (``crack_closure``): from
+    m0, with ``am`` the mean the damaged modulus ``ed`` = Δt_s E would give, the undamaged
+    ``ed0`` = Δt_s E0 exp(−c*(1−A)) acting wherever m ≤ 0 (the cracks closed) and ``ed`` where
+    m ≥ 0, the volumetric strain split where the step crosses 0. Shared by the explicit CPU
+    kernel and the CUDA kernel (numba compiles it for the device as it does
+    :func:`_dcrit_towards`)."""
+    if m0 < 0.0:
+        mc = m0 + (ed0 / ed) * (am - m0)
+        if mc > 0.0:
+            mc *= ed / ed0
+    elif am < 0.0:
+        mc = am * (ed0 / ed)
+    else:
+        mc = am
+    return mc
+
+
+@njit(cache=True, inline="always")
 def _dcrit_towards(sxx, syy, sxy, cohesion, q, denom, theta):
     """The factor f ∈ [0, 1] that brings a stress onto the envelope along the straight path
     towards the isotropic stress P = θ m I (m = (σ1 + σ2)/2, 0 < θ ≤ 2): σ' = P + f (σ − P).

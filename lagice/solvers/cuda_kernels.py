@@ -35,7 +35,7 @@ from numba import cuda
 from forcing.records import _bilinear
 
 from ..fem import element_strain_rate, solve_node_2x2
-from ..rheology.maxwell_eb import _dcrit_towards, _principal
+from ..rheology.maxwell_eb import _dcrit_towards, _principal, closed_crack_mean
 
 # counter slots (int64): C_NONFINITE counts nodes with a non-finite velocity,
 # C_NONFINITE_ELEM elements with a non-finite stress or damage (end of the step)
@@ -210,18 +210,8 @@ def element_update(e, tri, b, c, vel, sigma, damage, conc_factor, cohesion, sigm
         ayy = sigma[e, 1] + ed * (kxy * exx + kxx * eyy)
         am = 0.5 * (axx + ayy)
         if _OPTIONAL_TERMS and (keep_mean & 4) != 0:
-            # closed cracks: the mean m0 + Δm with the undamaged ed0 wherever m ≤ 0, the damaged
-            # ed where m ≥ 0, split where the step crosses 0 (the CPU kernel's ``closure``)
-            m0 = 0.5 * (sigma[e, 0] + sigma[e, 1])
-            ed0 = dt_s * E0 * conc_factor[e]
-            if m0 < 0.0:
-                mc = m0 + (ed0 / ed) * (am - m0)
-                if mc > 0.0:
-                    mc *= ed / ed0
-            elif am < 0.0:
-                mc = am * (ed0 / ed)
-            else:
-                mc = am
+            # closed cracks: the CPU kernel's ``closure``, the same device function
+            mc = closed_crack_mean(0.5 * (sigma[e, 0] + sigma[e, 1]), am, ed, dt_s * E0 * conc_factor[e])
             axx += mc - am
             ayy += mc - am
             am = mc

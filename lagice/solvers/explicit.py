@@ -47,7 +47,7 @@ from ..errors import ConfigError
 from ..fem import STRAIN_RATE, NodeSystem, element_strain_rate
 from ..forces import explicit_terms
 from ..rheology import MaxwellEB, _dcrit, damage_step
-from ..rheology.maxwell_eb import _dcrit_towards
+from ..rheology.maxwell_eb import _dcrit_towards, closed_crack_mean
 from ..stability import effective_dx
 from ..state import IceState
 from .base import StepInfo
@@ -331,18 +331,8 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
             ayy = sigma[e, 1] + ed * (kxy * exx + kxx * eyy)
             am = 0.5 * (axx + ayy)
             if closure is not None:  # pruned when None, as pmax is
-                # the mean m0 + Δm, Δm = ed kb tr(ε̇), with the undamaged ed0 wherever m ≤ 0
-                # (closed cracks), the damaged ed where m ≥ 0, split where the step crosses 0
-                m0 = 0.5 * (sigma[e, 0] + sigma[e, 1])
-                ed0 = dt_s * E0 * conc_factor[e]
-                if m0 < 0.0:
-                    mc = m0 + (ed0 / ed) * (am - m0)
-                    if mc > 0.0:
-                        mc *= ed / ed0
-                elif am < 0.0:
-                    mc = am * (ed0 / ed)
-                else:
-                    mc = am
+                # the mean with the undamaged modulus wherever the cracks are closed (m ≤ 0)
+                mc = closed_crack_mean(0.5 * (sigma[e, 0] + sigma[e, 1]), am, ed, dt_s * E0 * conc_factor[e])
                 axx += mc - am
                 ayy += mc - am
                 am = mc
