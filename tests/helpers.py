@@ -1,6 +1,8 @@
 """Small helpers shared by the tests (imported as ``from helpers import ...``)."""
 import weakref
 
+import numpy as np
+
 _CLOCKS = weakref.WeakKeyDictionary()
 
 
@@ -36,3 +38,13 @@ def series(sim, name):
 def compression_overrides(n_across=10, **kw):
     """Overrides of the uniaxial_compression scene for N elements across the short edge."""
     return {"domain.resolution_m": 100e3 / n_across, **kw}
+
+
+def node_constants_reference(m_dt, cda, mass, coriolis, fext, current):
+    """The (n, 8) per-node constants of the explicit node kernel
+    (``lagice.solvers.explicit.NODE_CONSTANTS``) from their parts, with the arithmetic of the
+    stepper's one-pass set-up (½ m f as (0.5 m) f): the reference its test compares with."""
+    nc = np.zeros((len(m_dt), 8))
+    nc[:, 0], nc[:, 1], nc[:, 2] = m_dt, cda, 0.5 * mass * coriolis
+    nc[:, 3:5], nc[:, 5:7] = fext, current
+    return nc

@@ -21,7 +21,7 @@ from lagice.solvers.explicit import (
 from lagice.stability import StabilityWarning, explicit_substep_limit, load_limits
 from lagice.state import IceState
 
-from helpers import compression_overrides, scene_sim, series, step
+from helpers import compression_overrides, node_constants_reference, scene_sim, series, step
 
 G = np.array([[2e-8, 0.7e-8], [-0.3e-8, -1.1e-8]])  # velocity gradient [s-1]
 
@@ -337,7 +337,7 @@ def test_node_kernel_matches_general_2x2_solve():
     free, half-prescribed and prescribed nodes and a turning angle, gives the same velocity
     to 1e-13 relative, and the gathered force is −Σ w·σ."""
     from lagice.fem import solve_node_2x2
-    from lagice.solvers.explicit import node_constants, node_velocity_kernel_serial
+    from lagice.solvers.explicit import node_velocity_kernel_serial
 
     poly, _ = rectangle_domain(40e3, 40e3)
     mesh = generate_mesh(poly, 6e3)
@@ -357,8 +357,8 @@ def test_node_kernel_matches_general_2x2_solve():
     cos_t, sin_t = np.cos(0.4), np.sin(0.4)
     vel, vsum = vel0.copy(), np.zeros((n, 2))
     node_velocity_kernel_serial(vel, vsum, sigma, ptr.astype(np.int32), elems.astype(np.int32), w,
-                                node_constants(m_dt, cda, mass, cor, fext, cur), cos_t, sin_t, fixed, pres0, pres1,
-                                0.25)
+                                node_constants_reference(m_dt, cda, mass, cor, fext, cur), cos_t, sin_t, fixed, pres0,
+                                pres1, 0.25)
     ref = np.empty((n, 2))
     for i in range(n):
         pu, pv = pres0[i] + 0.25 * (pres1[i] - pres0[i])
@@ -385,12 +385,12 @@ def test_node_kernel_matches_general_2x2_solve():
 def test_fused_node_setup_equals_the_separate_passes_bit_for_bit():
     """The stepper's one-pass set-up (``NODE_SETUP``, serial and parallel builds) gives the
     adjacency weights, the per-node constants and the lumped mass of
-    ``NodeSystem.setup`` + ``node_constants`` bit for bit, on a gmsh mesh with a non-uniform
+    ``NodeSystem.setup`` + the constants from their parts bit for bit, on a gmsh mesh with a non-uniform
     thickness, wind stress, Coriolis parameter, drag and current: the published runs stay
     reproducible by the code that ships."""
     from lagice.fem import NodeSystem
     from lagice.forces import ExplicitTerms
-    from lagice.solvers.explicit import NODE_SETUP, node_constants
+    from lagice.solvers.explicit import NODE_SETUP
 
     poly, _ = rectangle_domain(60e3, 40e3)
     mesh = generate_mesh(poly, 5e3)
@@ -404,7 +404,7 @@ def test_fused_node_setup_equals_the_separate_passes_bit_for_bit():
                           rng.uniform(1.2e-4, 1.45e-4, n))
     rho, dt_sub = 917.0, 3.7
     su = ns.setup(h, terms, rho, dt_sub, True)
-    nc_ref = node_constants(su.m_dt, su.cda, su.mass, terms.coriolis, su.fext, terms.current)
+    nc_ref = node_constants_reference(su.m_dt, su.cda, su.mass, terms.coriolis, su.fext, terms.current)
     ptr, elems, local = mesh.node_elements
     for build in NODE_SETUP:
         w, nc, mass = build(ptr, elems, local, ns.area, h, ns.b, ns.c, rho, dt_sub, terms.tau, terms.drag_coef,

@@ -101,34 +101,16 @@ KERNEL_FASTMATH = {"contract"}
 NODE_CONSTANTS = ("m_dt", "cda", "half_mf", "fext_x", "fext_y", "current_x", "current_y", "pad")
 
 
-@njit(cache=True)
-def node_constants(m_dt, cda, mass, coriolis, fext, current):
-    """The (n, 8) per-node constants of one outer step (:data:`NODE_CONSTANTS`); ½ m f from
-    the lumped mass m [kg] and the Coriolis parameter f [s-1] (n,)."""
-    n = m_dt.shape[0]
-    nc = np.empty((n, 8))
-    for i in range(n):
-        nc[i, 0] = m_dt[i]
-        nc[i, 1] = cda[i]
-        nc[i, 2] = 0.5 * mass[i] * coriolis[i]
-        nc[i, 3] = fext[i, 0]
-        nc[i, 4] = fext[i, 1]
-        nc[i, 5] = current[i, 0]
-        nc[i, 6] = current[i, 1]
-        nc[i, 7] = 0.0
-    return nc
-
-
 def _node_setup(ptr, elems, local, area, h, b, c, rho, dt_sub, tau, drag_coef, coriolis, current):
     """The per-node set-up of one outer step in one pass over the node→element adjacency:
     the adjacency weights ``w`` (nnz, 2) of :func:`lagice.fem._adjacency_weights` (thickness
-    weighted), the per-node constants ``nc`` (n, 8) of :func:`node_constants` and the lumped
+    weighted), the per-node constants ``nc`` (n, 8) (:data:`NODE_CONSTANTS`) and the lumped
     mass [kg] (n,), from thickness h [m], ρ [kg m-3], the sub-step Δt_s [s], the wind stress
     τ [N m-2] (n, 2), ρw Cw (n,), f [s-1] (n,) and the current [m s-1] (n, 2).
 
     Every value is computed with the same operations, in the same order, as the separate
     passes it replaces (:meth:`lagice.fem.NodeSystem.setup`: two lumped masses, the weights,
-    m/Δt_s, a τ, a ρw Cw; then :func:`node_constants`), so the results are the same bit for
+    m/Δt_s, a τ, a ρw Cw; then the constants, ½ m f among them), so the results are the same bit for
     bit (compiled without ``fastmath``: no fused multiply-adds); a test checks it. One pass
     reads the adjacency once instead of three times and writes no temporary arrays:
     docs/benchmarks.md, "2026-11-28, twenty-ninth session"."""
@@ -847,7 +829,7 @@ class ExplicitSolver:
         tri = mesh.triangles
         par = ns.parallel_for(mesh)
         ptr, elems, local = mesh.node_elements
-        # NodeSystem.setup and node_constants in one pass, bit for bit (_node_setup)
+        # NodeSystem.setup and the per-node constants in one pass, bit for bit (_node_setup)
         w_adj, nc, _mass = NODE_SETUP[int(par)](ptr, elems, local, ns.area,
                                                 np.ascontiguousarray(state.thickness, np.float64), ns.b, ns.c,
                                                 float(p.rho_ice), dt_s, terms.tau, terms.drag_coef, terms.coriolis,
