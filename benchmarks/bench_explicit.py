@@ -138,7 +138,8 @@ def element_kernel_rates(n_target: int = 50_000, reps: int = 20) -> dict:
                 np.full(m, heal), np.full(m, 4.0 * p.E0), np.full(m, 0.99), None, None, None, None, None, None,
                 4.0, 1.1,
                 0.3, 0.7,
-                rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), np.zeros(m, np.int8))
+                rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), np.zeros(m, np.int8),
+                None)
         kernel(*args)
         t0 = time.process_time()
         for _ in range(reps):

@@ -1688,6 +1688,46 @@ def _pin_all(overrides: list) -> list:
     return overrides if any(o.startswith(AFTER_REMESH_KEY) for o in overrides) else overrides + [
         AFTER_REMESH_KEY + "all"]
 
+# --- 2026-11-28 (thirtieth session): volumetric locking of the kept mean stress -------------------
+# Every set-up in which broken ice keeps its mean stress while its deviator relaxes (relax_mean_stress =
+# false: "damaged ice keeps its mean stress", effK, effC, effCP) locked the pack, and the records read
+# it as physics: "what lets a Maxwell-EB pack move is that its damaged ice sheds its pressure". But
+# such ice is nearly incompressible, and on gmsh's Delaunay mesh of the closed box (20 km, 500 km
+# side) the element divergences have full rank over the free velocity components: no non-zero
+# velocity field has zero divergence in every constant-strain triangle (volumetric locking). In a
+# stationary gyre wind over broken ice (d = 0.99, fixed mesh) the kept mean stress grows linearly,
+# to 37 kPa mean and 180 kPa max after 6 days, while with the whole stress relaxing it stays at
+# 15 Pa; with the volumetric strain averaged at the nodes (solver.volumetric_strain = "nodal", Bonet
+# and Burton 1998) it stays at 1.3 kPa mean from day 1 on, and the gyre turns at the relaxing
+# pack's speed (0.156 m/s). So the locked packs may be a property of the discretisation, not of
+# the ice. Stated 2026-11-28 18:24 UTC before the runs: three set-ups, each with the element and
+# the nodal volumetric strain, 20 km, closed basin, the validation month, each from its own 20 km
+# spin-up with its changes (strength_after_remesh = "all", as the screens they repeat; the element
+# runs of effK and effCP are B20-hthick-effK and B20-hthick-effCP, made on 2026-11-28 with the same
+# definitions; the kernels are unchanged for them since):
+#   K:    the nominal envelope, the mean stress kept;
+#   effK: the effective envelope, the mean stress kept (frictional rubble);
+#   effCP: the effective envelope, closed cracks, neXtSIM's P_max.
+# (M) the mechanism: for each set-up whose element run locks (wind factor below 0.003), the nodal run
+#     moves: wind factor at least 2x the element run's, and the interior's median compressive mean
+#     stress at day 28 at most half the element run's.
+# (L) a lead for the 10 km months: a nodal run with beta in 0.14-0.23, the wind factor in
+#     0.006-0.010 and at least 3 bands inside.
+# Predicted: (M) holds for K and effK; effCP's P_max caps the spurious pressure, so its element run
+#     may not lock as hard, and the nodal one moves more (wind factor 0.004-0.008). (L): effK-nodal is
+#     the candidate: floes in a frictional rubble that can now flow without volume change, wind
+#     factor 0.007-0.011, beta 0.10-0.16, tails 3.5-4.5 (too light), 2 bands inside: not a lead.
+#     K-nodal: beta about 0.05 (the nominal envelope's over-failure), the rate near the shipped
+#     set's.
+NODAL = ["solver.volumetric_strain=nodal"]
+for _tag, _changes, _what in (("K", KEEPMEAN, "the mean stress kept"),
+                              ("effK", EFFECTIVE + KEEPMEAN, "effective envelope, the mean stress kept"),
+                              ("effCP", EFFECTIVE + CLOSURE + PMAX, "effective envelope, cracks close, P_max")):
+    if _tag == "K":
+        add_screen_20km(f"{_tag}-velem", _changes, f"20 km: {_what}, element volumetric strain, own spin-up")
+    add_screen_20km(f"{_tag}-vnodal", _changes + NODAL, f"20 km: {_what}, nodal volumetric strain, own spin-up")
+
+
 
 for _n, (_scene, _o, *_rest) in list(EXPERIMENTS.items()):
     EXPERIMENTS[_n] = (_scene, _pin_all(_o), *_rest)

@@ -65,7 +65,7 @@ def test_element_kernel_damage_matches_rheology(kernel, theta):
     e_dt, gam = np.zeros(m), np.ones(m)
     kernel(tri, zeros3, zeros3, np.zeros((1, 2)), s2, d2, conc_factor, coh, kc, kt, td, heal, e_dt, gam, None,
            None, theta, None, None, None, 7.0, 1.0, 0.3, 0.7, rheo.q, rheo._denom, p.max_damage, p.E0,
-           p.relaxation_time_s, p.alpha, flag)
+           p.relaxation_time_s, p.alpha, flag, None)
     assert (dc < 1).sum() > 100
     if theta is not None:  # the path differs from the origin's where the correction acted
         s0, d0 = sigma.copy(), damage.copy()
@@ -115,7 +115,7 @@ def test_element_kernel_stress_update_uses_rheology_moduli(kernel):
                np.full(m, 20.0), np.zeros(m), dt_s * E, lam / (lam + dt_s), None, None, None, None, None, None, dt_s,
                *rheo.K[0, :2],
                rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, float(alpha),
-               np.zeros(m, np.int8))
+               np.zeros(m, np.int8), None)
         eps = strain_rate(mesh.triangles, b, c, vel)
         ref = (lam / (lam + dt_s))[:, None] * (sigma0 + dt_s * E[:, None] * (eps @ rheo.K.T))
         assert np.array_equal(d, damage)
@@ -151,7 +151,7 @@ def test_effective_failure_stress(kernel):
         sg, dm, flag = sigma.copy(), damage.copy(), np.zeros(m, np.int8)
         kernel(tri, zeros3, zeros3, np.zeros((1, 2)), sg, dm, np.ones(m), cohesion, kc, kt, np.full(m, 20.0),
                np.zeros(m), np.zeros(m), np.ones(m), None, None, None, None, eff, None, 7.0, *rheo.K[0, :2],
-               rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
+               rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag, None)
         return sg, dm, flag
 
     _, d_eff, f_eff = run(True, coh, sig0, d)
@@ -221,7 +221,7 @@ def test_crack_closure_builds_the_mean_stress_of_compressed_broken_ice_with_the_
         sg, dm, flag = sigma0.copy(), d.copy(), np.zeros(m, np.int8)
         kernel(tri, b, c, vel, sg, dm, g, np.full(m, 1e15), kc, kt, np.full(m, 20.0), np.zeros(m), dt_s * E,
                np.ones(m), None, True, None, None, None, closure, dt_s, *rheo.K[0, :2], rheo.K[2, 2], rheo.q,
-               rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
+               rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag, None)
         assert np.array_equal(dm, d) and not flag.any()
         return sg
 
@@ -320,7 +320,7 @@ def test_alpha4_builds_equal_general_builds():
         capped = kernel(mesh.triangles.astype(np.int32), b, c, vel, sigma, d, np.full(m, 0.9),
                         coh, kc, kt, np.full(m, 30.0), np.full(m, 1e-6), e_dt, gam, None, None, None, None, None, None,
                         dt_s, *rheo.K[0, :2],
-                        rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag)
+                        rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag, None)
         out.append((sigma, d, flag, capped, e_dt, gam))
     assert 0 < out[0][2].sum() < m  # some elements damage, some do not
     assert np.any(out[0][1] < damage0)  # some heal

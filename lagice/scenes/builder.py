@@ -640,7 +640,7 @@ def solver_options(cfg: dict) -> dict:
     accepted = set(inspect.signature(SOLVERS[sv["name"]].__init__).parameters)
     opts = {}
     for k in ("linear_solver", "tol", "max_iter", "substeps", "allow_unstable", "safety", "parallel",
-              "substep_limit", "damage_iterations", "damage_tol"):
+              "substep_limit", "volumetric_strain", "damage_iterations", "damage_tol"):
         if sv[k] is None or (k == "allow_unstable" and sv[k] is False):
             continue
         if k == "parallel" and isinstance(sv[k], str):
@@ -658,6 +658,13 @@ def solver_options(cfg: dict) -> dict:
                 from ..solvers.cuda_explicit import check_cuda_substep_limit
 
                 check_cuda_substep_limit(sv[k], bool(cfg["rheology"]["crack_closure"]))
+        if k == "volumetric_strain":
+            from ..solvers.explicit import check_volumetric_strain
+
+            check_volumetric_strain(sv[k])
+            if cfg["rheology"]["damage_nonlocal_radius_m"] and sv[k] != "element":
+                raise ConfigError(f"solver.volumetric_strain = {sv[k]!r} is not implemented with "
+                                  f"rheology.damage_nonlocal_radius_m; use \"element\"")
         opts[k] = sv[k]
     if sv["velocity"] is not None or sv["velocity_params"]:
         if "velocity" not in accepted:

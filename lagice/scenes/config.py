@@ -95,6 +95,10 @@ SCHEMA = {
         "linear_solver": (str, None), "tol": (NUM, None), "max_iter": (int, None),
         "allow_unstable": (bool, False), "safety": (NUM, None), "parallel": ((bool, str), None),
         "substep_limit": (str, None),
+        # explicit stepper: the volumetric strain rate of each element's stress update, its own
+        # ("element", the default) or averaged at the nodes ("nodal": no volumetric locking where the
+        # mean stress is kept; lagice.solvers.explicit._node_divergence)
+        "volumetric_strain": (str, None),
         # implicit solver: Dansereau et al. (2016)'s fixed point between the solve and the damage
         # update (lagice.solvers.implicit, step 4); 1 pass (no fixed point) by default
         "damage_iterations": (int, None), "damage_tol": (NUM, None),
@@ -175,6 +179,7 @@ LEGACY_VALUES = {
     "thermo.new_ice_undamaged": (False,),            # 2026-11-27: new ice takes the element's damage
     "initial.state_file": (None, ""),                # 2026-11-24: no spin-up state
     "solver.substep_limit": (None, "mesh"),          # 2026-11-25: the whole-mesh limit
+    "solver.volumetric_strain": (None, "element"),   # 2026-11-28: each element's own volumetric strain
 }
 
 

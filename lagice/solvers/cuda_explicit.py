@@ -155,6 +155,10 @@ def check_solver_device(sv: dict) -> None:
             raise ConfigError(f'solver.device = "cuda" runs the explicit stepper only; solver.name = '
                               f'{sv.get("name")!r} has no GPU version (set solver.name = "explicit", or '
                               f'solver.device = "cpu")')
+        if sv.get("volumetric_strain") not in (None, "element"):
+            raise ConfigError(f"solver.volumetric_strain = {sv.get('volumetric_strain')!r}: the CUDA stepper uses "
+                              f"each element's own volumetric strain only; set solver.device = \"cpu\", or leave "
+                              f"solver.volumetric_strain unset")
         require_cuda("solver.device")
 
 

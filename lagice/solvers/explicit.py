@@ -62,6 +62,19 @@ from .nonlocal_damage import NonlocalWeights
 #: (docs/physics.md §4, "Sub-step length"), so it is not the default.
 SUBSTEP_LIMITS = ("mesh", "element")
 
+#: the volumetric strain rate the element kernel's stress update uses (:func:`_node_divergence`):
+#: "element" (default): each element's own; "nodal": the mean of its nodes' area-weighted
+#: averages (Bonet and Burton 1998's average nodal pressure), against the volumetric locking of
+#: linear triangles whose mean stress is kept while the deviator relaxes (docs/solvers.md)
+VOLUMETRIC_STRAIN = ("element", "nodal")
+
+
+def check_volumetric_strain(volumetric_strain: str) -> str:
+    if volumetric_strain not in VOLUMETRIC_STRAIN:
+        raise ConfigError(f"solver.volumetric_strain = {volumetric_strain!r}: expected one of "
+                          f"{list(VOLUMETRIC_STRAIN)}")
+    return volumetric_strain
+
 
 def check_substep_limit(substep_limit: str) -> str:
     if substep_limit not in SUBSTEP_LIMITS:
@@ -243,7 +256,7 @@ _ALPHA_IS_4 = False
 
 def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion, kc, kt,
                            td, heal_rate, e_dt, gamma, pmax, keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy,
-                           kss, q, denom, max_damage, E0, lambda0, alpha, damaged_flag):
+                           kss, q, denom, max_damage, E0, lambda0, alpha, damaged_flag, divn):
     """Maxwell stress update and damage/healing of one sub-step, in place (module doc, step 2).
 
     e_dt = Δt_s E [Pa s], gamma = λ/(λ+Δt_s) per element, refreshed here where damage
@@ -286,12 +299,22 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     damaged e_dt where m ≥ 0; a sub-step that crosses m = 0 takes each modulus for its part of
     the volumetric strain. Intact ice (d = 0) is unchanged to round-off (ed0/ed = 1 up to the
     rounding of the two products).
+    divn: None (solver.volumetric_strain = "element", the default; pruned as pmax is): the
+    element's own strain rate. An (n,) array (``"nodal"``): the nodal volumetric strain rates of
+    :func:`_node_divergence` this sub-step; the element's volumetric rate ε̇xx + ε̇yy is replaced
+    by the mean of its three nodes' values, its deviatoric rate kept (the average nodal pressure
+    of Bonet and Burton 1998: no volumetric locking of linear triangles where the mean stress
+    is kept and the deviator relaxes).
     Returns the number of elements whose damage hit the cap.
     """
     m = tri.shape[0]
     n_capped = 0
     for e in prange(m):
         exx, eyy, exy = element_strain_rate(tri, b, c, vel, e)
+        if divn is not None:  # pruned when None, as pmax is
+            dv = 0.5 * ((divn[tri[e, 0]] + divn[tri[e, 1]] + divn[tri[e, 2]]) * (1.0 / 3.0) - (exx + eyy))
+            exx += dv
+            eyy += dv
         ed = e_dt[e]
         g = gamma[e]
         gp = g
@@ -375,6 +398,38 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
             e_dt[e] = dt_s * (E0 * x)
             gamma[e] = lam / (lam + dt_s)
     return n_capped
+
+
+def _node_divergence(vel, ptr, elems, tri, b, c, area, divn):
+    """Nodal volumetric strain rate [s-1] into ``divn`` (n,): the area-weighted mean of
+    ε̇xx + ε̇yy over the elements around each node (solver.volumetric_strain = "nodal").
+
+    Why: a constant-strain triangle whose mean stress is kept while its deviator relaxes
+    (rheology.relax_mean_stress = false, crack_closure) is close to incompressible, and on a
+    triangle mesh the element divergences are about as many constraints as there are free
+    velocity components: on gmsh's Delaunay mesh of a closed box no non-zero velocity field
+    has zero divergence in every element, so such ice can only flow by building a spurious
+    pressure (volumetric locking; Nagtegaal, Parks and Rice 1974, "On numerically accurate
+    finite element solutions in the fully plastic range", Comput. Methods Appl. Mech. Eng. 4).
+    Averaged at the nodes there is one constraint per node, half the free components, which
+    leaves room for divergence-free flow: the average nodal pressure triangle of Bonet and
+    Burton (1998, "A simple average nodal pressure tetrahedral element for incompressible and
+    nearly incompressible dynamic explicit applications", Commun. Numer. Meth. Eng. 14). The
+    element→node→element averaging is symmetric in the area-weighted inner product, so the
+    elastic energy stays a positive quadratic form and no sub-step limit grows."""
+    n = ptr.shape[0] - 1
+    for i in prange(n):
+        s = 0.0
+        a = 0.0
+        for p in range(ptr[i], ptr[i + 1]):
+            e = elems[p]
+            de = 0.0
+            for k in range(3):
+                j = tri[e, k]
+                de += b[e, k] * vel[j, 0] + c[e, k] * vel[j, 1]
+            s += area[e] * de
+            a += area[e]
+        divn[i] = s / a
 
 
 def _element_trial_load(tri, b, c, vel, sigma, e_dt, gamma, cohesion, kxx, kxy, kss, q, denom, load):
@@ -484,13 +539,16 @@ node_velocity_kernel_serial = _serial(_node_velocity)
 element_stress_damage_kernel = njit(cache=True, parallel=True, error_model="numpy", fastmath=KERNEL_FASTMATH)(
     _element_stress_damage)
 element_stress_damage_kernel_serial = _serial(_element_stress_damage)
+node_divergence_kernel = njit(cache=True, parallel=True, error_model="numpy", fastmath=KERNEL_FASTMATH)(
+    _node_divergence)
+node_divergence_kernel_serial = _serial(_node_divergence)
 PARALLEL_MIN_ELEMENTS = PARALLEL_MIN_SIZE
 
 
 @njit(cache=True, error_model="numpy")
 def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
                       c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat,
-                      eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+                      eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn, area):
     """All ``n_sub`` sub-steps of one outer step in compiled code (one call per outer
     step, no Python per sub-step): the node kernel then the element kernel, serial
     builds; the same calls as a Python loop over the kernels, bit-identical results."""
@@ -498,25 +556,29 @@ def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t,
     for k in range(n_sub):
         node_velocity_kernel_serial(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
                                     (k + 1) / n_sub)
+        if divn is not None:  # solver.volumetric_strain = "nodal" (pruned when None)
+            node_divergence_kernel_serial(vel, ptr, elems, tri, b, c, area, divn)
         n_capped += element_stress_damage_kernel_serial(
             tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta,
-            dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn)
     return n_capped
 
 
 @njit(cache=True, error_model="numpy")
 def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
                       c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat,
-                      eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag):
+                      eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn, area):
     """:func:`substeps_serial` with the parallel kernel builds (one fork/join per
     kernel and sub-step, launched from compiled code)."""
     n_capped = 0
     for k in range(n_sub):
         node_velocity_kernel(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
                              (k + 1) / n_sub)
+        if divn is not None:  # solver.volumetric_strain = "nodal" (pruned when None)
+            node_divergence_kernel(vel, ptr, elems, tri, b, c, area, divn)
         n_capped += element_stress_damage_kernel(
             tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta,
-            dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag)
+            dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn)
     return n_capped
 
 
@@ -607,6 +669,10 @@ class ExplicitSolver:
             :data:`AUTOTUNE_FIRST_INTERVAL_S` and then every :data:`AUTOTUNE_INTERVAL_S`
             of wall time; the choice is logged and kept
             in :attr:`kernel_choice`.
+        volumetric_strain: ``"element"`` (default) or ``"nodal"``: the volumetric strain
+            rate of each element's stress update is the mean of its nodes' area-weighted
+            averages (:func:`_node_divergence`; one more node pass per sub-step), which frees
+            ice whose mean stress does not relax from volumetric locking.
         profile_kernels: time the node and element kernels separately (a Python
             loop over the sub-steps, two kernel calls each) instead of running the
             whole sub-step loop in one compiled call (the default; same results).
@@ -631,7 +697,8 @@ class ExplicitSolver:
 
     def __init__(self, rheology: MaxwellEB, mesh, bcs=(), forces=(), substeps: int | None = None,
                  heal_rate=None, safety: float = 0.7, allow_unstable: bool = False,
-                 parallel: bool | str | None = None, profile_kernels: bool = False, substep_limit: str = "mesh"):
+                 parallel: bool | str | None = None, profile_kernels: bool = False, substep_limit: str = "mesh",
+                 volumetric_strain: str = "element"):
         if not isinstance(rheology, MaxwellEB):
             raise ConfigError(f"the explicit stepper solves the Maxwell-EB rheology; got "
                               f"{type(rheology).__name__} (use solver 'evp' for viscous-plastic)")
@@ -643,6 +710,7 @@ class ExplicitSolver:
         if not 0.0 < safety <= 1.0:
             raise ConfigError(f"safety = {safety!r} must be in (0, 1]")
         self.substep_limit = check_substep_limit(substep_limit)
+        self.volumetric_strain = check_volumetric_strain(volumetric_strain)
         self.rheology = rheology
         self.forces = list(forces)
         self.substeps = substeps
@@ -668,6 +736,9 @@ class ExplicitSolver:
         radius = rheology.params.damage_nonlocal_radius_m
         #: the nonlocal damage's averaging weights (rheology.damage_nonlocal_radius_m), or None
         self.nonlocal_weights = NonlocalWeights(radius) if radius else None
+        if self.nonlocal_weights is not None and self.volumetric_strain != "element":
+            raise ConfigError(f"solver.volumetric_strain = {volumetric_strain!r} is not implemented with "
+                              f"rheology.damage_nonlocal_radius_m = {radius!r}; use \"element\"")
         if self.nonlocal_weights is not None and profile_kernels:
             raise ConfigError("profile_kernels times the local element kernel; it is not implemented with "
                               f"rheology.damage_nonlocal_radius_m = {radius!r}")
@@ -784,7 +855,7 @@ class ExplicitSolver:
         """The sub-step loop in Python with each kernel timed (``profile_kernels``)."""
         (vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b, c, damage, conc_factor,
          coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom,
-         max_damage, E0, lambda0, alpha, flag) = args
+         max_damage, E0, lambda0, alpha, flag, divn, area) = args
         node_k = node_velocity_kernel if par else node_velocity_kernel_serial
         elem_k = element_kernels(alpha)[int(par)]
         n_capped = 0
@@ -792,10 +863,13 @@ class ExplicitSolver:
         for k in range(n_sub):
             ta = time.perf_counter()
             node_k(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, (k + 1) / n_sub)
+            if divn is not None:
+                (node_divergence_kernel if par else node_divergence_kernel_serial)(vel, ptr, elems, tri, b, c, area,
+                                                                                   divn)
             tb = time.perf_counter()
             n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma,
                                pmax, keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom,
-                               max_damage, E0, lambda0, alpha, flag)
+                               max_damage, E0, lambda0, alpha, flag, divn)
             tc = time.perf_counter()
             tn += tb - ta
             tm += tc - tb
@@ -863,7 +937,8 @@ class ExplicitSolver:
         args = (vel, vel_sum, sigma, ptr32, elems32, w_adj, nc, terms.cos_turn, terms.sin_turn, ns.fixed, pres0,
                 pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, k_c, k_t, self.td, heal, e_dt, gamma, pmax,
                 keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0,
-                p.relaxation_time_s, float(p.alpha), flag)
+                p.relaxation_time_s, float(p.alpha), flag,
+                np.empty(mesh.n_nodes, np.float64) if self.volumetric_strain == "nodal" else None, ns.area)
         if self.kernel_choice is None or (
                 self.parallel_setting is None
                 and time.perf_counter() - self._tuned_at > (
