@@ -63,13 +63,17 @@ def start_damage(run_dir, day: float, buffer_m: float = BUFFER_M) -> dict:
     (area-weighted over the elements whose centroid is >= ``buffer_m`` [m] from the mesh
     boundary), ``broken_area_share`` (their area with damage > :data:`BROKEN`),
     ``damaged_area_share`` (with damage > :data:`DAMAGED`), and the sums
-    ``damage_area_m2`` (Σ d·A) and ``area_m2`` (Σ A) over those elements.
+    ``damage_area_m2`` (Σ d·A) and ``area_m2`` (Σ A) over those elements, and
+    ``median_pressure_pa``: the median over them of the pressure −(σxx + σyy)/2 [Pa]
+    (compression positive).
     Raises ConfigError when no snapshot lies within an hour of ``day``."""
     path, snap_day = nearest_snapshot(run_dir, day)
     with xr.open_dataset(path, decode_times=False) as ds:
         xy = np.column_stack([ds["mesh_node_x"].values, ds["mesh_node_y"].values])
         tri = ds["mesh_face_nodes"].values.astype(np.int64)
         damage = np.asarray(ds["damage"].values, np.float64).reshape(-1)
+        pressure = -0.5 * (np.asarray(ds["stress_xx"].values, np.float64).reshape(-1)
+                           + np.asarray(ds["stress_yy"].values, np.float64).reshape(-1))
     if damage.shape[0] != tri.shape[0]:
         raise ConfigError(f"{run_dir}: snapshot {path.name}: {damage.shape[0]} damage values for "
                           f"{tri.shape[0]} elements")
@@ -79,7 +83,8 @@ def start_damage(run_dir, day: float, buffer_m: float = BUFFER_M) -> dict:
     return {"snapshot_day": snap_day, "mean_damage": float(np.sum(area * d) / area.sum()),
             "broken_area_share": float(area[d > BROKEN].sum() / area.sum()),
             "damaged_area_share": float(area[d > DAMAGED].sum() / area.sum()),
-            "damage_area_m2": float(np.sum(area * d)), "area_m2": float(area.sum())}
+            "damage_area_m2": float(np.sum(area * d)), "area_m2": float(area.sum()),
+            "median_pressure_pa": float(np.median(pressure[inner]))}
 
 
 def load_ratio(stress: np.ndarray, cohesion: np.ndarray, friction: float) -> np.ndarray:
@@ -191,7 +196,8 @@ def main(argv=None) -> int:
             for day in args.at:
                 r = start_damage(RUNS / name, day)
                 print(f"{name:34s} day {day:5.1f}: mean damage {r['mean_damage']:.3f}, area above "
-                      f"{DAMAGED:g}: {r['damaged_area_share']:.2f}, above {BROKEN:g}: {r['broken_area_share']:.2f}")
+                      f"{DAMAGED:g}: {r['damaged_area_share']:.2f}, above {BROKEN:g}: {r['broken_area_share']:.2f}, "
+                      f"median pressure {r['median_pressure_pa'] / 1e3:.1f} kPa")
         return 0
     records = json.loads(RECORDS.read_text())
     rows = [r for n in args.runs for r in rows_for(n, records)]

@@ -1719,6 +1719,20 @@ def _pin_all(overrides: list) -> list:
 #     factor 0.007-0.011, beta 0.10-0.16, tails 3.5-4.5 (too light), 2 bands inside: not a lead.
 #     K-nodal: beta about 0.05 (the nominal envelope's over-failure), the rate near the shipped
 #     set's.
+# Result (19:00 UTC): (M) holds for effCP only, (L) fails for all three, and the nodal runs are not
+# trustworthy. effCP: the wind factor rises from 0.0010 to 0.0090 (inside its band) and the interior's
+# median pressure at day 28 falls from 11.5 to 2.5 kPa; but beta is 0.594, the rate 0.056 per day, R2
+# 0.09, 579 remeshes, 0 bands inside. K: the element run locks (wind factor 0.0000, rate 5e-5 per day,
+# no remesh; its slow shear lies on long straight bands, beta 0.082), the nodal run has wind factor
+# 0.0013, a median pressure of 185 kPa at day 28 (element 64 kPa), beta 0.838, a rate of 0.144 per day
+# and 1049 remeshes with 3 km of drift. effK: wind factor 0.0016 (element 0.0017), pressure 55 kPa at
+# day 28 (element 47), beta 0.747, 914 remeshes. With the deviator of broken ice relaxing in seconds,
+# the nodal average leaves velocity fields whose element divergences alternate in sign and average
+# to zero at every node with no stiffness at all (the spurious modes of nodal averaging), and they
+# carry the deformation: shear noisy from element to element (docs/figures/volumetric_locking_screen.png).
+# So with constant-strain triangles a pack whose broken ice keeps its pressure is locked by the mesh
+# (element) or shaken by it (nodal); the earlier conclusion that kept pressure binds the floes is not
+# established either way. The 10 km runs are not made.
 NODAL = ["solver.volumetric_strain=nodal"]
 for _tag, _changes, _what in (("K", KEEPMEAN, "the mean stress kept"),
                               ("effK", EFFECTIVE + KEEPMEAN, "effective envelope, the mean stress kept"),
