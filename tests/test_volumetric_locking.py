@@ -140,8 +140,12 @@ def test_nodal_volumetric_strain_changes_nothing_under_an_affine_flow():
     element loop's plus the node divergence."""
     from lagice.fem import shape_gradients
     from lagice.rheology import MaxwellEB
-    from lagice.solvers.explicit import (element_kernels, envelope_factors, node_divergence_kernel,
-                                         node_divergence_kernel_serial)
+    from lagice.solvers.explicit import (
+        element_kernels,
+        envelope_factors,
+        node_divergence_kernel,
+        node_divergence_kernel_serial,
+    )
 
     mesh = _box_mesh(60e3, 8e3)
     m, n = mesh.n_elements, mesh.n_nodes
