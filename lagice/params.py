@@ -64,6 +64,14 @@ class MaxwellEBParams:
             mean takes the compressive term's factor above (it creeps where it is tensile or
             compressive beyond P_max). The ice then converges elastically, at damage events or
             above P_max. Explicit stepper only (CPU and CUDA)
+        bulk_shear_viscosity_ratio: ζ/η [-] of the Maxwell viscous flow (None: the default, the
+            whole stress relaxes with one λ, so ζ/η = K/G = (1 + ν)/(1 − ν), 1.86 at ν = 0.3, as in
+            Dansereau et al. 2016). Set, the mean stress relaxes with λ_m = r λ, r = (ζ/η)(1 − ν)/(1 + ν),
+            and the deviator with λ, so that the bulk viscosity K λ_m is ζ/η times the shear
+            viscosity G λ: Hibler's (1979) viscous-plastic ratio is e² = 4. Large ratios approach
+            the kept mean stress and its volumetric locking (docs/solvers.md). A diagnostic of
+            lagice (2026-11-28, thirtieth session); explicit CPU stepper only, with the whole stress
+            relaxing (relax_mean_stress true, no max_pressure_pa)
         dilatancy_angle_deg: ψ [degrees] ∈ [0, 45) of a dilatant Maxwell viscous flow (None or 0:
             off, the default; a diagnostic of lagice, 2026-11-27; docs/physics.md §4, "Broken ice
             that dilates as it shears"). The viscous (permanent) strain rate K⁻¹σ/(Eλ) of
@@ -121,6 +129,7 @@ class MaxwellEBParams:
     damage_nonlocal_radius_m: float | None = None
     failure_stress: str = "nominal"
     crack_closure: bool = False
+    bulk_shear_viscosity_ratio: float | None = None
 
     def __post_init__(self):
         check_range("poisson (ν)", self.poisson, 0.0, 0.5, high_open=True)
@@ -174,6 +183,18 @@ class MaxwellEBParams:
             raise ConfigError("rheology.crack_closure = true needs rheology.relax_mean_stress = false: the closed "
                               "cracks build the mean stress with the undamaged modulus, and a relaxing mean stress "
                               "would creep away as it is built")
+        if self.bulk_shear_viscosity_ratio is not None:
+            check_range("bulk_shear_viscosity_ratio (ζ/η)", self.bulk_shear_viscosity_ratio, 0.0, 1.0e6,
+                        low_open=True)
+            others = {"relax_mean_stress": self.relax_mean_stress, "max_pressure_pa": self.max_pressure_pa,
+                      "dilatancy_angle_deg": self.dilatancy_angle_deg,
+                      "damage_nonlocal_radius_m": self.damage_nonlocal_radius_m}
+            if not self.relax_mean_stress or self.max_pressure_pa or self.dilatancy_angle_deg \
+                    or self.damage_nonlocal_radius_m:
+                raise ConfigError(f"rheology.bulk_shear_viscosity_ratio = {self.bulk_shear_viscosity_ratio!r} is "
+                                  f"implemented with the whole stress relaxing only (relax_mean_stress = true, no "
+                                  f"max_pressure_pa, dilatancy_angle_deg or damage_nonlocal_radius_m); it is set "
+                                  f"with {others}")
         if self.stress_correction not in STRESS_CORRECTIONS:
             raise ConfigError(f"rheology.stress_correction = {self.stress_correction!r}: expected one of "
                               f"{list(STRESS_CORRECTIONS)}")
@@ -208,6 +229,8 @@ class MaxwellEBParams:
             out["failure_stress"] = self.failure_stress
         if self.crack_closure:
             out["crack_closure"] = True
+        if self.bulk_shear_viscosity_ratio is not None:
+            out["bulk_shear_viscosity_ratio"] = self.bulk_shear_viscosity_ratio
         return out
 
     @property

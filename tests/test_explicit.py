@@ -220,7 +220,7 @@ def test_crack_closure_builds_the_mean_stress_of_compressed_broken_ice_with_the_
         vel = rate * mesh.nodes + shear * np.column_stack([mesh.nodes[:, 1], 0.0 * mesh.nodes[:, 0]])
         sg, dm, flag = sigma0.copy(), d.copy(), np.zeros(m, np.int8)
         kernel(tri, b, c, vel, sg, dm, g, np.full(m, 1e15), kc, kt, np.full(m, 20.0), np.zeros(m), dt_s * E,
-               np.ones(m), None, True, None, None, None, closure, dt_s, *rheo.K[0, :2], rheo.K[2, 2], rheo.q,
+               np.ones(m), None, np.inf, None, None, None, closure, dt_s, *rheo.K[0, :2], rheo.K[2, 2], rheo.q,
                rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag, None)
         assert np.array_equal(dm, d) and not flag.any()
         return sg
@@ -845,3 +845,51 @@ def test_dilatancy_is_refused_where_it_is_not_implemented():
         MaxwellEB(dilatancy_angle_deg=20.0, relax_mean_stress=False)
     with pytest.raises(ConfigError, match="max_pressure_pa = 10000.0"):
         MaxwellEB(dilatancy_angle_deg=20.0, max_pressure_pa=10e3)
+
+
+def test_bulk_shear_viscosity_ratio_relaxes_the_mean_stress_with_its_own_time():
+    """``rheology.bulk_shear_viscosity_ratio`` ζ/η: on a motionless plate of damaged ice one
+    sub-step relaxes the deviator by γ = λ/(λ + Δt_s) and the mean stress by
+    γ_m = λ_m/(λ_m + Δt_s), λ_m = r λ with r = (ζ/η)(1 − ν)/(1 + ν), to round-off; the
+    default (None) relaxes both by γ, and the kept mean (relax_mean_stress false) not at all.
+    ζ/η = (1 + ν)/(1 − ν), the ratio of one λ, gives r = 1. Steppers without it refuse it."""
+    from lagice.solvers.explicit import mean_relaxation_ratio
+
+    rng = np.random.default_rng(5)
+    m = 200
+    rheo = MaxwellEB(bulk_shear_viscosity_ratio=4.0)
+    p = rheo.params
+    r = mean_relaxation_ratio(p)
+    assert r == pytest.approx(4.0 * 0.7 / 1.3, rel=1e-15)
+    assert mean_relaxation_ratio(MaxwellEB(bulk_shear_viscosity_ratio=1.3 / 0.7).params) == pytest.approx(1.0)
+    d = rng.uniform(0.5, 0.99, m)
+    E, lam = rheo.moduli(d, np.ones(m))
+    dt_s = 50.0
+    g = lam / (lam + dt_s)
+    sigma0 = rng.normal(0, 1e4, (m, 3))
+    kc, kt = envelope_factors(rheo)
+    tri = np.zeros((m, 3), np.int32)
+    zeros3 = np.zeros((m, 3))
+
+    def one(keep):
+        sg, dm, flag = sigma0.copy(), d.copy(), np.zeros(m, np.int8)
+        element_stress_damage_kernel_serial(
+            tri, zeros3, zeros3, np.zeros((1, 2)), sg, dm, np.ones(m), np.full(m, 1e15), kc, kt,
+            np.full(m, 20.0), np.zeros(m), dt_s * E, g, None, keep, None, None, None, None, dt_s, *rheo.K[0, :2],
+            rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag, None)
+        assert np.array_equal(dm, d)
+        return 0.5 * (sg[:, 0] + sg[:, 1]), np.column_stack([0.5 * (sg[:, 0] - sg[:, 1]), sg[:, 2]])
+
+    m0 = 0.5 * (sigma0[:, 0] + sigma0[:, 1])
+    s0 = np.column_stack([0.5 * (sigma0[:, 0] - sigma0[:, 1]), sigma0[:, 2]])
+    lam_m = r * lam
+    for keep, gm in ((None, g), (r, lam_m / (lam_m + dt_s)), (np.inf, np.ones(m))):
+        mean, dev = one(keep)
+        assert np.allclose(mean, gm * m0, rtol=1e-12, atol=1e-12 * np.abs(m0).max())
+        assert np.allclose(dev, g[:, None] * s0, rtol=1e-12, atol=1e-12 * np.abs(s0).max())
+    assert np.all(lam_m / (lam_m + dt_s) > g)  # the mean relaxes more slowly than the deviator
+    with pytest.raises(ConfigError, match="bulk_shear_viscosity_ratio = 4.0 is implemented with the whole stress"):
+        MaxwellEB(bulk_shear_viscosity_ratio=4.0, relax_mean_stress=False)
+    for stepper in ("implicit", "explicit_cuda"):
+        with pytest.raises(ConfigError, match="bulk_shear_viscosity_ratio"):
+            rheo.require_stepper(stepper)

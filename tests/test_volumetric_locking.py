@@ -171,7 +171,7 @@ def test_nodal_volumetric_strain_changes_nothing_under_an_affine_flow():
         for dv in (None, divn):
             sg, dm, flag = sigma0.copy(), d.copy(), np.zeros(m, np.int8)
             kernel(tri, b, c, vel, sg, dm, np.ones(m), np.full(m, 1e15), kc, kt, np.full(m, 20.0), np.zeros(m),
-                   dt_s * E, lam / (lam + dt_s), None, True, None, None, None, None, dt_s, *rheo.K[0, :2],
+                   dt_s * E, lam / (lam + dt_s), None, np.inf, None, None, None, None, dt_s, *rheo.K[0, :2],
                    rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag, dv)
             out.append(sg)
         assert np.allclose(out[1], out[0], rtol=1e-10, atol=1e-10 * np.abs(out[0]).max())

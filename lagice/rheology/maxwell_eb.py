@@ -289,7 +289,8 @@ CORRECTION_PATHS = {"implicit": STRESS_CORRECTIONS, "explicit": ("origin", "mean
 #: stepper that does not list it, so no stepper silently runs without it
 OPTIONAL_TERMS = {"implicit": ("failure_stress",),
                   "explicit": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg",
-                               "damage_nonlocal_radius_m", "failure_stress", "crack_closure"),
+                               "damage_nonlocal_radius_m", "failure_stress", "crack_closure",
+                               "bulk_shear_viscosity_ratio"),
                   "explicit_cuda": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg", "failure_stress",
                                     "crack_closure"), "prescribed": ()}
 STEPPER_LABELS = {"implicit": "the implicit solver (solver.name = 'implicit')",

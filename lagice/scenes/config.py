@@ -76,6 +76,9 @@ SCHEMA = {
         # quasi-unilateral damage: the mean stress of compressed ice changes with the undamaged
         # modulus (MaxwellEBParams.crack_closure; needs relax_mean_stress = false)
         "crack_closure": (bool, False),
+        # ζ/η of the Maxwell viscous flow: the mean stress relaxes more slowly than the deviator
+        # (MaxwellEBParams.bulk_shear_viscosity_ratio; None: one λ for the whole stress)
+        "bulk_shear_viscosity_ratio": (NUM, None),
         "p_star": (NUM, 27.5e3), "c_star": (NUM, 20.0), "ellipse": (NUM, 2.0), "delta_min": (NUM, 2e-9),
         "replacement_pressure": (bool, False),
         # strength law (lagice.strength; issue 12): "uniform" = cohesion_min/max_pa,
@@ -138,7 +141,8 @@ RHEOLOGY_KEYS = {
                    "alpha", "cohesion_min_pa", "cohesion_max_pa", "healing_time_s", "concentration_c",
                    "max_damage", "stress_correction", "stress_correction_mean_fraction", "max_pressure_pa",
                    "max_pressure_thickness_exponent", "relax_mean_stress",
-                   "dilatancy_angle_deg", "damage_nonlocal_radius_m", "failure_stress", "crack_closure"),
+                   "dilatancy_angle_deg", "damage_nonlocal_radius_m", "failure_stress", "crack_closure",
+                   "bulk_shear_viscosity_ratio"),
     "viscous_plastic": ("p_star", "c_star", "ellipse", "delta_min", "replacement_pressure", "rho_ice"),
 }
 
@@ -176,6 +180,7 @@ LEGACY_VALUES = {
     "rheology.damage_nonlocal_radius_m": (None, 0, 0.0),  # 2026-11-28: local damage
     "rheology.failure_stress": ("nominal",),         # 2026-11-28: the envelope judges the nominal stress
     "rheology.crack_closure": (False,),              # 2026-11-28: damage lowers the modulus for every strain
+    "rheology.bulk_shear_viscosity_ratio": (None,),  # 2026-11-28: one relaxation time for the whole stress
     "thermo.new_ice_undamaged": (False,),            # 2026-11-27: new ice takes the element's damage
     "initial.state_file": (None, ""),                # 2026-11-24: no spin-up state
     "solver.substep_limit": (None, "mesh"),          # 2026-11-25: the whole-mesh limit

@@ -229,6 +229,14 @@ def _node_velocity(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, 
         vel_sum[i, 1] += vn
 
 
+def mean_relaxation_ratio(params) -> float:
+    """r = λ_m/λ [-] for ``rheology.bulk_shear_viscosity_ratio`` ζ/η: the bulk viscosity K λ_m
+    over the shear viscosity G λ is ζ/η, with K/G = (1 + ν)/(1 − ν) in plane stress, so
+    r = (ζ/η)(1 − ν)/(1 + ν) (r = 1: one λ, the default Maxwell-EB)."""
+    nu = params.poisson
+    return float(params.bulk_shear_viscosity_ratio) * (1.0 - nu) / (1.0 + nu)
+
+
 def stability_modulus(params, E, concentration):
     """The modulus [Pa] per element that sets the sub-step limit: the damaged E of the
     Maxwell update, or with ``crack_closure`` the undamaged E0 exp(−c*(1 − A)), with which the
@@ -273,9 +281,11 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     relaxation factor is λ/(λ + Δt_s (1 − P̃)), P̃ = min(1, pmax/(−σn)), computed from γ
     as γ/(γ + (1 − γ)(1 − P̃)) (neXtSIM's ``updateSigmaDamage``).
     keep_mean: None (rheology.relax_mean_stress true, the default; pruned as pmax is): the
-    relaxation factor scales the whole stress. True: it scales the deviatoric stress
-    σ − m I only (m = (σxx + σyy)/2 after the elastic increment), and the mean m is kept, or,
-    with pmax, scaled by the compressive term's factor (it creeps in tension and above P_max).
+    relaxation factor scales the whole stress. A float r: it scales the deviatoric stress
+    σ − m I only (m = (σxx + σyy)/2 after the elastic increment), and the mean m relaxes with
+    λ_m = r λ (rheology.bulk_shear_viscosity_ratio), or, for r = inf
+    (relax_mean_stress false), is kept or, with pmax, scaled by the compressive term's factor
+    (it creeps in tension and above P_max).
     theta: None (rheology.stress_correction = "origin", the default; pruned as pmax is): a
     super-critical stress is scaled towards the origin. A float θ ∈ (0, 2]
     (``"mean_stress"``, θ = ``stress_correction_mean_fraction``): it is brought back along
@@ -341,7 +351,12 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
                 axx += mc - am
                 ayy += mc - am
                 am = mc
-            gm = 1.0 if pmax is None else gp
+            if pmax is not None:
+                gm = gp
+            elif keep_mean == math.inf:  # relax_mean_stress = false: the mean is kept
+                gm = 1.0
+            else:  # rheology.bulk_shear_viscosity_ratio: λ_m = r λ, so γ_m = r γ/(r γ + 1 − γ)
+                gm = keep_mean * g / (keep_mean * g + (1.0 - g))
             sxx = (axx - am) * g + am * gm
             syy = (ayy - am) * g + am * gm
             sxy = (sigma[e, 2] + ed * (kss * exy)) * g
@@ -913,7 +928,9 @@ class ExplicitSolver:
         rh = self.rheology
         pmax = rh.max_pressure(state.thickness, state.concentration)  # None: off
         pmax = None if pmax is None else np.ascontiguousarray(pmax, np.float64)
-        keep_mean = None if p.relax_mean_stress else True
+        # None: the whole stress relaxes; inf: the mean is kept; r: the mean relaxes with λ_m = r λ
+        keep_mean = (math.inf if not p.relax_mean_stress else None if p.bulk_shear_viscosity_ratio is None
+                     else mean_relaxation_ratio(p))
         theta = None if p.stress_correction == "origin" else float(p.mean_fraction)
         dilat = p.dilatancy_factor  # None: off
         eff = None if p.failure_stress == "nominal" else True
