@@ -1761,7 +1761,8 @@ for _n, (_o, *_rest) in list(SPINUPS.items()):
 # strength_after_remesh = "all" pinned, as for the references. A lead for the 10 km months if either
 # run puts beta in 0.14-0.23, the wind factor in 0.006-0.010 and at least 3 bands inside.
 # Predicted: neither; the ratio differs from the default's by x2.15 only, and broken ice relaxes in
-# seconds to hours either way: the wind factor and beta within 20 % of their references' (nominal 0.0044 and 0.046; effective 0.0132 and 0.192).
+# seconds to hours either way: the wind factor and beta within 20 % of their references' (nominal
+# 0.0044 and 0.046; effective 0.0132 and 0.192).
 for _tag, _changes, _what in (("zeta4", ["rheology.bulk_shear_viscosity_ratio=4"], "nominal envelope"),
                               ("eff-zeta4", EFFECTIVE + ["rheology.bulk_shear_viscosity_ratio=4"],
                                "effective envelope")):
