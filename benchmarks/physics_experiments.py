@@ -1763,6 +1763,14 @@ for _n, (_o, *_rest) in list(SPINUPS.items()):
 # Predicted: neither; the ratio differs from the default's by x2.15 only, and broken ice relaxes in
 # seconds to hours either way: the wind factor and beta within 20 % of their references' (nominal
 # 0.0044 and 0.046; effective 0.0132 and 0.192).
+# Result (18:52 UTC): neither is a lead, and the prediction was wrong: the ratio matters a lot. Nominal:
+# wind factor 0.0008 (x0.18), rate 0.00063 per day (x0.19), beta 0.016, 4 remeshes, 13 km of drift,
+# median pressure 28 kPa at day 10 (reference 9): the pack nearly locks. Effective: wind factor 0.0120
+# (x0.91), rate 0.023 per day (x0.97), beta 0.117 (x0.61), half-shear area 20.4 %, R2 0.37; the broken
+# share at day 28 is 0.91 above damage 0.9 (reference 0.68). Not the mesh: in the gyre test (broken ice,
+# d = 0.99) zeta/eta = 4 holds a steady 60 Pa and turns at the relaxing pack's speed (0.2 % slower), and
+# even zeta/eta = 400 stays bounded (2.3 kPa, 4 % slower); zeta/eta = 1.857 gives the default to the 17
+# digits printed.
 for _tag, _changes, _what in (("zeta4", ["rheology.bulk_shear_viscosity_ratio=4"], "nominal envelope"),
                               ("eff-zeta4", EFFECTIVE + ["rheology.bulk_shear_viscosity_ratio=4"],
                                "effective envelope")):
