@@ -371,7 +371,7 @@ class RunLock:
                         pass
                 raise OutputError(f"cannot write in the output folder {folder}: {err.strerror}") from None
             try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                _flock_exclusive(fd)
             except BlockingIOError:
                 holder = _lock_holder(fd)
                 os.close(fd)
@@ -445,6 +445,29 @@ class RunLock:
         return True
 
 
+#: a lock found held is tried again this many times, this far apart [s], before the run is
+#: refused: ``running_holder``'s probe (``lagice plot`` / ``diagnose`` beside the folder) holds a
+#: shared lock for microseconds, and a run or resume that starts in that moment waits it out
+#: instead of being refused; a run that holds the lock is still refused, after 0.2 s
+LOCK_RETRIES = 20
+LOCK_RETRY_S = 0.01
+
+
+def _flock_exclusive(fd) -> None:
+    """Take the exclusive flock of ``fd`` without blocking, tried :data:`LOCK_RETRIES` times
+    :data:`LOCK_RETRY_S` apart; BlockingIOError when it is still held."""
+    import fcntl
+
+    for k in range(LOCK_RETRIES):
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return
+        except BlockingIOError:
+            if k == LOCK_RETRIES - 1:
+                raise
+            time.sleep(LOCK_RETRY_S)
+
+
 def running_holder(folder) -> str | None:
     """'pid P on host H, since T' of the process that holds the run lock of ``folder`` now
     (a run still going, or a resume), else None (no lock file, or a lock left by a run that
@@ -452,8 +475,7 @@ def running_holder(folder) -> str | None:
     folder (``lagice plot``, ``lagice diagnose``), which may run beside the run: they say
     that their figure covers the run so far. The probe is a non-blocking *shared* flock
     that is released at once: it never waits, and a run that starts in the same
-    microseconds is the only one that can see it (it is then refused as locked, with
-    nothing written)."""
+    microseconds waits it out (:func:`_flock_exclusive` tries again for 0.2 s)."""
     import fcntl
 
     path = Path(folder) / LOCK

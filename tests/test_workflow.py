@@ -336,6 +336,37 @@ def test_run_lock_in_one_process(tmp_path):
     assert (notes / LOCK).read_text() == "another tool's lock"
 
 
+def test_a_run_waits_out_the_probe_of_plot_beside_it(tmp_path):
+    """``lagice plot`` / ``diagnose`` probe a run folder's lock with a shared flock
+    (``running_holder``) that they release at once. A run that starts in that moment is not
+    refused: it tries the lock again for 0.2 s. Here a shared lock is held for 50 ms (far
+    longer than a probe) while the run lock is taken: it is taken once the probe lets go.
+    A lock held for longer than the retries is still refused, naming the holder."""
+    import fcntl
+    import threading
+
+    from lagice.errors import RunFolderLocked
+    from lagice.rundir import LOCK, LOCK_RETRIES, LOCK_RETRY_S, RunLock, running_holder
+
+    out = tmp_path / "run"
+    with RunLock(out):
+        (out / "lagice_run.json").write_text("{}")
+    assert running_holder(out) is None
+    fd = os.open(out / LOCK, os.O_RDONLY)
+    fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)  # the probe, held long
+    threading.Timer(0.05, lambda: fcntl.flock(fd, fcntl.LOCK_UN)).start()
+    t0 = time.perf_counter()
+    with RunLock(out) as lock:
+        assert lock.held
+        assert time.perf_counter() - t0 >= 0.04  # it waited for the probe
+    fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)  # held past the retries: refused
+    t0 = time.perf_counter()
+    with pytest.raises(RunFolderLocked, match=rf"run folder {out} is in use"):
+        RunLock(out).acquire()
+    assert time.perf_counter() - t0 >= (LOCK_RETRIES - 1) * LOCK_RETRY_S
+    os.close(fd)
+
+
 def test_a_file_system_without_flock_is_refused_not_run_unlocked(tmp_path, monkeypatch):
     """No file system here lacks flock: flock is made to fail as it does there (EOPNOTSUPP /
     ENOLCK) to show the message; the run does not go on unlocked."""
