@@ -561,6 +561,15 @@ def test_members_start_largest_first(tmp_path, monkeypatch):
     explicit = load_scene("shear_box", {**ex, "domain.resolution_m": 40e3})
     finer = load_scene("shear_box", {**ex, "domain.resolution_m": 20e3})
     assert 7.5 < estimated_cost(finer) / estimated_cost(explicit) < 8.5  # 2² elements × 2× the sub-steps
+    # an implicit member counts its steps at IMPLICIT_STEP_SUBSTEPS element-sub-steps each, not one
+    from lagice.ensemble.core import IMPLICIT_STEP_SUBSTEPS
+    from lagice.scenes.builder import domain_polygon
+    from lagice.schedule import parse_duration
+
+    implicit = load_scene("shear_box", {"solver.name": "implicit", "solver.dt": 600.0, "domain.resolution_m": 40e3})
+    elements = domain_polygon(implicit).area / (3 ** 0.5 / 4 * 40e3 ** 2)
+    steps = parse_duration(implicit["run"]["duration"], "run.duration") / 600.0
+    assert estimated_cost(implicit) == pytest.approx(IMPLICIT_STEP_SUBSTEPS * elements * steps, rel=1e-9)
     broken = load_scene("shear_box", {})
     broken["domain"]["resolution_m"] = "not a number"
     assert estimated_cost(broken) == float("inf")

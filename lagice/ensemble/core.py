@@ -343,6 +343,15 @@ class Ensemble:
         return ds
 
 
+#: what one implicit step costs per element, in explicit element-sub-steps, for the start
+#: order of :func:`estimated_cost`. Measured on the 2-vCPU VM, one thread (2026-11-28): an
+#: implicit step took 1.0 µs per element in ``uniaxial_compression`` and 17.6 µs in
+#: ``winter_basin`` at 20 km, against about 22 ns per element-sub-step for the serial
+#: explicit kernels (45 M/s, docs/benchmarks.md): 45 and 800 sub-steps; 200 lies between them
+#: (their geometric mean is 190). A calibration for the order only.
+IMPLICIT_STEP_SUBSTEPS = 200.0
+
+
 def estimated_cost(cfg: dict) -> float:
     """A member's relative cost, for the order in which members start (:func:`largest_first`):
     elements × outer steps × sub-steps per step. Elements from the domain's area over the area
@@ -350,8 +359,8 @@ def estimated_cost(cfg: dict) -> float:
     ``solver.dt``; sub-steps ``solver.substeps`` when fixed, for the explicit Maxwell-EB stepper
     otherwise ``solver.dt`` over the stability limit at that resolution and the undamaged
     modulus (:func:`lagice.stability.explicit_substep_limit`, times ``solver.safety``), 300 for
-    mEVP (its default), and 1 for the implicit solver (its Newton iterations are not known
-    before it runs, so against members of a sub-stepped solver its members count low). Only an
+    mEVP (its default), and :data:`IMPLICIT_STEP_SUBSTEPS` for an implicit step (its Newton
+    iterations are not known before it runs: a measured average, not the member's). Only an
     estimate, for the order: nothing is meshed, and a member whose estimate fails (its domain
     cannot be built here) gets +inf, so it starts first rather than last."""
     from ..scenes.builder import domain_polygon
@@ -364,7 +373,7 @@ def estimated_cost(cfg: dict) -> float:
         dt = time_step_s(cfg)
         steps = parse_duration(cfg["run"]["duration"], "run.duration") / dt
         sv = cfg["solver"]
-        per_step = 1.0
+        per_step = IMPLICIT_STEP_SUBSTEPS if sv["name"] == "implicit" else 1.0
         if sv.get("substeps"):
             per_step = float(sv["substeps"])
         elif sv["name"] == "evp":
