@@ -1782,6 +1782,20 @@ for _tag, _changes, _what in (("zeta4", ["rheology.bulk_shear_viscosity_ratio=4"
     SPINUPS[f"H20-{_tag}"] = (_pin_all(SPINUPS[f"H20-{_tag}"][0]), *SPINUPS[f"H20-{_tag}"][1:])
 
 
+# The other side of the same lever (a diagnostic of the mechanism, not a value to ship), stated
+# 2026-11-28 18:44 UTC before the run: the nominal envelope with zeta/eta = 0.93, half the Maxwell-EB's
+# 1.857 (the mean relaxes with lambda_m = 0.5 lambda), 20 km, closed basin, the validation month, its own
+# spin-up, against B20-hthick-own. If the pack moves by the creep of its mean stress, it moves faster:
+# predicted wind factor and rate x1.5-3 (wind factor 0.007-0.013), beta still below 0.08 (compaction
+# creep is diffuse). A lead only with beta in 0.14-0.23, the wind factor in 0.006-0.010 and 3 bands
+# inside (not expected).
+add_screen_20km("zeta093", ["rheology.bulk_shear_viscosity_ratio=0.9286"],
+                "20 km: nominal envelope, bulk viscosity half the Maxwell-EB's ratio (zeta/eta 0.93), own spin-up")
+_e = EXPERIMENTS["B20-hthick-zeta093"]
+EXPERIMENTS["B20-hthick-zeta093"] = (_e[0], _pin_all(_e[1]), *_e[2:])
+SPINUPS["H20-zeta093"] = (_pin_all(SPINUPS["H20-zeta093"][0]), *SPINUPS["H20-zeta093"][1:])
+
+
 # --- 2026-11-28 (twenty-eighth session): the ±50 % runs with the shipped set --------------------
 # The sensitivity table of docs/validation.md for the set shipped since the switch: the closed basin's
 # validation month from the spin-up made with kept elements keeping their strength, one value changed
