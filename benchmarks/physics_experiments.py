@@ -1796,6 +1796,28 @@ EXPERIMENTS["B20-hthick-zeta093"] = (_e[0], _pin_all(_e[1]), *_e[2:])
 SPINUPS["H20-zeta093"] = (_pin_all(SPINUPS["H20-zeta093"][0]), *SPINUPS["H20-zeta093"][1:])
 
 
+# Result (18:53 UTC): as predicted for the drift and the rate, beta just above its prediction. zeta/eta = 0.93:
+# wind factor 0.0074 (inside 0.006-0.010; x1.7), rate 0.0076 per day (x2.3), beta 0.083 (x1.8), tails
+# 2.28 / 2.23 and half-shear area 5.7 % inside, R2 0.711 just below its band (0.78 before): 3 bands inside
+# (4 before). Over zeta/eta = 4, 1.857, 0.93 the wind factor is 0.0008, 0.0044, 0.0074 and beta 0.016,
+# 0.046, 0.083: both rise as the bulk viscosity falls. Bouchat and Tremblay (2017, "Using sea-ice
+# deformation fields to constrain the mechanical strength parameters of geophysical sea ice", JGR Oceans
+# 122) found a viscous-plastic pack at 10 km closer to RGPS with the compressive strength reduced against
+# the shear strength: a smaller zeta/eta than Hibler's e^2 = 4.
+# A sweep further down, stated 2026-11-28 18:49 UTC before the runs: the nominal envelope with zeta/eta =
+# 0.5 and 0.25, 20 km, closed basin, the validation month, own spin-ups. A lead for the 10 km months if
+# either run has beta in 0.14-0.23, the wind factor in 0.006-0.010 and at least 3 bands inside.
+# Predicted: beta rises on (0.10-0.13 at 0.5, 0.12-0.16 at 0.25), the wind factor too (0.009-0.014, so
+# out of its band at 0.25), the rate 0.010-0.015 per day, the tails stay inside, R2 falls (0.6-0.7):
+# 0.5 is not a lead (beta short), 0.25 is at best borderline.
+for _tag, _z in (("zeta05", "0.5"), ("zeta025", "0.25")):
+    add_screen_20km(_tag, [f"rheology.bulk_shear_viscosity_ratio={_z}"],
+                    f"20 km: nominal envelope, zeta/eta = {_z}, own spin-up")
+    _e = EXPERIMENTS[f"B20-hthick-{_tag}"]
+    EXPERIMENTS[f"B20-hthick-{_tag}"] = (_e[0], _pin_all(_e[1]), *_e[2:])
+    SPINUPS[f"H20-{_tag}"] = (_pin_all(SPINUPS[f"H20-{_tag}"][0]), *SPINUPS[f"H20-{_tag}"][1:])
+
+
 # --- 2026-11-28 (twenty-eighth session): the ±50 % runs with the shipped set --------------------
 # The sensitivity table of docs/validation.md for the set shipped since the switch: the closed basin's
 # validation month from the spin-up made with kept elements keeping their strength, one value changed
