@@ -1763,7 +1763,7 @@ for _n, (_o, *_rest) in list(SPINUPS.items()):
 # Predicted: neither; the ratio differs from the default's by x2.15 only, and broken ice relaxes in
 # seconds to hours either way: the wind factor and beta within 20 % of their references' (nominal
 # 0.0044 and 0.046; effective 0.0132 and 0.192).
-# Result (18:52 UTC): neither is a lead, and the prediction was wrong: the ratio matters a lot. Nominal:
+# Result (18:42 UTC): neither is a lead, and the prediction was wrong: the ratio matters a lot. Nominal:
 # wind factor 0.0008 (x0.18), rate 0.00063 per day (x0.19), beta 0.016, 4 remeshes, 13 km of drift,
 # median pressure 28 kPa at day 10 (reference 9): the pack nearly locks. Effective: wind factor 0.0120
 # (x0.91), rate 0.023 per day (x0.97), beta 0.117 (x0.61), half-shear area 20.4 %, R2 0.37; the broken
@@ -1796,7 +1796,7 @@ EXPERIMENTS["B20-hthick-zeta093"] = (_e[0], _pin_all(_e[1]), *_e[2:])
 SPINUPS["H20-zeta093"] = (_pin_all(SPINUPS["H20-zeta093"][0]), *SPINUPS["H20-zeta093"][1:])
 
 
-# Result (18:53 UTC): as predicted for the drift and the rate, beta just above its prediction. zeta/eta = 0.93:
+# Result (18:48 UTC): as predicted for the drift and the rate, beta just above its prediction. zeta/eta = 0.93:
 # wind factor 0.0074 (inside 0.006-0.010; x1.7), rate 0.0076 per day (x2.3), beta 0.083 (x1.8), tails
 # 2.28 / 2.23 and half-shear area 5.7 % inside, R2 0.711 just below its band (0.78 before): 3 bands inside
 # (4 before). Over zeta/eta = 4, 1.857, 0.93 the wind factor is 0.0008, 0.0044, 0.0074 and beta 0.016,
