@@ -1818,7 +1818,7 @@ for _tag, _z in (("zeta05", "0.5"), ("zeta025", "0.25")):
     SPINUPS[f"H20-{_tag}"] = (_pin_all(SPINUPS[f"H20-{_tag}"][0]), *SPINUPS[f"H20-{_tag}"][1:])
 
 
-# Result (18:57 UTC): neither is a lead; beta does not rise on, against the prediction. zeta/eta = 0.5: beta
+# Result (18:53 UTC): neither is a lead; beta does not rise on, against the prediction. zeta/eta = 0.5: beta
 # 0.043, tails 1.89 / 2.05 (both just below their bands), half-shear area 4.9 %, R2 0.687, rate 0.0096 per
 # day, wind factor 0.0082. zeta/eta = 0.25: beta 0.049, tails 2.58 / 2.64, half-shear area 5.1 %, R2
 # 0.721, rate 0.0112 per day (inside), wind factor 0.0087 (inside): the |div| tail, the half-shear area
