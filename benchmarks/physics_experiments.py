@@ -1839,6 +1839,21 @@ add_month_own_spinup("zeta025", ["rheology.bulk_shear_viscosity_ratio=0.25"],
                      "zeta/eta = 0.25 (the bulk viscosity a quarter of the shear viscosity), own spin-up")
 
 
+# The eight months of weather for zeta/eta = 0.25 (run only if the month above passes), stated 2026-11-28
+# 18:59 UTC, before the month's result: both basins, wind seeds 2027-2033 beside the validation month, from
+# the same 10 km spin-up. Against "kept elements keep their strength, ... eight months" (the shipped set),
+# by the twelfth session's rule made mechanical: `physics_experiments.py screen "zeta/eta = 0.25, closed,
+# eight months" "kept elements keep their strength, closed, eight months" --band-gain 0 --rate-gain 2
+# --beta-tolerance 0.005 --wind-factor-band 0.006 0.010` and the same for the strait: it passes in a basin
+# if it puts at least as many bands inside, the rate at least x2, beta no further from its band than
+# +0.005 and the median wind factor in 0.006-0.010. A candidate to ship if it passes in both basins (the
+# switch itself would be a later session's, with the validation report, the EVP control and the +-50 %
+# runs made again). Predicted: it passes in the strait and fails in the closed basin (R2 just below its
+# band: 3 bands inside against 4).
+add_weather_ensemble("zeta025", ["rheology.bulk_shear_viscosity_ratio=0.25"] + from_spinup("H1125-zeta025"),
+                     "zeta/eta = 0.25", "zeta/eta = 0.25", ENSEMBLE_SEEDS + MORE_SEEDS, suffix=", eight months")
+
+
 # --- 2026-11-28 (twenty-eighth session): the ±50 % runs with the shipped set --------------------
 # The sensitivity table of docs/validation.md for the set shipped since the switch: the closed basin's
 # validation month from the spin-up made with kept elements keeping their strength, one value changed
