@@ -431,7 +431,11 @@ def _node_divergence(vel, ptr, elems, tri, b, c, area, divn):
     Burton (1998, "A simple average nodal pressure tetrahedral element for incompressible and
     nearly incompressible dynamic explicit applications", Commun. Numer. Meth. Eng. 14). The
     element→node→element averaging is symmetric in the area-weighted inner product, so the
-    elastic energy stays a positive quadratic form and no sub-step limit grows."""
+    elastic energy stays a positive quadratic form and no sub-step limit grows. But it leaves
+    the velocity fields whose element divergences alternate in sign, and average to zero at
+    every node, with no volumetric stiffness: where broken ice's deviator relaxes in seconds
+    they carry the deformation (20 km basin screens: noisy shear, β 0.59–0.84), so the option is
+    a diagnostic of the locking, not a cure (docs/solvers.md, "Volumetric locking")."""
     n = ptr.shape[0] - 1
     for i in prange(n):
         s = 0.0
@@ -687,7 +691,8 @@ class ExplicitSolver:
         volumetric_strain: ``"element"`` (default) or ``"nodal"``: the volumetric strain
             rate of each element's stress update is the mean of its nodes' area-weighted
             averages (:func:`_node_divergence`; one more node pass per sub-step), which frees
-            ice whose mean stress does not relax from volumetric locking.
+            ice whose mean stress does not relax from volumetric locking (a diagnostic: its
+            spurious modes carry the deformation of broken ice in the winter basin).
         profile_kernels: time the node and element kernels separately (a Python
             loop over the sub-steps, two kernel calls each) instead of running the
             whole sub-step loop in one compiled call (the default; same results).
