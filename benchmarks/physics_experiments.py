@@ -1866,6 +1866,12 @@ add_weather_ensemble("zeta025", ["rheology.bulk_shear_viscosity_ratio=0.25"] + f
 # wind factor in 0.006-0.010, the rate at least x2, bands inside at least the shipped set's (4 and 3), in
 # both basins. Predicted: wind factor 0.006-0.007, the rate x1.8-2.2, both tails inside, half-shear area
 # 3.5-4.5 %: borderline, likely failing on the rate or one band in the closed basin.
+# Result (19:33 UTC): FAILS by one band in each basin, about as predicted. Closed: wind factor 0.0068
+# (inside), rate 0.0066 per day (x2.1), beta 0.044, tails 1.93 / 2.27 (inside), half-shear area 3.5 %
+# (just below 4 %), R2 0.787: 3 bands inside against 4. Strait: wind factor 0.0073, rate 0.0066 (x2.3),
+# beta 0.067, tails 1.91 / 1.93, half-shear area 2.9 %, R2 0.771: 2 bands against 3. Over zeta/eta = 1.857,
+# 0.93, 0.25 at 10 km the drift and the rate rise together and the half-shear area falls (4.4-4.9 %,
+# 2.9-3.5 %, 2.4-2.9 %): freer drift comes with more localisation, not with beta.
 add_month_own_spinup("zeta093", ["rheology.bulk_shear_viscosity_ratio=0.9286"],
                      "zeta/eta = 0.93 (half the Maxwell-EB's bulk-to-shear viscosity ratio), own spin-up")
 
