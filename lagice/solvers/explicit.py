@@ -442,11 +442,8 @@ def _node_divergence(vel, ptr, elems, tri, b, c, area, divn):
         a = 0.0
         for p in range(ptr[i], ptr[i + 1]):
             e = elems[p]
-            de = 0.0
-            for k in range(3):
-                j = tri[e, k]
-                de += b[e, k] * vel[j, 0] + c[e, k] * vel[j, 1]
-            s += area[e] * de
+            exx, eyy, _ = element_strain_rate(tri, b, c, vel, e)
+            s += area[e] * (exx + eyy)
             a += area[e]
         divn[i] = s / a
 
