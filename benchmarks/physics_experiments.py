@@ -1749,6 +1749,15 @@ for _n, (_o, *_rest) in list(SPINUPS.items()):
     if _n != "shipped" and _o is not None:
         SPINUPS[_n] = (_pin_all(_o), *_rest)
 
+
+def pin_screen_20km(tag: str) -> None:
+    """Pin ``"all"`` on the 20 km screen ``tag`` (:func:`add_screen_20km`) defined below this line,
+    as on the screens above it, so that it compares with them."""
+    e = EXPERIMENTS[f"B20-hthick-{tag}"]
+    EXPERIMENTS[f"B20-hthick-{tag}"] = (e[0], _pin_all(e[1]), *e[2:])
+    s = SPINUPS[f"H20-{tag}"]
+    SPINUPS[f"H20-{tag}"] = (_pin_all(s[0]), *s[1:])
+
 # --- 2026-11-28 (thirtieth session): a bulk viscosity larger than the shear viscosity -----------
 # Between the two ends measured so far, the whole stress relaxing with one lambda (zeta/eta = K/G =
 # (1 + nu)/(1 - nu) = 1.86) and the mean kept (zeta/eta infinite, locked by the mesh), lies Hibler's
@@ -1776,10 +1785,7 @@ for _tag, _changes, _what in (("zeta4", ["rheology.bulk_shear_viscosity_ratio=4"
                                "effective envelope")):
     add_screen_20km(_tag, _changes, f"20 km: {_what}, bulk viscosity 4x the shear viscosity (Hibler's e^2), "
                                     f"own spin-up")
-    EXPERIMENTS[f"B20-hthick-{_tag}"] = (*EXPERIMENTS[f"B20-hthick-{_tag}"][:1],
-                                         _pin_all(EXPERIMENTS[f"B20-hthick-{_tag}"][1]),
-                                         *EXPERIMENTS[f"B20-hthick-{_tag}"][2:])
-    SPINUPS[f"H20-{_tag}"] = (_pin_all(SPINUPS[f"H20-{_tag}"][0]), *SPINUPS[f"H20-{_tag}"][1:])
+    pin_screen_20km(_tag)
 
 
 # The other side of the same lever (a diagnostic of the mechanism, not a value to ship), stated
@@ -1791,9 +1797,7 @@ for _tag, _changes, _what in (("zeta4", ["rheology.bulk_shear_viscosity_ratio=4"
 # inside (not expected).
 add_screen_20km("zeta093", ["rheology.bulk_shear_viscosity_ratio=0.9286"],
                 "20 km: nominal envelope, bulk viscosity half the Maxwell-EB's ratio (zeta/eta 0.93), own spin-up")
-_e = EXPERIMENTS["B20-hthick-zeta093"]
-EXPERIMENTS["B20-hthick-zeta093"] = (_e[0], _pin_all(_e[1]), *_e[2:])
-SPINUPS["H20-zeta093"] = (_pin_all(SPINUPS["H20-zeta093"][0]), *SPINUPS["H20-zeta093"][1:])
+pin_screen_20km("zeta093")
 
 
 # Result (18:48 UTC): as predicted for the drift and the rate, beta just above its prediction. zeta/eta = 0.93:
@@ -1813,9 +1817,7 @@ SPINUPS["H20-zeta093"] = (_pin_all(SPINUPS["H20-zeta093"][0]), *SPINUPS["H20-zet
 for _tag, _z in (("zeta05", "0.5"), ("zeta025", "0.25")):
     add_screen_20km(_tag, [f"rheology.bulk_shear_viscosity_ratio={_z}"],
                     f"20 km: nominal envelope, zeta/eta = {_z}, own spin-up")
-    _e = EXPERIMENTS[f"B20-hthick-{_tag}"]
-    EXPERIMENTS[f"B20-hthick-{_tag}"] = (_e[0], _pin_all(_e[1]), *_e[2:])
-    SPINUPS[f"H20-{_tag}"] = (_pin_all(SPINUPS[f"H20-{_tag}"][0]), *SPINUPS[f"H20-{_tag}"][1:])
+    pin_screen_20km(_tag)
 
 
 # Result (18:53 UTC): neither is a lead; beta does not rise on, against the prediction. zeta/eta = 0.5: beta
