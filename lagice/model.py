@@ -237,6 +237,10 @@ class Model:
         for comp in self.components:
             for k, v in comp.checkpoint_state()[0].items():
                 arrays[f"component.{comp.name}.{k}"] = v
+        # a stepper's own dynamic state beyond the state's fields (the explicit stepper's
+        # Crouzeix–Raviart edge velocities), so that a resume is bit for bit
+        for k, v in getattr(self.stepper, "checkpoint_arrays", dict)().items():
+            arrays[f"stepper.{k}"] = v
         return arrays
 
     def state_meta(self) -> dict:
@@ -266,6 +270,13 @@ class Model:
         self.ledger = VolumeLedger.from_dict(meta["ledger"])
         self.timings = {**dict.fromkeys(TIMING_KEYS, 0.0), **meta.get("timings", {})}
         self.stepper.reset_topology(mesh)
+        held = {k[len("stepper."):]: v for k, v in arrays.items() if k.startswith("stepper.")}
+        if held or hasattr(self.stepper, "restore_arrays"):
+            restore = getattr(self.stepper, "restore_arrays", None)
+            if restore is None:
+                raise ConfigError(f"the checkpoint holds stepper arrays {sorted(held)} that the "
+                                  f"{type(self.stepper).__name__} stepper does not read")
+            restore(held)
         comp_meta = meta.get("components", {})
         fresh = []
         for c in self.components:

@@ -640,7 +640,8 @@ def solver_options(cfg: dict) -> dict:
     accepted = set(inspect.signature(SOLVERS[sv["name"]].__init__).parameters)
     opts = {}
     for k in ("linear_solver", "tol", "max_iter", "substeps", "allow_unstable", "safety", "parallel",
-              "substep_limit", "volumetric_strain", "damage_iterations", "damage_tol"):
+              "substep_limit", "volumetric_strain", "velocity_element", "jump_penalty", "damage_iterations",
+              "damage_tol"):
         if sv[k] is None or (k == "allow_unstable" and sv[k] is False):
             continue
         if k == "parallel" and isinstance(sv[k], str):
@@ -658,6 +659,24 @@ def solver_options(cfg: dict) -> dict:
                 from ..solvers.cuda_explicit import check_cuda_substep_limit
 
                 check_cuda_substep_limit(sv[k], bool(cfg["rheology"]["crack_closure"]))
+        if k == "velocity_element":
+            from ..solvers.explicit import check_velocity_element
+
+            check_velocity_element(sv[k])
+            if sv[k] != "linear":
+                if cfg["rheology"]["damage_nonlocal_radius_m"]:
+                    raise ConfigError(f"solver.velocity_element = {sv[k]!r} is not implemented with "
+                                      f"rheology.damage_nonlocal_radius_m; use \"linear\"")
+                if sv["volumetric_strain"] not in (None, "element"):
+                    raise ConfigError(f"solver.volumetric_strain = {sv['volumetric_strain']!r} averages linear "
+                                      f"velocities at the nodes; with solver.velocity_element = {sv[k]!r} use "
+                                      f"\"element\"")
+        if k == "jump_penalty" and not sv[k] >= 0.0:
+            raise ConfigError(f"solver.jump_penalty = {sv[k]!r}: expected a number >= 0 (Hansbo and Larson's penalty "
+                              f"factor κ; 0: none)")
+        if k == "jump_penalty" and sv[k] and sv["velocity_element"] != "crouzeix_raviart":
+            raise ConfigError(f"solver.jump_penalty = {sv[k]!r} penalises the jumps of Crouzeix-Raviart velocities; "
+                              f"set solver.velocity_element = \"crouzeix_raviart\" or leave it unset")
         if k == "volumetric_strain":
             from ..solvers.explicit import check_volumetric_strain
 

@@ -102,6 +102,12 @@ SCHEMA = {
         # ("element", the default) or averaged at the nodes ("nodal": no volumetric locking where the
         # mean stress is kept; lagice.solvers.explicit._node_divergence)
         "volumetric_strain": (str, None),
+        # explicit stepper: the velocity space, "linear" (the default, one value per node) or
+        # "crouzeix_raviart" (one per edge midpoint; lagice.solvers.crouzeix_raviart)
+        "velocity_element": (str, None),
+        # with "crouzeix_raviart": Hansbo and Larson's (2003) interior-edge jump penalty κ (0: none;
+        # lagice.solvers.crouzeix_raviart.JumpPenalty)
+        "jump_penalty": (NUM, None),
         # implicit solver: Dansereau et al. (2016)'s fixed point between the solve and the damage
         # update (lagice.solvers.implicit, step 4); 1 pass (no fixed point) by default
         "damage_iterations": (int, None), "damage_tol": (NUM, None),
@@ -185,6 +191,8 @@ LEGACY_VALUES = {
     "initial.state_file": (None, ""),                # 2026-11-24: no spin-up state
     "solver.substep_limit": (None, "mesh"),          # 2026-11-25: the whole-mesh limit
     "solver.volumetric_strain": (None, "element"),   # 2026-11-28: each element's own volumetric strain
+    "solver.velocity_element": (None, "linear"),     # 2026-11-28: velocities at the nodes
+    "solver.jump_penalty": (None, 0, 0.0),           # 2026-11-28: no jump penalty
 }
 
 

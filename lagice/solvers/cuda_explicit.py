@@ -159,6 +159,10 @@ def check_solver_device(sv: dict) -> None:
             raise ConfigError(f"solver.volumetric_strain = {sv.get('volumetric_strain')!r}: the CUDA stepper uses "
                               f"each element's own volumetric strain only; set solver.device = \"cpu\", or leave "
                               f"solver.volumetric_strain unset")
+        if sv.get("velocity_element") not in (None, "linear"):
+            raise ConfigError(f"solver.velocity_element = {sv.get('velocity_element')!r}: the CUDA stepper has "
+                              f"velocities at the nodes only; set solver.device = \"cpu\", or leave "
+                              f"solver.velocity_element unset")
         require_cuda("solver.device")
 
 

@@ -51,6 +51,12 @@ from ..rheology.maxwell_eb import _dcrit_towards, closed_crack_mean
 from ..stability import effective_dx
 from ..state import IceState
 from .base import StepInfo
+from .crouzeix_raviart import (
+    jump_impulse_kernel,
+    jump_impulse_kernel_serial,
+    jump_update_kernel,
+    jump_update_kernel_serial,
+)
 from .nonlocal_damage import NonlocalWeights
 
 #: how the measured sub-step limit C Δx/sqrt(E/ρ) is applied (:mod:`lagice.stability`):
@@ -67,6 +73,20 @@ SUBSTEP_LIMITS = ("mesh", "element")
 #: averages (Bonet and Burton 1998's average nodal pressure), against the volumetric locking of
 #: linear triangles whose mean stress is kept while the deviator relaxes (docs/solvers.md)
 VOLUMETRIC_STRAIN = ("element", "nodal")
+
+
+#: the velocity space of the explicit stepper: "linear" (default; continuous, linear per triangle,
+#: one value per node, as neXtSIM) or "crouzeix_raviart" (linear per triangle, continuous at the edge
+#: midpoints, one value per edge: :mod:`lagice.solvers.crouzeix_raviart`; a stable pair with the
+#: one stress per element, so ice whose mean stress is kept is not locked by the mesh)
+VELOCITY_ELEMENTS = ("linear", "crouzeix_raviart")
+
+
+def check_velocity_element(velocity_element: str) -> str:
+    if velocity_element not in VELOCITY_ELEMENTS:
+        raise ConfigError(f"solver.velocity_element = {velocity_element!r}: expected one of "
+                          f"{list(VELOCITY_ELEMENTS)}")
+    return velocity_element
 
 
 def check_volumetric_strain(volumetric_strain: str) -> str:
@@ -636,6 +656,37 @@ substeps_nonlocal_parallel = specialised_copy(
 
 SUBSTEPS_NONLOCAL = (substeps_nonlocal_serial, substeps_nonlocal_parallel)
 
+
+@njit(cache=True, error_model="numpy")
+def substeps_jump_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
+                         c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat,
+                         eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn,
+                         area, j_dofs, j_coef, j_left, j_right, h, j_kfac, j_T, j_ptr, j_idx, j_c, dt_over_m):
+    """:func:`substeps_serial` for Crouzeix–Raviart velocities with the jump penalty
+    (:class:`lagice.solvers.crouzeix_raviart.JumpPenalty`): each sub-step adds the penalty's
+    impulse from the last tractions, runs the node kernel over the edges, updates the tractions
+    from the new velocities and runs the element kernel."""
+    n_capped = 0
+    for k in range(n_sub):
+        jump_impulse_kernel_serial(vel, fixed, j_ptr, j_idx, j_c, j_T, dt_over_m)
+        node_velocity_kernel_serial(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
+                                    (k + 1) / n_sub)
+        jump_update_kernel_serial(vel, j_dofs, j_coef, j_left, j_right, h, e_dt, gamma, j_kfac, j_T)
+        n_capped += element_stress_damage_kernel_serial(
+            tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta,
+            dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn)
+    return n_capped
+
+
+#: :func:`substeps_jump_serial` with the parallel kernel builds
+substeps_jump_parallel = specialised_copy(
+    substeps_jump_serial, "_parallel",
+    {"node_velocity_kernel_serial": node_velocity_kernel,
+     "jump_impulse_kernel_serial": jump_impulse_kernel,
+     "jump_update_kernel_serial": jump_update_kernel,
+     "element_stress_damage_kernel_serial": element_stress_damage_kernel}, error_model="numpy")
+SUBSTEPS_JUMP = (substeps_jump_serial, substeps_jump_parallel)
+
 #: the α = 4 builds (Dansereau et al. 2016's value, the default): the element kernel with
 #: λ = λ0 x³ compiled in, and sub-step loops that call it
 element_stress_damage_kernel_a4 = specialised_copy(
@@ -690,6 +741,15 @@ class ExplicitSolver:
             averages (:func:`_node_divergence`; one more node pass per sub-step), which frees
             ice whose mean stress does not relax from volumetric locking (a diagnostic: its
             spurious modes carry the deformation of broken ice in the winter basin).
+        jump_penalty: κ ≥ 0 of the Crouzeix–Raviart velocities' interior-edge jump penalty
+            (:class:`~lagice.solvers.crouzeix_raviart.JumpPenalty`; 0, the default: none). Its
+            tractions are kept between steps like the edge velocities, and set to zero at a remesh.
+        velocity_element: ``"linear"`` (default) or ``"crouzeix_raviart"``: velocities at the
+            edge midpoints (:mod:`lagice.solvers.crouzeix_raviart`; the same kernels run over the
+            edges, with sub-steps :data:`~lagice.solvers.crouzeix_raviart.SUBSTEP_FACTOR` times
+            shorter). ``state.velocity`` holds their average at the nodes (the nodes move with
+            it); the edge velocities are kept between steps and rebuilt from the node velocities
+            after a remesh or a resume (logged; such a resume is not bit for bit).
         profile_kernels: time the node and element kernels separately (a Python
             loop over the sub-steps, two kernel calls each) instead of running the
             whole sub-step loop in one compiled call (the default; same results).
@@ -715,7 +775,7 @@ class ExplicitSolver:
     def __init__(self, rheology: MaxwellEB, mesh, bcs=(), forces=(), substeps: int | None = None,
                  heal_rate=None, safety: float = 0.7, allow_unstable: bool = False,
                  parallel: bool | str | None = None, profile_kernels: bool = False, substep_limit: str = "mesh",
-                 volumetric_strain: str = "element"):
+                 volumetric_strain: str = "element", velocity_element: str = "linear", jump_penalty: float = 0.0):
         if not isinstance(rheology, MaxwellEB):
             raise ConfigError(f"the explicit stepper solves the Maxwell-EB rheology; got "
                               f"{type(rheology).__name__} (use solver 'evp' for viscous-plastic)")
@@ -728,6 +788,20 @@ class ExplicitSolver:
             raise ConfigError(f"safety = {safety!r} must be in (0, 1]")
         self.substep_limit = check_substep_limit(substep_limit)
         self.volumetric_strain = check_volumetric_strain(volumetric_strain)
+        self.velocity_element = check_velocity_element(velocity_element)
+        if self.velocity_element != "linear" and self.volumetric_strain != "element":
+            raise ConfigError(f"solver.volumetric_strain = {volumetric_strain!r} averages linear velocities at the "
+                              f"nodes; with solver.velocity_element = {velocity_element!r} use \"element\"")
+        if not (isinstance(jump_penalty, (int, float)) and math.isfinite(jump_penalty) and jump_penalty >= 0.0):
+            raise ConfigError(f"solver.jump_penalty = {jump_penalty!r}: expected a number >= 0 (Hansbo and Larson's "
+                              f"penalty factor κ; 0: none)")
+        if jump_penalty and self.velocity_element != "crouzeix_raviart":
+            raise ConfigError(f"solver.jump_penalty = {jump_penalty!r} penalises the jumps of Crouzeix-Raviart "
+                              f"velocities; set solver.velocity_element = \"crouzeix_raviart\" or leave it unset")
+        self.jump_penalty = float(jump_penalty)
+        self._jump = None  # the JumpPenalty of the current mesh (jump_penalty > 0)
+        self._cr = None  # the CREdges of the current mesh (crouzeix_raviart)
+        self._cr_vel = None  # (edge velocities, the node velocities written with them)
         self.rheology = rheology
         self.forces = list(forces)
         self.substeps = substeps
@@ -756,6 +830,12 @@ class ExplicitSolver:
         if self.nonlocal_weights is not None and self.volumetric_strain != "element":
             raise ConfigError(f"solver.volumetric_strain = {volumetric_strain!r} is not implemented with "
                               f"rheology.damage_nonlocal_radius_m = {radius!r}; use \"element\"")
+        if self.nonlocal_weights is not None and self.velocity_element != "linear":
+            raise ConfigError(f"solver.velocity_element = {velocity_element!r} is not implemented with "
+                              f"rheology.damage_nonlocal_radius_m = {radius!r}; use \"linear\"")
+        if self.jump_penalty and profile_kernels:
+            raise ConfigError("profile_kernels times the sub-step loop without the jump penalty; it is not "
+                              f"implemented with solver.jump_penalty = {jump_penalty!r}")
         if self.nonlocal_weights is not None and profile_kernels:
             raise ConfigError("profile_kernels times the local element kernel; it is not implemented with "
                               f"rheology.damage_nonlocal_radius_m = {radius!r}")
@@ -782,6 +862,9 @@ class ExplicitSolver:
         """Rebuild everything that depends on connectivity (after a remesh)."""
         self._transport = None
         self._strain_rate = None
+        self._cr = None
+        self._jump = None
+        self._cr_vel = "remeshed"  # the next step rebuilds the edge velocities, as expected
         self.nodes.reset_topology(mesh)
 
     def update_geometry(self) -> None:
@@ -809,10 +892,19 @@ class ExplicitSolver:
         from ..stability import explicit_substep_limit
 
         E_max = self.rheology.params.E0 if E_max is None else E_max
-        lim = explicit_substep_limit(self.dx_eff, E_max, self.rheology.params)
+        lim = explicit_substep_limit(self.dx_eff, E_max, self.rheology.params) / self._substep_factor()
         return max(1, int(math.ceil(dt / (self.safety * lim) - 1e-9)))
 
+    def _substep_factor(self) -> float:
+        """How many times shorter than the measured linear limit the sub-step must be."""
+        if self.velocity_element == "linear":
+            return 1.0
+        from .crouzeix_raviart import SUBSTEP_FACTOR
+
+        return SUBSTEP_FACTOR
+
     def _check_stability(self, dt_s: float, E_max: float) -> None:
+        dt_s = dt_s * self._substep_factor()  # the linear limit's equivalent
         key = (round(dt_s, 9), round(self.dx_eff, 3), round(E_max, 3))
         if key in self._checked:
             return
@@ -892,6 +984,72 @@ class ExplicitSolver:
             tm += tc - tb
         return n_capped, tn, tm
 
+    # -- Crouzeix–Raviart velocities (velocity_element = "crouzeix_raviart") -------------
+    def _cr_edges(self):
+        from .crouzeix_raviart import CREdges, JumpPenalty
+
+        if self._cr is None:
+            self._cr = CREdges(self.mesh, self.nodes.fixed)
+            if self.jump_penalty > 0.0:
+                self._jump = JumpPenalty(self._cr, self.jump_penalty, self.rheology.params.poisson)
+        return self._cr
+
+    def _cr_start_velocity(self, cr, state, t_s: float):
+        """The edge velocities this step starts from, and the jump penalty's tractions (None without
+        it): those of the last step, if the node velocities are still the ones written with them,
+        else rebuilt from the nodes (the mean of each edge's two nodes; tractions zero): after a
+        remesh, and (logged) after a resume without them or a change of the velocity outside the
+        stepper."""
+        kept = self._cr_vel
+        n_jump = self._jump.n_inner if self._jump is not None else 0
+        if isinstance(kept, tuple) and kept[1].shape == state.velocity.shape and np.array_equal(kept[1],
+                                                                                                state.velocity):
+            return kept[0].copy(), (None if self._jump is None else kept[2].copy())
+        if t_s > 0.0 and kept != "remeshed":
+            import logging
+
+            logging.getLogger("lagice").info(f"explicit (crouzeix_raviart): edge velocities rebuilt from the node "
+                                             f"velocities at t = {t_s:.0f} s (a resume, or the velocity changed "
+                                             f"outside the stepper)")
+        return (np.ascontiguousarray(cr.at_edges(np.asarray(state.velocity, np.float64))),
+                None if self._jump is None else np.zeros((n_jump, 2)))
+
+    def checkpoint_arrays(self) -> dict:
+        """Arrays a checkpoint holds for this stepper beyond the state's fields: with
+        Crouzeix–Raviart velocities, the edge velocities of the last step and the node velocities
+        written with them (so that a resume continues bit for bit); none otherwise."""
+        if self.velocity_element == "linear" or not isinstance(self._cr_vel, tuple):
+            return {}
+        out = {"cr_edge_velocity": self._cr_vel[0], "cr_node_velocity": self._cr_vel[1]}
+        if self._cr_vel[2] is not None:
+            out["cr_jump_traction"] = self._cr_vel[2]
+        return out
+
+    def restore_arrays(self, arrays: dict) -> None:
+        """Take back what :meth:`checkpoint_arrays` wrote (after :meth:`reset_topology`)."""
+        if not arrays:
+            return
+        if self.velocity_element == "linear":
+            raise ConfigError(f"the checkpoint holds Crouzeix-Raviart edge velocities ({sorted(arrays)}) but "
+                              f"solver.velocity_element = \"linear\"")
+        e, nv = arrays["cr_edge_velocity"], arrays["cr_node_velocity"]
+        if e.shape != (self._cr_edges().n_edges, 2):
+            raise ConfigError(f"checkpoint array stepper.cr_edge_velocity has shape {e.shape}; the mesh has "
+                              f"{self._cr_edges().n_edges} edges")
+        jt = arrays.get("cr_jump_traction")
+        if (jt is None) != (self.jump_penalty == 0.0):
+            raise ConfigError(f"the checkpoint {'lacks' if jt is None else 'holds'} the jump penalty's tractions "
+                              f"(stepper.cr_jump_traction) but solver.jump_penalty = {self.jump_penalty!r}")
+        self._cr_vel = (np.array(e, np.float64), np.array(nv, np.float64),
+                        None if jt is None else np.array(jt, np.float64))
+
+    @staticmethod
+    def _cr_nodes(cr, edge_vel, pres_nodes, ns) -> np.ndarray:
+        out = cr.at_nodes(edge_vel, ns.mesh.triangles, ns.area, ns.mesh.n_nodes)
+        fx = ns.fixed.astype(bool)
+        out[fx] = pres_nodes[fx]
+        return out
+
     # -- one step -----------------------------------------------------------------
     def step(self, state: IceState, t_s: float, dt: float) -> StepInfo:
         if not dt > 0:
@@ -911,18 +1069,27 @@ class ExplicitSolver:
         dt_s = dt / n_sub
         self._check_stability(dt_s, E_max)
         t_new = t_s + dt
-        terms = explicit_terms(self.forces, t_new, mesh.nodes)
         pres0 = ns.prescribed_velocity(t_s)
         pres1 = ns.prescribed_velocity(t_new)
+        cr = self._cr_edges() if self.velocity_element == "crouzeix_raviart" else None
+        if cr is None:
+            terms = explicit_terms(self.forces, t_new, mesh.nodes)
+            ptr, elems, local = mesh.node_elements
+            gb, gc, fixed = ns.b, ns.c, ns.fixed
+        else:  # the same kernels over the edges (lagice.solvers.crouzeix_raviart): forcing at the midpoints
+            terms = explicit_terms(self.forces, t_new, cr.midpoints(mesh.nodes))
+            pres0n, pres1n = pres0, pres1
+            pres0, pres1 = cr.at_edges(pres0n), cr.at_edges(pres1n)
+            ptr, elems, local = cr.ptr, cr.elems, cr.local
+            gb, gc, fixed = -2.0 * ns.b, -2.0 * ns.c, cr.fixed  # ∇ψ_k = −2 ∇φ_k
         t1 = time.perf_counter()
         kt["forcing"] = t1 - t0
 
         tri = mesh.triangles
         par = ns.parallel_for(mesh)
-        ptr, elems, local = mesh.node_elements
         # NodeSystem.setup and the per-node constants in one pass, bit for bit (_node_setup)
         w_adj, nc, _mass = NODE_SETUP[int(par)](ptr, elems, local, ns.area,
-                                                np.ascontiguousarray(state.thickness, np.float64), ns.b, ns.c,
+                                                np.ascontiguousarray(state.thickness, np.float64), gb, gc,
                                                 float(p.rho_ice), dt_s, terms.tau, terms.drag_coef, terms.coriolis,
                                                 terms.current)
         e_dt = dt_s * E
@@ -942,7 +1109,10 @@ class ExplicitSolver:
         heal = np.ascontiguousarray(heal, np.float64)
         nu = p.poisson
         kxx, kxy, kss = 1.0 / (1.0 - nu * nu), nu / (1.0 - nu * nu), (1.0 - nu) / (1.0 - nu * nu)
-        vel = np.ascontiguousarray(state.velocity, np.float64).copy()
+        if cr is None:
+            vel = np.ascontiguousarray(state.velocity, np.float64).copy()
+        else:
+            vel, jump_T = self._cr_start_velocity(cr, state, t_s)
         sigma = np.array(state.stress, np.float64, order="C")  # copies: the state is left
         damage = np.array(state.damage, np.float64)  # untouched if the step fails
         coh = np.ascontiguousarray(state.cohesion, np.float64)
@@ -952,9 +1122,9 @@ class ExplicitSolver:
         t2 = time.perf_counter()
         kt["setup"] = t2 - t1
 
-        ptr32, elems32, tri32 = self._indices(mesh)
-        args = (vel, vel_sum, sigma, ptr32, elems32, w_adj, nc, terms.cos_turn, terms.sin_turn, ns.fixed, pres0,
-                pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, k_c, k_t, self.td, heal, e_dt, gamma, pmax,
+        ptr32, elems32, tri32 = self._indices(mesh) if cr is None else (cr.ptr, cr.elems, cr.elem_edges)
+        args = (vel, vel_sum, sigma, ptr32, elems32, w_adj, nc, terms.cos_turn, terms.sin_turn, fixed, pres0,
+                pres1, tri32, gb, gc, damage, conc_factor, coh, k_c, k_t, self.td, heal, e_dt, gamma, pmax,
                 keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0,
                 p.relaxation_time_s, float(p.alpha), flag,
                 np.empty(mesh.n_nodes, np.float64) if self.volumetric_strain == "nodal" else None, ns.area)
@@ -973,6 +1143,12 @@ class ExplicitSolver:
                 pres0, pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, self.td, heal, e_dt, gamma, dt_s, kxx,
                 kxy, kss, rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), flag, nl_ptr,
                 nl_idx, nl_w, np.empty(mesh.n_elements, np.float64), np.empty(mesh.n_elements, np.int8))
+        elif cr is not None and self._jump is not None:
+            jp = self._jump
+            jp.update_geometry(mesh.nodes, ns.b, ns.c)
+            n_capped = SUBSTEPS_JUMP[int(par)](
+                n_sub, *args, jp.dofs, jp.coef, jp.left, jp.right, np.ascontiguousarray(state.thickness, np.float64),
+                jp.kfac, jump_T, jp.ptr, jp.idx, jp.c, 1.0 / nc[:, 0])
         elif self.profile_kernels:
             n_capped, tn, tm = self._profiled_substeps(par, n_sub, args)
             kt["node_velocity"] = tn
@@ -980,11 +1156,22 @@ class ExplicitSolver:
         else:
             n_capped = substep_loops(float(p.alpha))[int(par)](n_sub, *args)
         kt["substeps"] = time.perf_counter() - ta
-        state.velocity = vel
         state.stress = sigma
         state.damage = damage
-        self._transport = vel_sum / n_sub
-        self._strain_rate = STRAIN_RATE[int(par)](tri, ns.b, ns.c, self._transport)
+        if cr is None:
+            state.velocity = vel
+            self._transport = vel_sum / n_sub
+            self._strain_rate = STRAIN_RATE[int(par)](tri, ns.b, ns.c, self._transport)
+        else:
+            mean_e = vel_sum / n_sub
+            self._strain_rate = STRAIN_RATE[int(par)](cr.elem_edges, gb, gc, mean_e)
+            # the nodes: the mean of their elements' linear fields; prescribed components as the
+            # linear stepper has them (the last sub-step's value, and the mean over the sub-steps)
+            w_mean = (n_sub + 1) / (2.0 * n_sub)
+            node_vel = self._cr_nodes(cr, vel, pres1n, ns)
+            self._transport = self._cr_nodes(cr, mean_e, pres0n + w_mean * (pres1n - pres0n), ns)
+            state.velocity = node_vel
+            self._cr_vel = (vel, node_vel.copy(), jump_T)
         self.last_substeps = n_sub
         rh.n_capped_total += int(n_capped)
         for k, v in kt.items():
