@@ -433,6 +433,8 @@ class CudaExplicitSolver:
     # -- sub-step choice: the CPU stepper's own rules (same N, same refusals) -------
     substeps_for = ExplicitSolver.substeps_for
     _check_stability = ExplicitSolver._check_stability
+    _substep_factor = ExplicitSolver._substep_factor
+    velocity_element = "linear"  # the CUDA stepper's velocities are at the nodes (refused otherwise)
 
     # -- forcing paths (documentation, tests) ---------------------------------------
     @property
