@@ -748,8 +748,8 @@ class ExplicitSolver:
             edge midpoints (:mod:`lagice.solvers.crouzeix_raviart`; the same kernels run over the
             edges, with sub-steps :data:`~lagice.solvers.crouzeix_raviart.SUBSTEP_FACTOR` times
             shorter). ``state.velocity`` holds their average at the nodes (the nodes move with
-            it); the edge velocities are kept between steps and rebuilt from the node velocities
-            after a remesh or a resume (logged; such a resume is not bit for bit).
+            it); the edge velocities are kept between steps and in checkpoints (a resume is bit
+            for bit), and rebuilt from the node velocities after a remesh.
         profile_kernels: time the node and element kernels separately (a Python
             loop over the sub-steps, two kernel calls each) instead of running the
             whole sub-step loop in one compiled call (the default; same results).
@@ -801,7 +801,7 @@ class ExplicitSolver:
         self.jump_penalty = float(jump_penalty)
         self._jump = None  # the JumpPenalty of the current mesh (jump_penalty > 0)
         self._cr = None  # the CREdges of the current mesh (crouzeix_raviart)
-        self._cr_vel = None  # (edge velocities, the node velocities written with them)
+        self._cr_vel = None  # (edge velocities, the node velocities written with them, jump tractions or None)
         self.rheology = rheology
         self.forces = list(forces)
         self.substeps = substeps
