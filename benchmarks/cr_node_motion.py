@@ -1,0 +1,104 @@
+"""What the mesh follows with Crouzeix–Raviart velocities (``solver.velocity_element``;
+docs/solvers.md, "Crouzeix–Raviart velocities", "What the mesh follows").
+
+With Crouzeix–Raviart velocities the rheology sees each element's own linear field (its edge
+velocities), while the nodes, and so the mesh, the drifters and every Lagrangian window of the
+deformation statistics, move with the area-weighted mean of the elements' fields at each vertex.
+This script runs ``winter_basin_pack`` through the scene builder and ``Simulation`` from its
+shipped spun-up state with each velocity element and, after every outer step, compares per element:
+
+* ``mismatch``: Σ A |ε̇_mesh − ε̇| / Σ A |ε̇|, ε̇ the strain rate the rheology used (the mean over
+  the step's sub-steps) and ε̇_mesh the strain rate of the nodes' mean velocity over the step (the
+  one that moves the mesh), |ε̇|² = ε̇xx² + ε̇yy² + 2 ε̇xy². It is 0 for linear velocities, whose
+  nodes carry the field itself;
+* ``roughness``: the same sum for ε̇ against its one-element smoothing (the area-weighted mean at
+  the nodes, then the mean of the three nodes): how much of the strain field lives at the
+  element scale;
+* ``shear ratio``: Σ A ε̇_II of the mesh's field over that of the rheology's (ε̇_II the maximum
+  shear rate).
+
+It prints the medians over the steps (the steps of a remesh are left out).
+
+    NUMBA_NUM_THREADS=1 python benchmarks/cr_node_motion.py --steps 60
+"""
+from __future__ import annotations
+
+import argparse
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from lagice.fem import shape_gradients, strain_rate
+from lagice.scenes.builder import build_simulation
+from lagice.scenes.config import load_scene
+
+VARIANTS = (("linear", {}),
+            ("crouzeix_raviart, jump_penalty 1", {"solver.velocity_element": "crouzeix_raviart",
+                                                  "solver.jump_penalty": 1.0}))
+
+
+def _norm(e: np.ndarray) -> np.ndarray:
+    return np.sqrt(e[:, 0] ** 2 + e[:, 1] ** 2 + 2.0 * e[:, 2] ** 2)
+
+
+def _shear(e: np.ndarray) -> np.ndarray:
+    return np.sqrt((e[:, 0] - e[:, 1]) ** 2 + 4.0 * e[:, 2] ** 2)
+
+
+def smoothed(tri: np.ndarray, area: np.ndarray, n_nodes: int, field: np.ndarray) -> np.ndarray:
+    """One-element smoothing of an element field (m, k): the area-weighted mean at each node,
+    then the mean of each element's three nodes."""
+    w = np.bincount(tri.ravel(), weights=np.repeat(area, 3), minlength=n_nodes)
+    nodal = np.stack([np.bincount(tri.ravel(), weights=np.repeat(area * field[:, j], 3), minlength=n_nodes) / w
+                      for j in range(field.shape[1])], axis=1)
+    return nodal[tri].mean(axis=1)
+
+
+def step_measures(sim) -> dict | None:
+    """The three measures of the step just made (None if the mesh changed under it)."""
+    st, mesh = sim.model.stepper, sim.model.mesh
+    eps = st._strain_rate
+    if eps is None or len(eps) != mesh.n_elements or len(st._transport) != mesh.n_nodes:
+        return None
+    b, c, area = shape_gradients(mesh.nodes, mesh.triangles)
+    eps_mesh = strain_rate(mesh.triangles, b, c, st._transport)
+    den = float(np.sum(area * _norm(eps)))
+    if den == 0.0:
+        return None
+    return {"mismatch": float(np.sum(area * _norm(eps_mesh - eps))) / den,
+            "roughness": float(np.sum(area * _norm(smoothed(mesh.triangles, area, mesh.n_nodes, eps) - eps))) / den,
+            "shear_ratio": float(np.sum(area * _shear(eps_mesh)) / np.sum(area * _shear(eps)))}
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--steps", type=int, default=60, help="outer steps measured")
+    ap.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                    help="a scene override for every variant (repeatable)")
+    args = ap.parse_args(argv)
+    extra = dict(s.split("=", 1) for s in args.sets)
+    print(f"winter_basin_pack from its shipped spun-up state, {args.steps} outer steps"
+          + (f", {' '.join(args.sets)}" if args.sets else ""))
+    print("| velocity element | mismatch (mesh against rheology) | roughness | shear ratio | steps |")
+    print("|---|---|---|---|---|")
+    for name, ov in VARIANTS:
+        cfg = load_scene("winter_basin_pack", [f"{k}={v}" for k, v in {**ov, **extra}.items()]
+                         + ["run.progress=false", "output.plot=false", "run.duration=100d", "output.every=100d",
+                            "checkpoint.every=100d"])
+        rows = []
+        with tempfile.TemporaryDirectory() as tmp:
+            sim = build_simulation(cfg, Path(tmp) / "run")
+            for _ in range(args.steps):
+                n0 = sim.model.state.counters.get("remesh_count", 0)
+                sim.run(n_steps=1)
+                r = step_measures(sim) if sim.model.state.counters.get("remesh_count", 0) == n0 else None
+                if r is not None:
+                    rows.append(r)
+        med = {k: float(np.median([r[k] for r in rows])) for k in rows[0]}
+        print(f"| {name} | {med['mismatch']:.3f} | {med['roughness']:.3f} | {med['shear_ratio']:.3f} | "
+              f"{len(rows)} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
