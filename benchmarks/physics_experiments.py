@@ -2608,7 +2608,9 @@ def main(argv=None):
                     help="screen: the candidate's median rate must be this many times the reference's")
     ap.add_argument("--wind-factor-band", type=float, nargs=2, default=None, metavar=("LO", "HI"),
                     help="screen: the candidate's median wind factor (drift_response.json) must lie in LO-HI")
-    args = ap.parse_args(argv)
+    # intermixed: "run --jobs 2 NAME ..." and "run NAME ... --jobs 2" both work (plain parse_args
+    # gives the positional list nothing when an option comes between it and ``what``)
+    args = ap.parse_intermixed_args(argv)
     if args.jobs != 1 and args.what != "run":
         raise SystemExit(f"physics: --jobs applies to 'run' only (asked with {args.what!r})")
     if args.what in ("run", "spinup"):

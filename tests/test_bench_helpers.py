@@ -159,6 +159,12 @@ def test_physics_run_queues_deal_the_runs_round_robin_and_check_names_first(monk
         with pytest.raises(SystemExit, match=rf"experiment '{name}' \(scene winter_basin_pack\) does not resolve"):
             pe.run_queues(names + [name], 2)
     assert started == []
+    # the command line takes the names before or after --jobs (argparse read none after it, 2026-11-29)
+    monkeypatch.setattr(pe, "prepare_inputs", lambda: None)  # no inputs written into the checkout
+    for argv in (["run", "--jobs", "2", *names[:2], "F10-nope"], ["run", *names[:2], "F10-nope", "--jobs", "2"]):
+        with pytest.raises(SystemExit, match="unknown experiment 'F10-nope'"):
+            pe.main(argv)
+    assert started == []
 
 
 def test_every_physics_experiment_resolves_to_a_valid_scene():
