@@ -2034,6 +2034,24 @@ ENSEMBLES["20 km, Crouzeix-Raviart, jump penalty 1, closed, eight months"] = ["B
 # (x0.96 in 2028, x1.78 in 2030). The element doubles beta and brings the drift into its band in most
 # months; it loses the shear tail, the half-shear area and R2 to a little too much spread; beta stays at
 # half the observed band. Wall 566-1191 s a run on one thread (two or three runs on the two cores).
+# effK with the penalty (thirty-second session), the one kept-pressure set-up the penalty screen left out,
+# stated 2026-11-29 06:00 UTC before its runs: effK-vcrj, the effective envelope with the mean stress kept,
+# Crouzeix-Raviart velocities, kappa = 0.1 (as K-vcrj and effCP-vcrj), 20 km, closed basin, the validation
+# month, own spin-up, "all" pinned. Rule (M) as for the others: unlocked if its wind factor is at least twice
+# its linear run's (B20-hthick-effK: 0.0017, so above 0.0034) and its day-28 median pressure at most half
+# the linear run's 47 kPa (so below 24 kPa; plain CR velocities, effK-vcr, had 32); free of noise if beta
+# is below 0.3 and it remeshes fewer than 177 times. Rule (L) for a lead.
+# Predicted: locked, like K-vcrj (wind factor below 0.0034, pressure 20-40 kPa at day 28), free of noise.
+add_screen_20km("effK-vcrj", EFFECTIVE + KEEPMEAN + ["solver.velocity_element=crouzeix_raviart",
+                                                    "solver.jump_penalty=0.1"],
+                "20 km: effective envelope, the mean stress kept, Crouzeix-Raviart velocities with the jump "
+                "penalty 0.1, own spin-up")
+pin_screen_20km("effK-vcrj")
+# Result (2026-11-29, 06:12 UTC): (M) fails, as predicted: still locked. Wind factor 0.0018 (linear 0.0017,
+# plain CR 0.0024), day-28 median pressure 22.6 kPa (day 10: 112; beta_vs_damage.py --at 10 28): halved,
+# but the pack does not drift. Not free of noise either (280 remeshes, above 177; beta 0.201 below 0.3).
+# beta 0.201, tails 3.65 / 3.69, half-shear area 14.4 %, R2 0.33, rate 0.0114 per day (inside): the pack
+# deforms inside without drifting; (L) fails (1 band). 336 s on 2 threads.
 
 
 # --- 2026-11-28 (twenty-eighth session): the ±50 % runs with the shipped set --------------------
