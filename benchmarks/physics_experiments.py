@@ -2052,6 +2052,29 @@ pin_screen_20km("effK-vcrj")
 # but the pack does not drift. Not free of noise either (280 remeshes, above 177; beta 0.201 below 0.3).
 # beta 0.201, tails 3.65 / 3.69, half-shear area 14.4 %, R2 0.33, rate 0.0114 per day (inside): the pack
 # deforms inside without drifting; (L) fails (1 band). 336 s on 2 threads.
+# neXtSIM's compressive term on the stable element (thirty-third session), stated 2026-11-29 06:34 UTC
+# before its runs. The shipped interior converges as a whole (docs/physics.md, "Where beta is lost": 72-87 %
+# of its |divergence| closes, and the divergence part's beta is near 0), because damaged ice under any
+# pressure creeps. neXtSIM keeps the pressure of damaged ice below P_max = 10 kPa h^1.5 exp(-20(1-A))
+# (PMAX, sourced), so only ice above P_max closes. On linear velocities that term over-localised, but a kept
+# pressure locks constant-strain triangles, so it was judged on a locking mesh. With Crouzeix-Raviart
+# velocities and kappa = 1 (vcrj1) it has not been measured. P-vcrj1: the nominal set + PMAX + the element,
+# 20 km, closed basin, its own 20 km spin-up, "all" pinned, in three months: the validation month (2026),
+# and 2028 and 2030, where vcrj1's beta was lowest against its linear run (0.050 and 0.084).
+# Rule: a lead for the eight months if beta is at least 0.14 in at least 2 of the 3 months (vcrj1: 1 of 3:
+# 0.152, 0.050, 0.084), the wind factor (drift_response.py) lies in 0.006-0.010 in at least 2 of 3, and each
+# month has at least as many bands inside as vcrj1's (3, 4, 3). Mechanism check: the net-divergence ratio
+# of beta_components.py is nearer 0 than vcrj1's in 2028 and 2030.
+# Predicted: it fails on beta (about +0.02 over vcrj1 in each month, so 2028 stays below 0.14), the wind
+# factor about vcrj1's (0.006-0.007), the half-shear area below vcrj1's (more localised), and the
+# net-divergence ratio nearer 0 by at least 0.1.
+add_screen_20km("P-vcrj1", PMAX + ["solver.velocity_element=crouzeix_raviart", "solver.jump_penalty=1"],
+                "20 km: neXtSIM's compressive term, Crouzeix-Raviart velocities with the jump penalty 1, own spin-up")
+pin_screen_20km("P-vcrj1")
+for _seed in (2028, 2030):
+    EXPERIMENTS[f"B20-hthick-P-vcrj1-w{_seed}"] = (
+        "closed", EXPERIMENTS["B20-hthick-P-vcrj1"][1] + [f"forcing.wind.seed={_seed}"], 20e3, 28,
+        f"B20-hthick-P-vcrj1, the weather of wind seed {_seed}")
 
 
 # --- 2026-11-28 (twenty-eighth session): the ±50 % runs with the shipped set --------------------
