@@ -2077,7 +2077,7 @@ for _seed in ENSEMBLE_SEEDS + MORE_SEEDS:
         f"B20-hthick-P-vcrj1, the weather of wind seed {_seed}")
 ENSEMBLES["20 km, compressive term and Crouzeix-Raviart, jump penalty 1, closed, eight months"] = [
     "B20-hthick-P-vcrj1"] + [f"B20-hthick-P-vcrj1-w{s}" for s in ENSEMBLE_SEEDS + MORE_SEEDS]
-# Results so far (06:58 UTC; 2030 still running). Validation month: beta 0.190 (vcrj1 0.152), tails 2.50 /
+# Results so far (06:55 UTC; 2030 still running). Validation month: beta 0.190 (vcrj1 0.152), tails 2.50 /
 # 2.58, half-shear area 9.5 %, R2 0.658, rate 0.0108 per day, wind factor 0.0059 (vcrj1 0.0063), 277
 # remeshes: 4 bands inside (beta, both tails, the rate; vcrj1 3). 2028: beta 0.126 (vcrj1 0.050), tails 2.38
 # / 2.73, half-shear area 6.2 %, R2 0.68, rate 0.0074, wind factor 0.0039 (vcrj1 0.0041), 121 remeshes: 3
@@ -2085,7 +2085,7 @@ ENSEMBLES["20 km, compressive term and Crouzeix-Raviart, jump penalty 1, closed,
 # half-shear area inside). The mechanism check holds in 2028: net-divergence ratio -0.35 against vcrj1's
 # -0.61, the divergence part's beta 0.189 against 0.090. The rule fails on the wind factor whatever 2030
 # gives (below 0.006 in 2026 and 2028).
-# Follow-up, stated 2026-11-29 06:58 UTC before 2030's result and before these runs: a diagnostic of the
+# Follow-up, stated 2026-11-29 06:56 UTC before 2030's result and before these runs: a diagnostic of the
 # mechanism, not a lead. The other five months of the ensemble (2027, 2029, 2031-2033), so that the group
 # "20 km, compressive term and Crouzeix-Raviart, ..." has the eight months of vcrj1's group (beta 0.085,
 # wind factor 0.0066, 1 band inside in the group medians). The term's gain in beta survives the weather,
