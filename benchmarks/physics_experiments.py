@@ -2092,6 +2092,16 @@ ENSEMBLES["20 km, compressive term and Crouzeix-Raviart, jump penalty 1, closed,
 # where the element's alone did not reach the band, if the eight-month median beta is at least 0.12 and
 # beta exceeds vcrj1's in at least 6 months of 8. Predicted: median beta 0.11-0.14, above vcrj1's in 7 of 8
 # months, median wind factor 0.004-0.006 (below its band), 1-2 bands inside in the group medians.
+# The 10 km validation month, stated 2026-11-29 07:13 UTC before its runs (with five of the eight 20 km
+# months in: beta 0.126-0.190 in all five, above vcrj1's in each). The flagship is at 10 km, so whether the
+# combination carries there is the next question. P-vcrj1 from its own 10 km spin-up (H1125-P-vcrj1),
+# closed basin, today's defaults (as F10-hthick-vcrj1), against F10-hthick-vcrj1 (beta 0.142, wind factor
+# 0.0056, rate 0.0084 per day, 3 bands) and the shipped set's F10-hthick-newc (4 bands, 0.0036, 0.0031). The
+# combination carries to 10 km if beta is at least 0.14, the rate at least 0.01 per day and at least 3
+# bands are inside. Predicted: beta 0.16-0.20, rate 0.011-0.014 per day, wind factor 0.005-0.006, both tails
+# inside, the half-shear area and R2 outside: 3-4 bands, so it carries. The strait run is defined, not run.
+add_month_own_spinup("P-vcrj1", PMAX + ["solver.velocity_element=crouzeix_raviart", "solver.jump_penalty=1"],
+                     "neXtSIM's compressive term, Crouzeix-Raviart velocities with the jump penalty 1, own spin-up")
 
 
 # --- 2026-11-28 (twenty-eighth session): the ±50 % runs with the shipped set --------------------
