@@ -2092,7 +2092,7 @@ ENSEMBLES["20 km, compressive term and Crouzeix-Raviart, jump penalty 1, closed,
 # where the element's alone did not reach the band, if the eight-month median beta is at least 0.12 and
 # beta exceeds vcrj1's in at least 6 months of 8. Predicted: median beta 0.11-0.14, above vcrj1's in 7 of 8
 # months, median wind factor 0.004-0.006 (below its band), 1-2 bands inside in the group medians.
-# The 10 km validation month, stated 2026-11-29 07:13 UTC before its runs (with five of the eight 20 km
+# The 10 km validation month, stated 2026-11-29 07:12 UTC before its runs (with five of the eight 20 km
 # months in: beta 0.126-0.190 in all five, above vcrj1's in each). The flagship is at 10 km, so whether the
 # combination carries there is the next question. P-vcrj1 from its own 10 km spin-up (H1125-P-vcrj1),
 # closed basin, today's defaults (as F10-hthick-vcrj1), against F10-hthick-vcrj1 (beta 0.142, wind factor
