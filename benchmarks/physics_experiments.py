@@ -2092,6 +2092,16 @@ ENSEMBLES["20 km, compressive term and Crouzeix-Raviart, jump penalty 1, closed,
 # where the element's alone did not reach the band, if the eight-month median beta is at least 0.12 and
 # beta exceeds vcrj1's in at least 6 months of 8. Predicted: median beta 0.11-0.14, above vcrj1's in 7 of 8
 # months, median wind factor 0.004-0.006 (below its band), 1-2 bands inside in the group medians.
+# Result (2026-11-29, 07:40 UTC): it holds, and the prediction was too low. 2030: beta 0.162 (vcrj1 0.084),
+# wind factor 0.0064, 3 bands (vcrj1 3), net-divergence ratio -0.21 (-0.57); so the first rule fails on the
+# wind factor alone (in its band in 1 month of 3: 0.0059, 0.0039, 0.0064). Eight-month medians (vcrj1's
+# group in brackets): beta 0.171 (0.085) [0.126-0.207], above vcrj1's in 8 months of 8, in 0.17-0.20 in 3
+# and in 0.14-0.23 in 6; tails 2.88 / 2.81 (2.67 / 2.49); half-shear area 7.2 % (8.1 %); R2 0.632 (0.663);
+# rate 0.00999 per day (0.0078; 4 months of 8 in the band); wind factor 0.0063 (0.0066; 5 months of 8 in
+# 0.006-0.010); 121-298 remeshes; 2 bands inside in the group medians (beta, the half-shear area), the rate
+# 0.0004 % below its band and the |divergence| tail 0.005 above. The net-divergence ratio is nearer 0 than
+# vcrj1's in every month compared (2027-2033: -0.22 to +0.20 against -0.63 to +0.02). 585-816 s a run on
+# one thread, two runs on the two cores.
 # The 10 km validation month, stated 2026-11-29 07:12 UTC before its runs (with five of the eight 20 km
 # months in: beta 0.126-0.190 in all five, above vcrj1's in each). The flagship is at 10 km, so whether the
 # combination carries there is the next question. P-vcrj1 from its own 10 km spin-up (H1125-P-vcrj1),
