@@ -2099,7 +2099,7 @@ ENSEMBLES["20 km, compressive term and Crouzeix-Raviart, jump penalty 1, closed,
 # and in 0.14-0.23 in 6; tails 2.88 / 2.81 (2.67 / 2.49); half-shear area 7.2 % (8.1 %); R2 0.632 (0.663);
 # rate 0.00999 per day (0.0078; 4 months of 8 in the band); wind factor 0.0063 (0.0066; 5 months of 8 in
 # 0.006-0.010); 121-298 remeshes; 2 bands inside in the group medians (beta, the half-shear area), the rate
-# 0.0004 % below its band and the |divergence| tail 0.005 above. The net-divergence ratio is nearer 0 than
+# 0.04 % below its band and the |divergence| tail 0.005 above. The net-divergence ratio is nearer 0 than
 # vcrj1's in 6 of the 7 months compared (2027-2033: -0.35 to +0.20 against -0.63 to +0.02; not in 2031, +0.20
 # against +0.02). 585-816 s a run on one thread, two runs on the two cores.
 # The 10 km validation month, stated 2026-11-29 07:12 UTC before its runs (with five of the eight 20 km
