@@ -258,6 +258,15 @@ VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.me
             # Cyclone disk (05:52 UTC): the rule fails and the prediction holds. Local index of damage >= 0.5:
             # 0.24 / 0.29 / 0.27 (linear: 0.29 / 0.30 / 0.25); of the shear rate's top decile: 0.30 / 0.27 /
             # 0.31 (0.30 / 0.30 / 0.31); damaged fraction 0.34-0.36 (0.32-0.33); 460-471 s a run.
+            # neXtSIM's compressive term with the same element (thirty-third session; "P-vcrj1" of
+            # physics_experiments.py, which lifts the basin's beta). Stated 2026-11-29 07:41 UTC before the
+            # run: "delaunay+explicit+vcrj1P", N = 40, seed 0, against vcrj1's run. Item 7 is met only by
+            # the rule above. Predicted: not met, and little change: in this 1 m plate at concentration 1,
+            # P_max is 10 kPa, a fifth of the mean stress at the peak (about 50 kPa), so the term holds
+            # only ice already relaxed far below the peak; the post-peak damage faults within 5 deg of
+            # vcrj1's (26.0, 26.4) and the peak within 3 % of its 104 kPa.
+            "vcrj1P": ["solver.velocity_element=crouzeix_raviart", "solver.jump_penalty=1",
+                       "rheology.max_pressure_pa=10e3", "rheology.max_pressure_thickness_exponent=1.5"],
             **{f"mean{int(round(100 * t)):03d}": ["rheology.stress_correction=mean_stress",
                                                   f"rheology.stress_correction_mean_fraction={t}"]
                for t in (0.25, 0.5, 0.75, 1.25, 1.5, 2.0)}}
