@@ -2112,6 +2112,12 @@ ENSEMBLES["20 km, compressive term and Crouzeix-Raviart, jump penalty 1, closed,
 # inside, the half-shear area and R2 outside: 3-4 bands, so it carries. The strait run is defined, not run.
 add_month_own_spinup("P-vcrj1", PMAX + ["solver.velocity_element=crouzeix_raviart", "solver.jump_penalty=1"],
                      "neXtSIM's compressive term, Crouzeix-Raviart velocities with the jump penalty 1, own spin-up")
+# Result (2026-11-29, 08:33 UTC): it does not carry in full; FAILS on the rate and the bands. beta 0.182
+# (vcrj1 0.142, shipped 0.060), tails 2.88 / 2.92 (both lighter than observed; vcrj1 2.30 / 2.43 inside),
+# half-shear area 5.6 %, R2 0.635, rate 0.0071 per day (vcrj1 0.0084; x2.3 the shipped set's), wind factor
+# 0.0050 (vcrj1 0.0056), 850 remeshes (vcrj1 904), net-divergence ratio -0.41: 2 bands inside (beta, the
+# half-shear area) against vcrj1's 3 and the shipped set's 4. The prediction held for beta and the drift,
+# and failed for the rate and the tails. 2585 s on 2 threads (the spin-up 37 min on one).
 
 
 # --- 2026-11-28 (twenty-eighth session): the ±50 % runs with the shipped set --------------------
