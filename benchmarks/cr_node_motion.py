@@ -57,11 +57,11 @@ def step_measures(sim) -> dict | None:
     """The measures of the step just made, on a mesh no remesh changed during it (None before
     the stepper has a strain rate, or for a pack at rest)."""
     st, mesh = sim.model.stepper, sim.model.mesh
-    eps, tri = st._strain_rate, mesh.triangles
+    eps, tri = st.last_strain_rate, mesh.triangles
     if eps is None:
         return None
     b, c, area = shape_gradients(mesh.nodes, tri)
-    eps_mesh = strain_rate(tri, b, c, st._transport)
+    eps_mesh = strain_rate(tri, b, c, st.transport_velocity)
     den = float(np.sum(area * _norm(eps)))
     if den == 0.0:
         return None

@@ -152,6 +152,17 @@ def add_month_own_spinup(tag: str, changes: list, what: str) -> None:
     EXPERIMENTS[f"F10s-hthick-{tag}"] = ("strait", changes + from_spinup(f"H1125-{tag}"), 10e3, 28, f"strait: {what}")
 
 
+def add_months_20km(tag: str, group: str, seeds) -> None:
+    """The 20 km screen ``B20-hthick-{tag}`` (:func:`add_screen_20km`) in the weather of each wind seed
+    of ``seeds`` (``B20-hthick-{tag}-w{seed}``, the same spin-up), and the group ``group`` of
+    :data:`ENSEMBLES` holding the screen and those runs."""
+    base = f"B20-hthick-{tag}"
+    for seed in seeds:
+        EXPERIMENTS[f"{base}-w{seed}"] = ("closed", EXPERIMENTS[base][1] + [f"forcing.wind.seed={seed}"], 20e3, 28,
+                                          f"{base}, the weather of wind seed {seed}")
+    ENSEMBLES[group] = [base] + [f"{base}-w{seed}" for seed in seeds]
+
+
 def add_weather_ensemble(tag: str, overrides: list, what: str, group: str, seeds, suffix: str = "") -> None:
     """The 10 km, 28-day runs of one set-up in both basins: ``F10-hthick-{tag}`` /
     ``F10s-hthick-{tag}`` (the scene's wind seed) and ``...-w{seed}`` for ``seeds``, with the
@@ -1976,7 +1987,9 @@ for _tag, _changes, _what in (("vcrj", [], "the nominal set"),
 # 0.046, wind factor 0.0044), the penalty is a knob like the nonlocal radius, and vcrj's beta is not a
 # property of the ice. Predicted: towards P1 but not all the way (beta 0.08-0.15, 100-250 remeshes),
 # since the penalty makes the element more nearly conforming.
-add_screen_20km("vcrj1", ["solver.velocity_element=crouzeix_raviart", "solver.jump_penalty=1"],
+#: Crouzeix-Raviart velocities with the jump penalty 1 (the element of the screens below)
+CR_KAPPA1 = ["solver.velocity_element=crouzeix_raviart", "solver.jump_penalty=1"]
+add_screen_20km("vcrj1", CR_KAPPA1,
                 "20 km: the nominal set, Crouzeix-Raviart velocities with the jump penalty 1, own spin-up")
 pin_screen_20km("vcrj1")
 # Results (21:16 UTC). K-vcrj: locked again (wind factor 0.0001, rate 0.0009 per day, 111 remeshes, beta
@@ -2000,7 +2013,7 @@ pin_screen_20km("vcrj1")
 # rate is at least x2 the shipped set's, and at least as many bands are inside (4). beta reported.
 # Predicted: wind factor 0.006-0.008, the rate x2.5-4, beta 0.10-0.18 (the element's effect shrinks as
 # the mesh refines), tails inside, R2 and the half-shear area just outside: 3 bands, so it fails by one.
-add_month_own_spinup("vcrj1", ["solver.velocity_element=crouzeix_raviart", "solver.jump_penalty=1"],
+add_month_own_spinup("vcrj1", CR_KAPPA1,
                      "Crouzeix-Raviart velocities with the jump penalty 1, own spin-up")
 # Result (22:27 UTC): FAILS narrowly, on two of its three conditions. Wind factor 0.0056 (just below 0.006;
 # shipped 0.0036), the rate 0.0084 per day (x2.7: passes), beta 0.142 (shipped 0.060), tails 2.30 / 2.43
@@ -2019,12 +2032,7 @@ add_month_own_spinup("vcrj1", ["solver.velocity_element=crouzeix_raviart", "solv
 # inside. Predicted: it does not in full; median beta 0.10-0.15 (3-5 months in 0.14-0.23), beta at least
 # twice the linear element's in every month, the rate in its band in at least 5 months, median wind factor
 # 0.005-0.007, both tails inside in the group medians, R2 and the half-shear area just outside: 3 bands.
-for _seed in ENSEMBLE_SEEDS + MORE_SEEDS:
-    EXPERIMENTS[f"B20-hthick-vcrj1-w{_seed}"] = (
-        "closed", EXPERIMENTS["B20-hthick-vcrj1"][1] + [f"forcing.wind.seed={_seed}"], 20e3, 28,
-        f"B20-hthick-vcrj1, the weather of wind seed {_seed}")
-ENSEMBLES["20 km, Crouzeix-Raviart, jump penalty 1, closed, eight months"] = ["B20-hthick-vcrj1"] + [
-    f"B20-hthick-vcrj1-w{s}" for s in ENSEMBLE_SEEDS + MORE_SEEDS]
+add_months_20km("vcrj1", "20 km, Crouzeix-Raviart, jump penalty 1, closed, eight months", ENSEMBLE_SEEDS + MORE_SEEDS)
 # Result (2026-11-29, 05:40 UTC): the lead does not survive the weather, and the prediction was too high.
 # Eight-month medians (linear velocities in brackets): beta 0.085 (0.043; 0.050-0.152, 1 month of 8 in
 # 0.14-0.23, the validation month), tails 2.67 / 2.49 (2.34 / 2.53), half-shear area 8.1 % (7.6 %), R2
@@ -2068,15 +2076,11 @@ pin_screen_20km("effK-vcrj")
 # Predicted: it fails on beta (about +0.02 over vcrj1 in each month, so 2028 stays below 0.14), the wind
 # factor about vcrj1's (0.006-0.007), the half-shear area below vcrj1's (more localised), and the
 # net-divergence ratio nearer 0 by at least 0.1.
-add_screen_20km("P-vcrj1", PMAX + ["solver.velocity_element=crouzeix_raviart", "solver.jump_penalty=1"],
+add_screen_20km("P-vcrj1", PMAX + CR_KAPPA1,
                 "20 km: neXtSIM's compressive term, Crouzeix-Raviart velocities with the jump penalty 1, own spin-up")
 pin_screen_20km("P-vcrj1")
-for _seed in ENSEMBLE_SEEDS + MORE_SEEDS:
-    EXPERIMENTS[f"B20-hthick-P-vcrj1-w{_seed}"] = (
-        "closed", EXPERIMENTS["B20-hthick-P-vcrj1"][1] + [f"forcing.wind.seed={_seed}"], 20e3, 28,
-        f"B20-hthick-P-vcrj1, the weather of wind seed {_seed}")
-ENSEMBLES["20 km, compressive term and Crouzeix-Raviart, jump penalty 1, closed, eight months"] = [
-    "B20-hthick-P-vcrj1"] + [f"B20-hthick-P-vcrj1-w{s}" for s in ENSEMBLE_SEEDS + MORE_SEEDS]
+add_months_20km("P-vcrj1", "20 km, compressive term and Crouzeix-Raviart, jump penalty 1, closed, eight months",
+                ENSEMBLE_SEEDS + MORE_SEEDS)
 # Results so far (06:55 UTC; 2030 still running). Validation month: beta 0.190 (vcrj1 0.152), tails 2.50 /
 # 2.58, half-shear area 9.5 %, R2 0.658, rate 0.0108 per day, wind factor 0.0059 (vcrj1 0.0063), 277
 # remeshes: 4 bands inside (beta, both tails, the rate; vcrj1 3). 2028: beta 0.126 (vcrj1 0.050), tails 2.38
@@ -2110,7 +2114,7 @@ ENSEMBLES["20 km, compressive term and Crouzeix-Raviart, jump penalty 1, closed,
 # combination carries to 10 km if beta is at least 0.14, the rate at least 0.01 per day and at least 3
 # bands are inside. Predicted: beta 0.16-0.20, rate 0.011-0.014 per day, wind factor 0.005-0.006, both tails
 # inside, the half-shear area and R2 outside: 3-4 bands, so it carries. The strait run is defined, not run.
-add_month_own_spinup("P-vcrj1", PMAX + ["solver.velocity_element=crouzeix_raviart", "solver.jump_penalty=1"],
+add_month_own_spinup("P-vcrj1", PMAX + CR_KAPPA1,
                      "neXtSIM's compressive term, Crouzeix-Raviart velocities with the jump penalty 1, own spin-up")
 # Result (2026-11-29, 08:33 UTC): it does not carry in full; FAILS on the rate and the bands. beta 0.182
 # (vcrj1 0.142, shipped 0.060), tails 2.88 / 2.92 (both lighter than observed; vcrj1 2.30 / 2.43 inside),
