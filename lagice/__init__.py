@@ -17,6 +17,13 @@ if "GOMP_SPINCOUNT" not in _os.environ and "OMP_WAIT_POLICY" not in _os.environ:
     _os.environ["GOMP_SPINCOUNT"] = "10000"
 _os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
+# numba's disk cache keyed on all of the model's source (lagice/_numba_cache.py): numba keys a
+# kernel on its own file only, so an edit to a function another module's kernel inlines would
+# otherwise load a stale kernel. Before any kernel module is imported.
+from . import _numba_cache  # noqa: E402
+
+_numba_cache.configure()
+
 from .errors import (  # noqa: E402
     ConfigError,
     ForcingError,
