@@ -2124,6 +2124,31 @@ add_month_own_spinup("P-vcrj1", PMAX + CR_KAPPA1,
 # and failed for the rate and the tails. 2585 s on 2 threads (the spin-up 37 min on one).
 
 
+# --- 2026-11-29 (thirty-fourth session): the element count under remeshing ---------------------------
+# Written 2026-11-29 09:06 UTC, before the runs. The shipped scene gains elements at its remeshes (+3.2 %
+# median in 28 days over the sixteen 10 km months of the shipped set, +7.6 % in the stormiest;
+# docs/remeshing.md): gmsh fills a patch, whose boundary keeps its short edges, with more elements than the
+# target size gives its area. [remesh.params] density_control = true (new) meshes such a patch again with
+# the size inside it scaled up until the count is within 1 % of the target's (at most 5 more gmsh calls, the
+# size at most x2). In the ocean-driven channel (8 km, 10 days) it cut the growth from +43 % to +8-9 %.
+# Runs: the shipped scene as it is in the stormiest month (wind seed 2032; the same as F10-hthick-newc-w2032,
+# made again to measure its element count, and to check that today's code gives its record), and the same
+# with density_control, plus the validation month in both basins with density_control. Rule: density_control
+# holds the element count if the growth over 28 days is at most half the shipped scene's in the same month and
+# at most 2 % in each of the three runs; it leaves the physics as it was if every one of the six medians
+# moves by less than another strength-disorder draw moves it (docs/physics.md §4, "How much of this is the
+# draw": beta 0.03, rate x0.65-1.55; for the tails 0.3, the half-shear area 1.5 points and R2 0.05, no draw
+# was measured, these three are ours) and the bands inside are within one.
+# Predicted: growth +0-2 % against +7 % in 2032; the medians within those spreads; fewer remeshes (-10 to -30 %).
+DENSITY = ["remesh.params.density_control=true"]
+EXPERIMENTS["F10-hthick-ship-w2032"] = ("closed", ["forcing.wind.seed=2032"], 10e3, 28,
+                                        "the shipped scene as it is, the weather of wind seed 2032 "
+                                        "(as F10-hthick-newc-w2032)")
+EXPERIMENTS["F10-hthick-dens-w2032"] = ("closed", DENSITY + ["forcing.wind.seed=2032"], 10e3, 28,
+                                        "density_control, the weather of wind seed 2032")
+EXPERIMENTS["F10-hthick-dens"] = ("closed", DENSITY, 10e3, 28, "density_control, the validation month")
+EXPERIMENTS["F10s-hthick-dens"] = ("strait", DENSITY, 10e3, 28, "strait: density_control, the validation month")
+
 # --- 2026-11-28 (twenty-eighth session): the ±50 % runs with the shipped set --------------------
 # The sensitivity table of docs/validation.md for the set shipped since the switch: the closed basin's
 # validation month from the spin-up made with kept elements keeping their strength, one value changed

@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import ConfigError, MeshError
 from ..fields import remapped_element_fields
 from ..mesh import Mesh, angles_deg, renumber_for_locality, signed_areas
-from .patch import Stitch, grow_patch, make_manifold, mesh_patch, patch_boundary, stitch
+from .patch import Stitch, grow_patch, make_manifold, mesh_patch, patch_boundary, stitch, target_element_count
 from .remap import interpolate_nodal, intersect_triangles, locate_points, remap_field, remap_weights
 from .trigger import TriggerParams, TriggerResult, check_trigger, evaluate_size
 
@@ -68,6 +68,8 @@ class RemeshEvent:
     kept_nodes: np.ndarray | None = field(default=None, repr=False)     # old index of new node k < len
     node_perm: np.ndarray | None = field(default=None, repr=False)      # renumbering after the stitch
     element_perm: np.ndarray | None = field(default=None, repr=False)
+    n_patch_target: float = float("nan")  # elements the target size gives the patch (density_control)
+    size_scale: float = 1.0        # factor on the target size inside the patch (density_control)
 
     @property
     def elements_touched(self) -> int:
@@ -137,8 +139,14 @@ def _extrema(fields: dict, sel) -> dict:
     return out
 
 
+#: density_control: at most this many extra gmsh calls per patch, and this factor on the size
+DENSITY_ITERATIONS = 5
+MAX_SIZE_SCALE = 2.0
+
+
 def remesh_region(state, mask: np.ndarray, size_field, *, algorithm: int = 6,
-                  remap_method: str = "auto", damage_remap: str = "area"):
+                  remap_method: str = "auto", damage_remap: str = "area",
+                  density_control: bool = False, density_tolerance: float = 0.01):
     """Remesh the elements in ``mask`` (made manifold first) and remap ``state``.
 
     Returns ``(new_mesh, new_fields, new_velocity, stitch, timings)``; ``state``
@@ -148,6 +156,12 @@ def remesh_region(state, mask: np.ndarray, size_field, *, algorithm: int = 6,
     (conserves ∫d da); ``"compliance"`` remaps the compliance 1/(1 − d)
     (keeps the series stiffness across thin damage bands, Åström & Benn 2019 eq. 1,
     at the price of raising ∫d da; see docs/remeshing.md).
+
+    ``density_control``: when gmsh puts more than (1 + ``density_tolerance``) times the
+    elements the target size gives the patch's area (:func:`.patch.target_element_count`), the
+    patch is meshed once more with the size inside it scaled by √(made / target), and the
+    mesh whose count is nearer the target is kept (docs/remeshing.md, "Element count drift").
+    The timings then hold ``n_target`` and ``size_scale``.
     """
     if damage_remap not in ("area", "compliance"):
         raise ConfigError(f"damage_remap = {damage_remap!r}; expected 'area' or 'compliance'")
@@ -156,6 +170,26 @@ def remesh_region(state, mask: np.ndarray, size_field, *, algorithm: int = 6,
     t0 = time.perf_counter()
     bnd = patch_boundary(mesh, mask)
     new_xy, new_tri = mesh_patch(mesh, bnd, size_field, algorithm=algorithm)
+    extra = {}
+    if density_control:
+        pe = np.flatnonzero(mask)
+        n_target = target_element_count(mesh, pe, size_field, algorithm)
+        scale, best = 1.0, 1.0
+        trial = len(new_tri)
+        for _ in range(DENSITY_ITERATIONS):
+            # done: within the tolerance, or below the target at the target size itself (the
+            # size is never made finer than the target)
+            if abs(trial - n_target) <= density_tolerance * n_target or (scale == 1.0 and trial < n_target):
+                break
+            new_scale = min(max(scale * float(np.sqrt(trial / n_target)), 1.0), MAX_SIZE_SCALE)
+            if new_scale == scale:  # at a bound
+                break
+            scale = new_scale
+            xy2, tri2 = mesh_patch(mesh, bnd, size_field, algorithm=algorithm, size_scale=scale)
+            trial = len(tri2)
+            if abs(trial - n_target) < abs(len(new_tri) - n_target):
+                new_xy, new_tri, best = xy2, tri2, scale
+        extra = {"n_target": n_target, "size_scale": best}
     t_gmsh = time.perf_counter() - t0
     t0 = time.perf_counter()
     st: Stitch = stitch(mesh, mask, new_xy, new_tri)
@@ -185,7 +219,7 @@ def remesh_region(state, mask: np.ndarray, size_field, *, algorithm: int = 6,
                                 nm.nodes[nk:])
     velocity = np.concatenate([state.velocity[st.kept_nodes], vel_new])
     t_remap = time.perf_counter() - t0
-    return nm, fields, velocity, st, {"gmsh": t_gmsh, "remap": t_remap}
+    return nm, fields, velocity, st, {"gmsh": t_gmsh, "remap": t_remap, **extra}
 
 
 def apply_remesh(state, nm, fields, velocity, solver=None, kept_nodes=None, renumber: bool = False):
@@ -230,7 +264,8 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
                      flagged=None, log: RemeshLog | None = None, algorithm: int = 6,
                      remap_method: str = "auto", damage_remap: str = "area",
                      force_global: bool = False, time_s: float = 0.0, step: int = 0,
-                     before_remap=None, renumber: bool = False) -> RemeshEvent | None:
+                     before_remap=None, renumber: bool = False, density_control: bool = False,
+                     density_tolerance: float = 0.01) -> RemeshEvent | None:
     """Check the trigger and, if needed, remesh and remap ``state`` in place.
 
     Args:
@@ -253,6 +288,8 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
         before_remap: called (no arguments) when the trigger fired, before any field
             is read (:meth:`lagice.model.Model.needs_host_state`: a device stepper's
             fields come to the host only when a remesh happens).
+        density_control, density_tolerance: hold the element density of remeshed patches to
+            the target size's (:func:`remesh_region`; off by default).
         renumber: renumber the new mesh for memory locality (:func:`apply_remesh`);
             ``kept_elements``/``kept_nodes`` of the event refer to the stitched order
             before it, ``element_perm``/``node_perm`` map it (new k is stitched ``perm[k]``).
@@ -297,7 +334,8 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
             continue
         try:
             result = remesh_region(state, mask, size_field, algorithm=algorithm, remap_method=remap_method,
-                                   damage_remap=damage_remap)
+                                   damage_remap=damage_remap, density_control=density_control,
+                                   density_tolerance=density_tolerance)
         except MeshError as exc:
             ev.attempts.append(f"{kind} rings={r}: {exc}")
             continue
@@ -333,6 +371,8 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
     ev.n_elements_after = nm.n_elements
     ev.t_gmsh_s = tm["gmsh"]
     ev.t_remap_s = tm["remap"]
+    ev.n_patch_target = tm.get("n_target", float("nan"))
+    ev.size_scale = tm.get("size_scale", 1.0)
     ev.t_total_s = time.perf_counter() - t_start
     if log is not None:
         log.append(ev)

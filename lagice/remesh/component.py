@@ -7,7 +7,8 @@ from ..errors import ConfigError
 from .trigger import TriggerParams
 
 #: options of :func:`lagice.remesh.remesh_if_needed` a scene may set in ``[remesh.params]``
-REMESH_OPTIONS = ("rings", "max_retries", "max_patch_fraction", "algorithm", "remap_method", "damage_remap")
+REMESH_OPTIONS = ("rings", "max_retries", "max_patch_fraction", "algorithm", "remap_method", "damage_remap",
+                  "density_control", "density_tolerance")
 
 
 def remeshed_transport(old_mesh, transport, mesh, ev):

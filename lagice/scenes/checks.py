@@ -77,6 +77,7 @@ SPECS = {
     "algorithm": Spec(INTEGER, choices=(1, 2, 3, 5, 6, 7, 8, 9, 11)),
     "remap_method": Spec(STRING, choices=("auto", "clip", "celltree")),
     "damage_remap": Spec(STRING, choices=("area", "compliance")),
+    "density_control": Spec(BOOLEAN), "density_tolerance": Spec(NUMBER, 0.0, 1.0),
 }
 
 _ANNOTATIONS = {"float": NUMBER, "int": INTEGER, "bool": BOOLEAN, "str": STRING}
