@@ -70,6 +70,7 @@ class RemeshEvent:
     element_perm: np.ndarray | None = field(default=None, repr=False)
     n_patch_target: float = float("nan")  # elements the target size gives the patch (density_control)
     size_scale: float = 1.0        # factor on the target size inside the patch (density_control)
+    n_patch_at_target_size: int = 0  # elements gmsh made at the target size itself (= n_patch_new without)
 
     @property
     def elements_touched(self) -> int:
@@ -146,7 +147,8 @@ MAX_SIZE_SCALE = 2.0
 
 def remesh_region(state, mask: np.ndarray, size_field, *, algorithm: int = 6,
                   remap_method: str = "auto", damage_remap: str = "area",
-                  density_control: bool = False, density_tolerance: float = 0.01):
+                  density_control: bool = False, density_tolerance: float = 0.01,
+                  density_reference: float | None = None):
     """Remesh the elements in ``mask`` (made manifold first) and remap ``state``.
 
     Returns ``(new_mesh, new_fields, new_velocity, stitch, timings)``; ``state``
@@ -158,10 +160,14 @@ def remesh_region(state, mask: np.ndarray, size_field, *, algorithm: int = 6,
     at the price of raising ∫d da; see docs/remeshing.md).
 
     ``density_control``: when gmsh puts more than (1 + ``density_tolerance``) times the
-    elements the target size gives the patch's area (:func:`.patch.target_element_count`), the
-    patch is meshed once more with the size inside it scaled by √(made / target), and the
-    mesh whose count is nearer the target is kept (docs/remeshing.md, "Element count drift").
-    The timings then hold ``n_target`` and ``size_scale``.
+    elements the reference density gives the patch's area (:func:`.patch.target_element_count`;
+    ``density_reference``: area per element / h², default gmsh's own inside a large region),
+    the patch is meshed again with the size inside it scaled up by √(made / target) (at most
+    ``DENSITY_ITERATIONS`` times, to at most ``MAX_SIZE_SCALE``, never finer than the target
+    size), and the mesh whose count is nearest the target is kept (docs/remeshing.md,
+    "Element count drift").
+    The timings then hold ``n_target``, ``size_scale`` and ``n_at_target_size`` (gmsh's count
+    at the target size itself).
     """
     if damage_remap not in ("area", "compliance"):
         raise ConfigError(f"damage_remap = {damage_remap!r}; expected 'area' or 'compliance'")
@@ -173,23 +179,24 @@ def remesh_region(state, mask: np.ndarray, size_field, *, algorithm: int = 6,
     extra = {}
     if density_control:
         pe = np.flatnonzero(mask)
-        n_target = target_element_count(mesh, pe, size_field, algorithm)
+        n_target = target_element_count(mesh, pe, size_field, algorithm, density_reference)
         scale, best = 1.0, 1.0
-        trial = len(new_tri)
-        for _ in range(DENSITY_ITERATIONS):
-            # done: within the tolerance, or below the target at the target size itself (the
-            # size is never made finer than the target)
-            if abs(trial - n_target) <= density_tolerance * n_target or (scale == 1.0 and trial < n_target):
-                break
-            new_scale = min(max(scale * float(np.sqrt(trial / n_target)), 1.0), MAX_SIZE_SCALE)
-            if new_scale == scale:  # at a bound
-                break
-            scale = new_scale
-            xy2, tri2 = mesh_patch(mesh, bnd, size_field, algorithm=algorithm, size_scale=scale)
-            trial = len(tri2)
-            if abs(trial - n_target) < abs(len(new_tri) - n_target):
-                new_xy, new_tri, best = xy2, tri2, scale
-        extra = {"n_target": n_target, "size_scale": best}
+        trial, tri_first = len(new_tri), new_tri
+        if trial > (1.0 + density_tolerance) * n_target:
+            # coarser until at or below the target (coming from above: the count is not biased
+            # upwards), then the try nearest the target; never finer than the target size
+            for _ in range(DENSITY_ITERATIONS):
+                new_scale = min(scale * float(np.sqrt(trial / n_target)), MAX_SIZE_SCALE)
+                if new_scale <= scale:  # at the bound
+                    break
+                scale = new_scale
+                xy2, tri2 = mesh_patch(mesh, bnd, size_field, algorithm=algorithm, size_scale=scale)
+                trial = len(tri2)
+                if abs(trial - n_target) < abs(len(new_tri) - n_target):
+                    new_xy, new_tri, best = xy2, tri2, scale
+                if trial <= n_target:
+                    break
+        extra = {"n_target": n_target, "size_scale": best, "n_at_target_size": len(tri_first)}
     t_gmsh = time.perf_counter() - t0
     t0 = time.perf_counter()
     st: Stitch = stitch(mesh, mask, new_xy, new_tri)
@@ -265,7 +272,8 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
                      remap_method: str = "auto", damage_remap: str = "area",
                      force_global: bool = False, time_s: float = 0.0, step: int = 0,
                      before_remap=None, renumber: bool = False, density_control: bool = False,
-                     density_tolerance: float = 0.01) -> RemeshEvent | None:
+                     density_tolerance: float = 0.01, density_reference: float | None = None
+                     ) -> RemeshEvent | None:
     """Check the trigger and, if needed, remesh and remap ``state`` in place.
 
     Args:
@@ -288,8 +296,8 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
         before_remap: called (no arguments) when the trigger fired, before any field
             is read (:meth:`lagice.model.Model.needs_host_state`: a device stepper's
             fields come to the host only when a remesh happens).
-        density_control, density_tolerance: hold the element density of remeshed patches to
-            the target size's (:func:`remesh_region`; off by default).
+        density_control, density_tolerance, density_reference: hold the element density of
+            remeshed patches (:func:`remesh_region`; off by default).
         renumber: renumber the new mesh for memory locality (:func:`apply_remesh`);
             ``kept_elements``/``kept_nodes`` of the event refer to the stitched order
             before it, ``element_perm``/``node_perm`` map it (new k is stitched ``perm[k]``).
@@ -335,7 +343,7 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
         try:
             result = remesh_region(state, mask, size_field, algorithm=algorithm, remap_method=remap_method,
                                    damage_remap=damage_remap, density_control=density_control,
-                                   density_tolerance=density_tolerance)
+                                   density_tolerance=density_tolerance, density_reference=density_reference)
         except MeshError as exc:
             ev.attempts.append(f"{kind} rings={r}: {exc}")
             continue
@@ -373,6 +381,7 @@ def remesh_if_needed(state, size_field, *, solver=None, params: TriggerParams | 
     ev.t_remap_s = tm["remap"]
     ev.n_patch_target = tm.get("n_target", float("nan"))
     ev.size_scale = tm.get("size_scale", 1.0)
+    ev.n_patch_at_target_size = tm.get("n_at_target_size", st.n_new_elements)
     ev.t_total_s = time.perf_counter() - t_start
     if log is not None:
         log.append(ev)

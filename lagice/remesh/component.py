@@ -60,6 +60,9 @@ class Remesher:
         except (TypeError, ValueError) as exc:
             raise ConfigError(f"[remesh.params]: {exc}") from None
         self.options = {k: v for k, v in params.items() if k in REMESH_OPTIONS}
+        #: density_control: the mesh's area per element / h² at the start of the run (measured at
+        #: the first step, carried by checkpoints), the density remeshed patches are held to
+        self.density_reference = None
         self.log = RemeshLog()
         #: events before the checkpoint this run resumed from (:meth:`restore`)
         self.n_events_before = 0
@@ -74,7 +77,15 @@ class Remesher:
         st = model.state
         motion = model.component("mesh_motion")
         old_mesh, transport = st.mesh, model.transport_velocity  # the step's, on the mesh it moved
-        ev = remesh_if_needed(st, self.size_field, solver=model.stepper, params=self.trigger,
+        extra = {}
+        if self.options.get("density_control"):
+            if self.density_reference is None:
+                from .patch import area_per_size2
+                # the density the run started with; measured before this step's remesh (the mesh
+                # has moved by one step: the area is that of the ice it holds)
+                self.density_reference = area_per_size2(st.mesh, self.size_field)
+            extra["density_reference"] = self.density_reference
+        ev = remesh_if_needed(st, self.size_field, solver=model.stepper, params=self.trigger, **extra,
                               flagged=motion.last_flagged if motion is not None else None, log=self.log,
                               time_s=model.clock.time_s + dt_s, step=model.clock.iteration + 1,
                               before_remap=model.needs_host_state, renumber=self.renumber, **self.options)
@@ -92,8 +103,15 @@ class Remesher:
         return self.n_events_before + len(self.log)
 
     def checkpoint_state(self):
-        return {}, {"n_events": self.n_events}
+        import numpy as np
+
+        arrays = {} if self.density_reference is None else {
+            "density_reference": np.array([self.density_reference], np.float64)}
+        return arrays, {"n_events": self.n_events}
 
     def restore(self, arrays, meta):
-        """Carry the event count of the run so far (:attr:`log` holds this session's events only)."""
+        """Carry the event count of the run so far (:attr:`log` holds this session's events only)
+        and the density_control reference (a checkpoint without it: measured at the next step)."""
         self.n_events_before = int(meta.get("n_events", 0))
+        if "density_reference" in arrays:
+            self.density_reference = float(arrays["density_reference"][0])

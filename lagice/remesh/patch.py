@@ -157,14 +157,27 @@ def element_area_per_size2(algorithm: int) -> float:
     return _AREA_PER_SIZE2[algorithm]
 
 
-def target_element_count(mesh: Mesh, elements: np.ndarray, size_field, algorithm: int) -> float:
-    """How many elements gmsh ``algorithm`` would put in the area of ``elements`` at the target
-    size: Σ A_e / (k h(c_e)²), k = :func:`element_area_per_size2`, c_e the centroid."""
+def area_per_size2(mesh: Mesh, size_field, elements=None) -> float:
+    """Mean of A_e / h(c_e)² over ``elements`` (all by default) of ``mesh``: its density
+    relative to the target size (c_e the centroid)."""
+    tri = mesh.triangles if elements is None else mesh.triangles[elements]
+    c = mesh.nodes[tri].mean(axis=1)
+    h = evaluate_size(size_field, c[:, 0], c[:, 1])
+    return float(np.mean(np.abs(signed_areas(mesh.nodes, tri)) / h ** 2))
+
+
+def target_element_count(mesh: Mesh, elements: np.ndarray, size_field, algorithm: int,
+                         reference: float | None = None) -> float:
+    """How many elements the area of ``elements`` holds at the reference density: Σ A_e /
+    (k h(c_e)²), c_e the centroid, k = ``reference`` (area per element / h²; the Remesher
+    passes the mesh's own at the start of the run) or, by default, what gmsh ``algorithm``
+    gives inside a large region (:func:`element_area_per_size2`)."""
     tri = mesh.triangles[elements]
     c = mesh.nodes[tri].mean(axis=1)
     h = evaluate_size(size_field, c[:, 0], c[:, 1])
     a = np.abs(signed_areas(mesh.nodes, tri))
-    return float(np.sum(a / h ** 2) / element_area_per_size2(algorithm))
+    k = element_area_per_size2(algorithm) if reference is None else float(reference)
+    return float(np.sum(a / h ** 2) / k)
 
 
 def mesh_patch(mesh: Mesh, bnd: PatchBoundary, size_field, algorithm: int = 6, size_scale: float = 1.0):
