@@ -2122,6 +2122,14 @@ add_month_own_spinup("P-vcrj1", PMAX + CR_KAPPA1,
 # 0.0050 (vcrj1 0.0056), 850 remeshes (vcrj1 904), net-divergence ratio -0.41: 2 bands inside (beta, the
 # half-shear area) against vcrj1's 3 and the shipped set's 4. The prediction held for beta and the drift,
 # and failed for the rate and the tails. 2585 s on 2 threads (the spin-up 37 min on one).
+# The strait month, stated 2026-11-29 09:29 UTC (thirty-fourth session) before its run (F10s-hthick-P-vcrj1,
+# from the same spin-up, H1125-P-vcrj1). The closed basin's month failed its rule on the rate and the tails;
+# the strait is run to complete the validation month in both basins, not as a candidate. Against the shipped
+# set's strait month (F10s-hthick-newc: beta 0.06, 3 bands, wind factor 0.0044, rate 0.0029 per day).
+# Predicted: as in the closed basin, beta 0.15-0.20, both tails lighter than observed (above 2.5 for the
+# shear, above 2.8 for |divergence|), R2 below 0.73, the rate 0.006-0.009 per day, 1-2 bands. The strait
+# carries the closed basin's result if beta is at least 0.14 and the bands are within one of the closed
+# basin's (2).
 
 
 # --- 2026-11-29 (thirty-fourth session): the element count under remeshing ---------------------------
