@@ -78,6 +78,20 @@ def run_counts(name: str) -> dict:
         out[f"elements_{key}"] = mesh.n_elements
         out[f"density_ratio_{key}"] = density_ratio(mesh, size, alg)
     out["growth"] = out["elements_last"] / out["elements_first"] - 1.0
+    # where the growth is: the elements never remeshed between the first and the last snapshot
+    # (followed by node id) and the rest, the part remeshed at least once
+    from lagice.diagnostics.windows import window_arrays
+    from lagice.mesh import signed_areas
+
+    xy0, xy1, tri, _, info = window_arrays(d, 0.0, 1e12)  # the first and the last snapshot
+    start_xy, start_tri = info["start_mesh"][:2]
+    area_all = np.abs(signed_areas(start_xy, start_tri)).sum()
+    ok = np.all(np.isfinite(xy1[tri]).reshape(len(tri), -1), axis=1)
+    a0, a1 = np.abs(signed_areas(xy0, tri[ok])).sum(), np.abs(signed_areas(xy1, tri[ok])).sum()
+    out.update(never_remeshed=int(ok.sum()), never_remeshed_area_change=float(a1 / a0 - 1.0),
+               remeshed_elements_first=int(len(start_tri) - ok.sum()),
+               remeshed_elements_last=int(out["elements_last"] - ok.sum()),
+               remeshed_area_change=float((area_all - a1) / (area_all - a0) - 1.0))
     summary = json.loads((d / "summary.json").read_text())
     out["remesh_count"] = summary.get("remesh_count")
     out["density_control"] = bool(cfg.get("remesh", {}).get("params", {}).get("density_control", False))
@@ -110,6 +124,11 @@ def main(argv=None) -> int:
             print(f"{name:28s} density_control {str(x['density_control']):5s}: elements {x['elements_first']} -> "
                   f"{x['elements_last']} ({100 * x['growth']:+.1f} %), density ratio {x['density_ratio_first']:.3f} "
                   f"-> {x['density_ratio_last']:.3f}, {x['remesh_count']} remeshes")
+            print(f"    never remeshed: {x['never_remeshed']} elements, their area "
+                  f"{100 * x['never_remeshed_area_change']:+.1f} %; remeshed at least once: elements "
+                  f"{x['remeshed_elements_first']} -> {x['remeshed_elements_last']} "
+                  f"({100 * (x['remeshed_elements_last'] / x['remeshed_elements_first'] - 1):+.1f} %), area "
+                  f"{100 * x['remeshed_area_change']:+.1f} %")
     return 0
 
 

@@ -3,7 +3,6 @@
 import numpy as np
 import pytest
 
-import lagice.remesh as rm
 from lagice.errors import ConfigError
 from lagice.mesh import generate_mesh, rectangle_domain, signed_areas
 from lagice.remesh import remesh_region, totals
@@ -108,9 +107,9 @@ def test_channel_run_holds_the_start_density(tmp_path):
     is made coarser (never finer than the target size) and the try nearest the target is kept, the
     patches end within 2 % of their targets in sum, the mesh gains less than half as many
     elements as without, and the ice volume is kept to round-off."""
-    from helpers import scene_sim
-
     from lagice.remesh.patch import area_per_size2
+
+    from helpers import scene_sim
 
     growth = {}
     for on in (False, True):
