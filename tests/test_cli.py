@@ -20,6 +20,10 @@ def test_cli_run_compression(tmp_path):
                 "--set", "run.duration=10000s", "--set", "run.seed=3")
     assert r.returncode == 0, r.stderr
     assert "plot:" in r.stdout and "uniaxial_compression.png" in r.stdout
+    # the mesh it made, against what was asked
+    line = next(ln for ln in r.stdout.splitlines() if "mesh:" in ln)
+    n_faces = xr.open_dataset(sorted((out / "snapshots").glob("*.nc"))[0]).sizes["mesh_face"]
+    assert f"mesh: {n_faces} elements" in line and "x domain.resolution_m = 12.5 km" in line, line
     png = out / "uniaxial_compression.png"
     assert png.stat().st_size > 10_000 and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     ds = xr.load_dataset(out / "timeseries.nc", decode_times=False)

@@ -129,3 +129,27 @@ def test_segment_off_the_boundary_is_refused_before_meshing(monkeypatch):
     assert called
     e = mesh.edges_with_tag("open")
     assert len(e) >= 4 and np.allclose(mesh.nodes[e.ravel(), 0], 1000.3)
+
+
+def test_size_report_against_the_target():
+    """A fresh gmsh mesh of a square at h has its median edge near h; the basin's 10 km mesh
+    (gmsh's Delaunay on its coast) has 8 km edges, and the log line says why."""
+    from lagice.mesh import size_line, size_report
+    from lagice.scenes.builder import build_mesh
+    from lagice.scenes.config import load_scene
+
+    poly, _ = rectangle_domain(200e3, 120e3)
+    mesh = generate_mesh(poly, 8e3, algorithm=6)
+    r = size_report(mesh.nodes, mesh.triangles, 8e3)
+    assert r["n_elements"] == mesh.n_elements and 0.9 < r["median_edge_to_target"] < 1.05
+    assert r["edge_p05_m"] < r["median_edge_m"] < r["edge_p95_m"]
+    assert 0.38 < r["mean_area_to_target2"] < 0.44  # equilateral: 0.433
+    line = size_line(r, "domain.resolution_m = 8 km")
+    assert "x domain.resolution_m = 8 km" in line and "gmsh also takes" not in line
+    # a size field: the ratio is taken element by element
+    half = size_report(mesh.nodes, mesh.triangles, lambda x, y: 0.0 * x + 16e3)
+    assert half["median_edge_to_target"] == pytest.approx(r["median_edge_to_target"] / 2)
+    basin = build_mesh(load_scene("winter_basin_pack"))[0]
+    b = size_report(basin.nodes, basin.triangles, 10e3)
+    assert 0.75 < b["median_edge_to_target"] < 0.85
+    assert "gmsh also takes the size from the pieces" in size_line(b, "domain.resolution_m = 10 km")

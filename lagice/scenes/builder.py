@@ -9,6 +9,7 @@ stores the validated config and ``"lagice.scenes.builder:build_simulation"``, so
 from __future__ import annotations
 
 import json
+import logging
 import math
 from pathlib import Path
 
@@ -942,10 +943,23 @@ def build_simulation(cfg: dict, out_dir=None, progress: bool | None = None, over
     return sim
 
 
+def _log_mesh_size(model, cfg: dict) -> None:
+    """One log line: the mesh's edge lengths against ``domain.resolution_m`` (what was asked
+    and what gmsh, or the state file, gave)."""
+    from ..mesh import size_line, size_report
+    from .components import build_remesher
+
+    res = cfg["domain"]["resolution_m"]
+    size = build_remesher(cfg).size_field if isinstance(res, str) else float(res)
+    target = f"domain.resolution_m = {res}" if isinstance(res, str) else f"domain.resolution_m = {res / 1e3:g} km"
+    logging.getLogger("lagice").info(size_line(size_report(model.mesh.nodes, model.mesh.triangles, size), target))
+
+
 def _simulation(cfg: dict, out: Path, progress) -> Simulation:
     """The model (mesh, initial state: the checks that need the mesh) and its
     :class:`Simulation` writing into the prepared folder ``out``."""
     model = build_model(cfg, validated=True)
+    _log_mesh_size(model, cfg)
     prog = cfg["run"]["progress"] if progress is None else progress
     sim = Simulation(model, dt=time_step_s(cfg), stop=cfg["run"]["duration"], progress=prog, builder=BUILDER,
                      max_speed_m_s=cfg["run"]["max_speed_m_s"])
