@@ -19,7 +19,13 @@ shipped spun-up state with each velocity element and, after every outer step, co
 
 It prints the medians over the steps (the steps of a remesh are left out).
 
+``--remesh-triggers`` prints, for each velocity element over the same steps, what fired the
+remeshes: the events, the elements each criterion of the trigger caught (angle, edge length,
+near inversion; :mod:`lagice.remesh.trigger`) summed over the events, the elements replaced,
+and the strain rates the mesh moved by (the area-weighted mean of ε̇_II of the mesh's field).
+
     NUMBA_NUM_THREADS=1 python benchmarks/cr_node_motion.py --steps 60
+    NUMBA_NUM_THREADS=2 python benchmarks/cr_node_motion.py --steps 432 --remesh-triggers
 """
 from __future__ import annotations
 
@@ -78,12 +84,15 @@ def main(argv=None) -> None:
     ap.add_argument("--steps", type=int, default=60, help="outer steps measured")
     ap.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
                     help="a scene override for every variant (repeatable)")
+    ap.add_argument("--remesh-triggers", action="store_true",
+                    help="also what fired the remeshes of each velocity element over the steps")
     args = ap.parse_args(argv)
     extra = dict(s.split("=", 1) for s in args.sets)
     print(f"winter_basin_pack from its shipped spun-up state, {args.steps} outer steps"
           + (f", {' '.join(args.sets)}" if args.sets else ""))
     print("| velocity element | mismatch (mesh against rheology) | roughness | mesh roughness | shear ratio | steps |")
     print("|---|---|---|---|---|---|")
+    triggers = []
     for name, ov in VARIANTS:
         cfg = load_scene("winter_basin_pack", [f"{k}={v}" for k, v in {**ov, **extra}.items()]
                          + ["run.progress=false", "output.plot=false", "run.duration=100d", "output.every=100d",
@@ -97,9 +106,21 @@ def main(argv=None) -> None:
                 r = step_measures(sim) if sim.model.state.counters.get("remesh_count", 0) == n0 else None
                 if r is not None:
                     rows.append(r)
+            if args.remesh_triggers:
+                ev = [e for e in sim.model.component("remeshing").log.events if e.kind != "failed"]
+                caught = {k: sum(e.trigger_counts.get(k, 0) for e in ev)
+                          for k in ("angle", "edge_length", "near_inversion", "total")}
+                triggers.append((name, len(ev), caught, sum(e.n_patch_old for e in ev), rows))
         med = {k: float(np.median([r[k] for r in rows])) for k in rows[0]}
         print(f"| {name} | {med['mismatch']:.3f} | {med['roughness']:.3f} | {med['mesh_roughness']:.3f} | "
               f"{med['shear_ratio']:.3f} | {len(rows)} |", flush=True)
+    if args.remesh_triggers:
+        print("\n| velocity element | remeshes | elements caught: angle / edge length / near inversion (total) "
+              "| elements replaced |")
+        print("|---|---|---|---|")
+        for name, n, c, replaced, _ in triggers:
+            print(f"| {name} | {n} | {c['angle']} / {c['edge_length']} / {c['near_inversion']} ({c['total']}) "
+                  f"| {replaced} |")
 
 
 if __name__ == "__main__":
