@@ -211,7 +211,8 @@ class Simulation:
 
     def summary(self) -> dict:
         """Simulated time and steps, wall time (all sessions of the run, resumed parts
-        included, like the component ``timings``), remesh count, ice volume budget,
+        included, like the component ``timings``), remesh count, the mesh's element and node
+        counts now (remeshing changes them: docs/remeshing.md §7.1), ice volume budget,
         why the run stopped early (None: it reached its end) and the last checkpoint."""
         m = self.model
         st = m.state
@@ -219,6 +220,7 @@ class Simulation:
         return {"time_s": m.clock.time_s, "steps": m.clock.iteration, "stop_time_s": self.stop_time,
                 "finished": self.finished, "wall_s": self.wall_s,
                 "timings": dict(m.timings), "remesh_count": st.counters.get("remesh_count", 0),
+                "n_elements": int(st.mesh.n_elements), "n_nodes": int(st.mesh.n_nodes),
                 "ice_volume_m3": st.ice_volume_m3, "volume_budget": m.volume_budget(),
                 "stop_reason": self.stop_reason,
                 "checkpoint": str(ck.last_path) if ck is not None and ck.last_path is not None else None,

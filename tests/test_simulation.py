@@ -287,6 +287,7 @@ def test_resume_bit_identical_across_remeshing(tmp_path):
     for k in a:
         assert a[k].shape == b[k].shape and np.array_equal(a[k], b[k]), f"{k} differs after resume"
     assert np.array_equal(full.model.mesh.triangles, resumed.model.mesh.triangles)
+    assert full.summary()["n_elements"] == resumed.summary()["n_elements"] == full.model.mesh.n_elements
     assert np.array_equal(np.array(full.model.drifters.track), np.array(resumed.model.drifters.track))
     assert (full.model.component("mesh_motion").budget == resumed.model.component("mesh_motion").budget)
     # mass: the moving mesh and every remap conserve ice volume
