@@ -2130,6 +2130,13 @@ add_month_own_spinup("P-vcrj1", PMAX + CR_KAPPA1,
 # shear, above 2.8 for |divergence|), R2 below 0.73, the rate 0.006-0.009 per day, 1-2 bands. The strait
 # carries the closed basin's result if beta is at least 0.14 and the bands are within one of the closed
 # basin's (2).
+# Result (2026-11-29, 10:33 UTC): it carries, by the rule. beta 0.197 (in 0.17-0.20; shipped 0.064), the
+# |divergence| tail 2.62 (inside), the shear tail 2.66 (0.16 past its band), half-shear area 4.9 %, R2 0.608,
+# rate 0.0066 per day (x2.3 the shipped set's), wind factor 0.0057 (shipped 0.0044), 919 remeshes (240),
+# 52 km mean drift: 3 bands inside (beta, the |divergence| tail, the half-shear area), as many as the
+# shipped set's strait month but different ones. The prediction held for beta, the shear tail, R2 and the
+# rate, and was wrong for the |divergence| tail (inside, not light) and the count (3, not 1-2). 3451 s on 2
+# threads.
 
 
 # --- 2026-11-29 (thirty-fourth session): the element count under remeshing ---------------------------
