@@ -111,6 +111,19 @@ def check_mesh_algorithm(algorithm, key: str = "algorithm") -> int:
     return algorithm
 
 
+def set_size_options(gmsh, algorithm: int, size_max_m: float, from_boundary: bool) -> None:
+    """gmsh's 2-D algorithm and every size option (they persist across models, so all are set
+    each time): no minimum, ``size_max_m`` as the maximum, sizes from the points and extended
+    from the boundary's pieces only if ``from_boundary``, none from curvature."""
+    opt = gmsh.option
+    opt.setNumber("Mesh.Algorithm", algorithm)
+    opt.setNumber("Mesh.MeshSizeMin", 0.0)
+    opt.setNumber("Mesh.MeshSizeMax", size_max_m)
+    opt.setNumber("Mesh.MeshSizeFromPoints", int(from_boundary))
+    opt.setNumber("Mesh.MeshSizeExtendFromBoundary", int(from_boundary))
+    opt.setNumber("Mesh.MeshSizeFromCurvature", 0)
+
+
 def generate_mesh(polygon: Polygon, size, *, segments: dict | None = None,
                   exterior_tag: str = COAST, island_tag: str = COAST,
                   algorithm: int = 6) -> Mesh:
@@ -163,25 +176,14 @@ def generate_mesh(polygon: Polygon, size, *, segments: dict | None = None,
             loops.append(geo.addCurveLoop(lines))
         geo.addPlaneSurface(loops)
         geo.synchronize()
-        opt = gmsh.option
-        opt.setNumber("Mesh.Algorithm", algorithm)
-        # gmsh options persist across models: set every size option each time
-        opt.setNumber("Mesh.MeshSizeMin", 0.0)
-        opt.setNumber("Mesh.MeshSizeMax", 1e22)
-        opt.setNumber("Mesh.MeshSizeFromPoints", 1)
-        opt.setNumber("Mesh.MeshSizeExtendFromBoundary", 1)
-        opt.setNumber("Mesh.MeshSizeFromCurvature", 0)
+        # a constant size also comes from the points and the boundary's pieces (docs/remeshing.md §7.1)
+        set_size_options(gmsh, algorithm, 1e22 if callable(size_v) else float(size_v),
+                         from_boundary=not callable(size_v))
         if callable(size_v):
-            opt.setNumber("Mesh.MeshSizeFromPoints", 0)
-            opt.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-            opt.setNumber("Mesh.MeshSizeFromCurvature", 0)
-
             def cb(dim, tag, x, y, z, lc):
                 return float(np.asarray(size_v(np.array([x]), np.array([y]))).ravel()[0])
 
             gmsh.model.mesh.setSizeCallback(cb)
-        else:
-            opt.setNumber("Mesh.MeshSizeMax", float(size_v))
         try:
             gmsh.model.mesh.generate(2)
         except Exception as exc:  # noqa: BLE001

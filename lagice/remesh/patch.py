@@ -26,6 +26,7 @@ import numpy as np
 
 from ..errors import MeshError
 from ..mesh import Mesh, gmsh_session, signed_areas
+from ..mesh.generate import set_size_options
 from .trigger import evaluate_size
 
 
@@ -143,13 +144,7 @@ def element_area_per_size2(algorithm: int) -> float:
             geo.synchronize()
             for ln in lines:
                 gmsh.model.mesh.setTransfiniteCurve(ln, n + 1)
-            opt = gmsh.option
-            opt.setNumber("Mesh.Algorithm", algorithm)
-            opt.setNumber("Mesh.MeshSizeMin", 0.0)
-            opt.setNumber("Mesh.MeshSizeFromPoints", 0)
-            opt.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-            opt.setNumber("Mesh.MeshSizeFromCurvature", 0)
-            opt.setNumber("Mesh.MeshSizeMax", 1.0)
+            set_size_options(gmsh, algorithm, 1.0, from_boundary=False)
             gmsh.model.mesh.generate(2)
             etypes, _, enodes = gmsh.model.mesh.getElements(2)
         n_tri = len(enodes[list(etypes).index(2)]) // 3
@@ -157,13 +152,18 @@ def element_area_per_size2(algorithm: int) -> float:
     return _AREA_PER_SIZE2[algorithm]
 
 
-def area_per_size2(mesh: Mesh, size_field, elements=None) -> float:
-    """Mean of A_e / h(c_e)² over ``elements`` (all by default) of ``mesh``: its density
-    relative to the target size (c_e the centroid)."""
+def _area_over_size2(mesh: Mesh, size_field, elements=None) -> np.ndarray:
+    """A_e / h(c_e)² of ``elements`` (all by default), c_e the centroid."""
     tri = mesh.triangles if elements is None else mesh.triangles[elements]
     c = mesh.nodes[tri].mean(axis=1)
     h = evaluate_size(size_field, c[:, 0], c[:, 1])
-    return float(np.mean(np.abs(signed_areas(mesh.nodes, tri)) / h ** 2))
+    return np.abs(signed_areas(mesh.nodes, tri)) / h ** 2
+
+
+def area_per_size2(mesh: Mesh, size_field, elements=None) -> float:
+    """Mean of A_e / h(c_e)² over ``elements`` (all by default) of ``mesh``: its density
+    relative to the target size (c_e the centroid)."""
+    return float(np.mean(_area_over_size2(mesh, size_field, elements)))
 
 
 def target_element_count(mesh: Mesh, elements: np.ndarray, size_field, algorithm: int,
@@ -172,12 +172,8 @@ def target_element_count(mesh: Mesh, elements: np.ndarray, size_field, algorithm
     (k h(c_e)²), c_e the centroid, k = ``reference`` (area per element / h²; the Remesher
     passes the mesh's own at the start of the run) or, by default, what gmsh ``algorithm``
     gives inside a large region (:func:`element_area_per_size2`)."""
-    tri = mesh.triangles[elements]
-    c = mesh.nodes[tri].mean(axis=1)
-    h = evaluate_size(size_field, c[:, 0], c[:, 1])
-    a = np.abs(signed_areas(mesh.nodes, tri))
     k = element_area_per_size2(algorithm) if reference is None else float(reference)
-    return float(np.sum(a / h ** 2) / k)
+    return float(np.sum(_area_over_size2(mesh, size_field, elements)) / k)
 
 
 def mesh_patch(mesh: Mesh, bnd: PatchBoundary, size_field, algorithm: int = 6, size_scale: float = 1.0):
@@ -211,17 +207,8 @@ def mesh_patch(mesh: Mesh, bnd: PatchBoundary, size_field, algorithm: int = 6, s
         geo.synchronize()
         for ln in lines_all:
             gmsh.model.mesh.setTransfiniteCurve(ln, 2)
-        opt = gmsh.option
-        opt.setNumber("Mesh.Algorithm", algorithm)
-        opt.setNumber("Mesh.MeshSizeMin", 0.0)
-        opt.setNumber("Mesh.MeshSizeFromPoints", 0)
-        opt.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        opt.setNumber("Mesh.MeshSizeFromCurvature", 0)
-        if const:
-            opt.setNumber("Mesh.MeshSizeMax", float(size_field))
-        else:
-            opt.setNumber("Mesh.MeshSizeMax", 1e22)
-
+        set_size_options(gmsh, algorithm, float(size_field) if const else 1e22, from_boundary=False)
+        if not const:
             def cb(dim, tag, x, y, z, lc_):
                 return float(evaluate_size(size_field, np.array([x]), np.array([y]))[0])
 

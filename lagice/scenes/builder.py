@@ -91,12 +91,17 @@ def build_domain(d: dict):
     if d["resolution_m"] is None:
         raise ConfigError("domain.resolution_m is required (target element size in m, or an expression in x, y)")
     res = d["resolution_m"]
-    if isinstance(res, str):
-        size = lambda x, y: spatial_values(res, np.atleast_1d(x), np.atleast_1d(y), "domain.resolution_m")  # noqa: E731
-    else:
+    if not isinstance(res, str):
         check_range("domain.resolution_m", res, 0.0, None, low_open=True, unit="m")
-        size = res
-    return poly, segs, d["exterior_tag"], size
+    return poly, segs, d["exterior_tag"], resolution_size_field(res)
+
+
+def resolution_size_field(res):
+    """The target element size [m] of ``domain.resolution_m``: the number itself, or for an
+    expression in x, y a vectorised ``f(x, y)`` (mesh generation, remeshing, the run's mesh line)."""
+    if isinstance(res, str):
+        return lambda x, y: spatial_values(res, np.atleast_1d(x), np.atleast_1d(y), "domain.resolution_m")
+    return res
 
 
 def _geojson_crs(gj: dict) -> str | None:
@@ -945,14 +950,13 @@ def build_simulation(cfg: dict, out_dir=None, progress: bool | None = None, over
 
 def _log_mesh_size(model, cfg: dict) -> None:
     """One log line: the mesh's edge lengths against ``domain.resolution_m`` (what was asked
-    and what gmsh, or the state file, gave)."""
+    and what gmsh gave)."""
     from ..mesh import size_line, size_report
-    from .components import build_remesher
 
     res = cfg["domain"]["resolution_m"]
-    size = build_remesher(cfg).size_field if isinstance(res, str) else float(res)
     target = f"domain.resolution_m = {res}" if isinstance(res, str) else f"domain.resolution_m = {res / 1e3:g} km"
-    logging.getLogger("lagice").info(size_line(size_report(model.mesh.nodes, model.mesh.triangles, size), target))
+    report = size_report(model.mesh.nodes, model.mesh.triangles, resolution_size_field(res))
+    logging.getLogger("lagice").info(size_line(report, target))
 
 
 def _simulation(cfg: dict, out: Path, progress) -> Simulation:

@@ -579,7 +579,6 @@ def check_forcing_files(cfg: dict, points_xy, duration_s: float) -> None:
     (``run.start_date`` .. + ``run.duration``; ``time_extrapolation = "hold"`` opts
     in to holding the first/last record) and no NaN over the domain
     (``points_xy``: points spanning the domain polygon, in the scene CRS)."""
-    import numpy as np
 
     fc = cfg["forcing"]
     crs, start = cfg["domain"]["crs"], cfg["run"]["start_date"]
@@ -693,10 +692,8 @@ def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
 
 def build_remesher(cfg):
     from ..remesh import Remesher
-    from .config import spatial_values
+    from .builder import resolution_size_field
 
-    res = cfg["domain"]["resolution_m"]
-    size = res if not isinstance(res, str) else (
-        lambda x, y: spatial_values(res, np.atleast_1d(x), np.atleast_1d(y), "domain.resolution_m"))
+    size = resolution_size_field(cfg["domain"]["resolution_m"])
     return Remesher(size, cfg["remesh"]["min_angle_deg"], renumber=cfg["domain"]["renumber"],
                     **cfg["remesh"]["params"])
