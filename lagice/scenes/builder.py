@@ -36,6 +36,7 @@ from .config import (
     load_scene,
     override_config,
     physics_view,
+    resolution_size_field,
     resolve_hook,
     spatial_values,
     time_space_callable,
@@ -95,13 +96,6 @@ def build_domain(d: dict):
         check_range("domain.resolution_m", res, 0.0, None, low_open=True, unit="m")
     return poly, segs, d["exterior_tag"], resolution_size_field(res)
 
-
-def resolution_size_field(res):
-    """The target element size [m] of ``domain.resolution_m``: the number itself, or for an
-    expression in x, y a vectorised ``f(x, y)`` (mesh generation, remeshing, the run's mesh line)."""
-    if isinstance(res, str):
-        return lambda x, y: spatial_values(res, np.atleast_1d(x), np.atleast_1d(y), "domain.resolution_m")
-    return res
 
 
 def _geojson_crs(gj: dict) -> str | None:

@@ -692,7 +692,7 @@ def build(cfg: dict, mesh, state, rheology, duration_s: float) -> dict:
 
 def build_remesher(cfg):
     from ..remesh import Remesher
-    from .builder import resolution_size_field
+    from .config import resolution_size_field
 
     size = resolution_size_field(cfg["domain"]["resolution_m"])
     return Remesher(size, cfg["remesh"]["min_angle_deg"], renumber=cfg["domain"]["renumber"],

@@ -596,3 +596,11 @@ def time_space_callable(value, key: str):
             raise ConfigError(f"{key} = {value!r}: cannot evaluate the expression in t, x, y: {exc}") from exc
         return f
     raise ConfigError(f"{key} = {value!r}: expected a number, an expression in t, x, y or module:function")
+
+
+def resolution_size_field(res):
+    """The target element size [m] of ``domain.resolution_m``: the number itself, or for an
+    expression in x, y a vectorised ``f(x, y)`` (mesh generation, remeshing, the run's mesh line)."""
+    if isinstance(res, str):
+        return lambda x, y: spatial_values(res, np.atleast_1d(x), np.atleast_1d(y), "domain.resolution_m")
+    return res
