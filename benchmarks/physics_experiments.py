@@ -2191,6 +2191,36 @@ for _key, _lo, _hi, _what in SENSITIVITY_CHANGES:
             "closed", NEWC + from_spinup("H1125-newc") + [_change], 10e3, 28,
             f"{_what} {_sign.replace('-', '−')} %, 10 km, kept elements keep their strength (the shipped set)")
 
+# --- 2026-11-29 (thirty-fifth session): the basin meshed at domain.resolution_m ------------------
+# Written 2026-11-29 11:19 UTC, before the runs. Until today gmsh took the basin's element size also
+# from the pieces it cut the coast into (about 8.6 km) and spread it inwards: the "10 km" flagship ran
+# on 28 048 elements with 7.99 km median edges. lagice.mesh.generate now takes the size from
+# domain.resolution_m alone (20 726 elements, 9.26 km median edges; docs/remeshing.md §7.1); a
+# correction of what the scene asks, not a calibration. Every shipped run changes, so the whole set
+# is remade: the spin-up (H1125-m10 = the new data_stubs/winter_basin_spinup.npz, also remade by
+# `spinup shipped` and compared bit for bit), both basins in eight months of weather, the EVP
+# controls and the ±50 % runs. Prediction, against the shipped set on the old mesh (validation month
+# closed / strait: beta 0.060 / 0.064, tails 2.11 / 2.28 and 2.53 / 2.29, half-shear area 4.4 % /
+# 4.9 %, R2 0.75 / 0.78, rate 0.0031 / 0.0029 per day, 4 / 3 bands; eight-month medians beta 0.056 /
+# 0.052, rate 0.0023 / 0.0027 per day, 4 / 4 bands): the strength law makes elements 16 % longer
+# about 7 % weaker, which the ±50 % runs (strength -50 %: rate x2.7) turn into a rate x1.0-1.4; every
+# other median moves by about a disorder draw (the mesh is a new draw: beta within 0.03, each tail
+# within 0.4, half-shear area within 1.5 points, R2 within 0.05); the count of bands inside within
+# one; beta stays below its band. Whatever the result, the mesh change stays: it is what the scene asks.
+add_month_own_spinup("m10", [], "meshed at domain.resolution_m (not from the coast's pieces), own spin-up")
+add_weather_ensemble("m10", from_spinup("H1125-m10"), "meshed at domain.resolution_m",
+                     "meshed at domain.resolution_m", ENSEMBLE_SEEDS + MORE_SEEDS, suffix=", eight months")
+EXPERIMENTS["E10h-m10"] = ("closed", from_spinup("H1125-m10") + EVP, 10e3, 28,
+                           "EVP control, meshed at domain.resolution_m")
+EXPERIMENTS["E10hs-m10"] = ("strait", from_spinup("H1125-m10") + EVP, 10e3, 28,
+                            "EVP control, strait, meshed at domain.resolution_m")
+for _key, _lo, _hi, _what in SENSITIVITY_CHANGES:
+    for _sign, _change in (("-50", _lo), ("+50", _hi)):
+        EXPERIMENTS[f"X10h-{_key}{_sign}-m10"] = (
+            "closed", from_spinup("H1125-m10") + [_change], 10e3, 28,
+            f"{_what} {_sign.replace('-', '−')} %, 10 km, meshed at domain.resolution_m (the shipped set)")
+
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]

@@ -132,8 +132,10 @@ def test_segment_off_the_boundary_is_refused_before_meshing(monkeypatch):
 
 
 def test_size_report_against_the_target():
-    """A fresh gmsh mesh of a square at h has its median edge near h; the basin's 10 km mesh
-    (gmsh's Delaunay on its coast) has 8 km edges, and the log line says why."""
+    """A fresh gmsh mesh of a square at h has its median edge near h, and so do the 10 km
+    basin (97 coast vertices 27-43 km apart) and the 8 km disk (coast vertices about 5 km
+    apart): the size is not taken from the pieces gmsh cuts the coast into (before
+    2026-11-29 it was: median edges 8.0 km and 5.2 km). An off mesh's log line says why."""
     from lagice.mesh import size_line, size_report
     from lagice.scenes.builder import build_mesh
     from lagice.scenes.config import load_scene
@@ -145,11 +147,13 @@ def test_size_report_against_the_target():
     assert r["edge_p05_m"] < r["median_edge_m"] < r["edge_p95_m"]
     assert 0.38 < r["mean_area_to_target2"] < 0.44  # equilateral: 0.433
     line = size_line(r, "domain.resolution_m = 8 km")
-    assert "x domain.resolution_m = 8 km" in line and "gmsh also takes" not in line
+    assert "x domain.resolution_m = 8 km" in line and "elements are smaller" not in line
     # a size field: the ratio is taken element by element
     half = size_report(mesh.nodes, mesh.triangles, lambda x, y: 0.0 * x + 16e3)
     assert half["median_edge_to_target"] == pytest.approx(r["median_edge_to_target"] / 2)
-    basin = build_mesh(load_scene("winter_basin_pack"))[0]
-    b = size_report(basin.nodes, basin.triangles, 10e3)
-    assert 0.75 < b["median_edge_to_target"] < 0.85
-    assert "gmsh also takes the size from the pieces" in size_line(b, "domain.resolution_m = 10 km")
+    assert "elements are smaller along a boundary" in size_line(half, "domain.resolution_m = 16 km")
+    for scene, target_m in (("winter_basin_pack", 10e3), ("imprint_cyclone_disk", 8e3)):
+        m = build_mesh(load_scene(scene))[0]
+        b = size_report(m.nodes, m.triangles, target_m)
+        assert 0.9 < b["median_edge_to_target"] < 1.05, (scene, b["median_edge_to_target"])
+        assert "elements are smaller" not in size_line(b, "domain.resolution_m")

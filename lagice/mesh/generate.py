@@ -176,9 +176,10 @@ def generate_mesh(polygon: Polygon, size, *, segments: dict | None = None,
             loops.append(geo.addCurveLoop(lines))
         geo.addPlaneSurface(loops)
         geo.synchronize()
-        # a constant size also comes from the points and the boundary's pieces (docs/remeshing.md §7.1)
-        set_size_options(gmsh, algorithm, 1e22 if callable(size_v) else float(size_v),
-                         from_boundary=not callable(size_v))
+        # the size comes from ``size`` alone, never from the boundary's pieces: gmsh would
+        # otherwise spread the pieces it cuts a coast into (shorter than the size where the
+        # coast's vertices are closer) over the whole domain (docs/remeshing.md §7.1)
+        set_size_options(gmsh, algorithm, 1e22 if callable(size_v) else float(size_v), from_boundary=False)
         if callable(size_v):
             def cb(dim, tag, x, y, z, lc):
                 return float(np.asarray(size_v(np.array([x]), np.array([y]))).ravel()[0])

@@ -71,6 +71,7 @@ def size_line(report: dict, target_text: str) -> str:
             f"median (5-95 %: {r['edge_p05_m'] / 1e3:.3g}-{r['edge_p95_m'] / 1e3:.3g} km), "
             f"{r['median_edge_to_target']:.2f} x {target_text}")
     if abs(r["median_edge_to_target"] - 1.0) > 0.10:
-        line += ("; gmsh also takes the size from the pieces it cuts the boundary into, and a moved or remeshed "
-                 "mesh drifts from it (docs/remeshing.md, section 7.1); remeshed patches are made at the target")
+        line += ("; elements are smaller along a boundary whose vertices are closer than the target, and a moved "
+                 "or remeshed mesh drifts from it (docs/remeshing.md, section 7.1); remeshed patches are made at the "
+                 "target")
     return line
