@@ -128,11 +128,15 @@ WIND_FACTOR_BAND = THORNDIKE_COLONY_WINTER["factor"]
 #: the Maxwell-EB runs are F10-hthick-newc / F10s-hthick-newc, EVP E10h-newc / E10hs-newc, the ±50 %
 #: runs X10h-*-newc. A run whose folder is gone is carried from the previous report, labelled
 #: (carry_sensitivity, carry_ensembles).
-PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-newc", "strait_maxwell_eb": "F10s-hthick-newc",
-                "closed_evp": "E{evp}h-newc", "strait_evp": "E{evp}hs-newc", "sensitivity_base": "F10-hthick-newc",
-                "sensitivity_strength-50": "X10h-str-50-newc", "sensitivity_strength+50": "X10h-str+50-newc",
-                "sensitivity_drag-50": "X10h-drag-50-newc", "sensitivity_drag+50": "X10h-drag+50-newc",
-                "sensitivity_wind-50": "X10h-wind-50-newc", "sensitivity_wind+50": "X10h-wind+50-newc"}
+#: Since 2026-11-29 the basin is meshed at domain.resolution_m (20 726 elements, not the 28 048 that
+#: gmsh made from the coast's pieces), and the shipped spin-up state is the one made so
+#: (spinup-H1125-m10.npz): the runs are F10-hthick-m10 / F10s-hthick-m10, E10h-m10 / E10hs-m10 and
+#: X10h-*-m10; the runs of the 8 km mesh keep their records (docs/figures/physics_experiments.json).
+PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-m10", "strait_maxwell_eb": "F10s-hthick-m10",
+                "closed_evp": "E{evp}h-m10", "strait_evp": "E{evp}hs-m10", "sensitivity_base": "F10-hthick-m10",
+                "sensitivity_strength-50": "X10h-str-50-m10", "sensitivity_strength+50": "X10h-str+50-m10",
+                "sensitivity_drag-50": "X10h-drag-50-m10", "sensitivity_drag+50": "X10h-drag+50-m10",
+                "sensitivity_wind-50": "X10h-wind-50-m10", "sensitivity_wind+50": "X10h-wind+50-m10"}
 #: the weather ensemble of the flagship Maxwell-EB runs (--from-physics): the validation run
 #: (wind seed 2026, the scene's) and the same set-up under the winds of seeds 2027-2033 for
 #: the shipped pack (eight months since 2026-11-26), 2027-2029 for the pack shipped before
@@ -140,8 +144,12 @@ PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-newc", "strait_maxwell_eb": "F1
 #: weather: whether a metric is inside its band is read from how many members are inside.
 #: The pack shipped before 2026-11-25 (F10-1125...) is the comparison.
 PHYSICS_ENSEMBLE = {
-    "closed": ["F10-hthick-newc"] + [f"F10-hthick-newc-w{y}" for y in range(2027, 2034)],
-    "strait": ["F10s-hthick-newc"] + [f"F10s-hthick-newc-w{y}" for y in range(2027, 2034)],
+    "closed": ["F10-hthick-m10"] + [f"F10-hthick-m10-w{y}" for y in range(2027, 2034)],
+    "strait": ["F10s-hthick-m10"] + [f"F10s-hthick-m10-w{y}" for y in range(2027, 2034)],
+    "closed, the 8 km mesh gmsh made from the coast's pieces (before 2026-11-29)":
+        ["F10-hthick-newc"] + [f"F10-hthick-newc-w{y}" for y in range(2027, 2034)],
+    "strait, the 8 km mesh gmsh made from the coast's pieces (before 2026-11-29)":
+        ["F10s-hthick-newc"] + [f"F10s-hthick-newc-w{y}" for y in range(2027, 2034)],
     "closed, strength recomputed at every remesh (before 2026-11-28)":
         ["F10-hthick-1125"] + [f"F10-hthick-1125-w{y}" for y in range(2027, 2034)],
     "strait, strength recomputed at every remesh (before 2026-11-28)":
