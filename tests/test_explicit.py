@@ -600,7 +600,7 @@ def _run_compression_pair(tmp):
     out = {}
     for solver in ("implicit", "explicit"):
         sim = scene_sim("uniaxial_compression", tmp / solver, compression_overrides(
-            10, **{"solver.name": solver, "healing.law": "none", "run.duration": 2600 * 20.0}))
+            10, **{"solver.name": solver, "healing.law": "none", "run.duration": 3000 * 20.0}))
         sim.run()
         out[solver] = (-series(sim, "macro_stress"), sim.model)
     return out
@@ -793,7 +793,8 @@ def test_sheared_broken_ice_opens_with_dilatancy():
     viscous within seconds), bottom held, top driven along x with its v free, the sides
     free. The flow rule of ``dilatancy_angle_deg`` makes the divergence sin ψ times the
     viscous shear rate e1 − e2; the held bottom keeps the plate from widening, so a small
-    pressure builds and the interior opens at 0.6-1 times that (0.28 at ψ = 20°, in
+    pressure builds and the interior opens at 0.6-1 times that (0.29 at ψ = 20°, the median of
+    the elements' ratios; 0.32, the interior's total divergence over its total shear; in
     proportion to sin ψ: ψ = 10° gives half), and at about 0 without dilatancy; the top rises."""
     poly, segs = rectangle_domain(20e3, 20e3)
     mesh = generate_mesh(poly, 2e3, segments=segs, exterior_tag="free")
@@ -817,16 +818,20 @@ def test_sheared_broken_ice_opens_with_dilatancy():
         div = e[inner, 0] + e[inner, 1]
         shear = np.sqrt((e[inner, 0] - e[inner, 1]) ** 2 + 4 * e[inner, 2] ** 2)
         top = mesh.nodes_with_tag("top")
-        return np.median(div / shear), float(st.velocity[top, 1].mean()), float(np.median(shear))
+        # the median of the element ratios, and the interior's total divergence over its total shear
+        return (np.median(div / shear), div.sum() / shear.sum(), float(st.velocity[top, 1].mean()),
+                float(np.median(shear)))
 
     s20, s10 = np.sin(np.radians(20.0)), np.sin(np.radians(10.0))
-    ratio, v_top, shear = run(20.0)
+    ratio, total, v_top, shear = run(20.0)
     assert shear > 0.3 * u_top / 20e3  # the interior shears
-    assert 0.6 * s20 < ratio < s20
+    assert 0.6 * s20 < ratio < s20 and 0.6 * s20 < total < s20
     assert v_top > 0.0
-    ratio10, _, _ = run(10.0)
-    assert ratio10 / ratio == pytest.approx(s10 / s20, rel=0.05)
-    ratio0, v_top0, _ = run(None)
+    _, total10, _, _ = run(10.0)
+    # on gmsh's meshes of this square at 1.8-2.2 km the totals' ratio is 0.48-0.54 (sin 10°/sin 20°
+    # = 0.508; the medians' 0.45-0.56): the discretisation's part, not the flow rule's
+    assert total10 / total == pytest.approx(s10 / s20, rel=0.10)
+    ratio0, _, v_top0, _ = run(None)
     assert abs(ratio0) < 0.01 and v_top > 100 * abs(v_top0)
     # the parallel kernels (prange over elements, no races) give the serial ones' state bit for bit
     states = [sheared(20.0, n_steps=5, parallel=par)[1] for par in (False, True)]

@@ -70,7 +70,8 @@ def test_weights_do_not_depend_on_when_the_candidates_were_found(plate):
     area0 = _area(plate)
     moved = plate.nodes.copy()
     rng = np.random.default_rng(3)
-    moved += rng.uniform(-1, 1, moved.shape) * 60.0 + 0.01 * moved[:, ::-1]   # a shear and noise, < R/8
+    # a shear and noise: every centroid moves by at most 0.005·√2·20 km + 60·√2 m = 226 m < R/8 = 312 m
+    moved += rng.uniform(-1, 1, moved.shape) * 60.0 + 0.005 * moved[:, ::-1]
     old = NonlocalWeights(R)
     old.update(plate.triangles, plate.nodes, area0)
     field = rng.uniform(0, 2, plate.n_elements)

@@ -548,8 +548,14 @@ def test_spinup_state_that_does_not_cover_the_domain_is_refused_before_meshing(s
     out = tmp_path / "run"
     r = run_cli("run", "winter_basin_pack", "--out", out,
                 sets=["run.duration=1h", "domain.resolution_m=80e3", f'initial.state_file="{state}"'])
+    from lagice.spinup import footprint_tolerance_m
+
+    # five times the state's centroid spacing (about 4.7 km on the 9.3 km mesh it was made on)
+    tol_m = footprint_tolerance_m(str(state))
+    assert 15e3 < tol_m < 35e3
+    tol_text = f"tolerance {tol_m / 1e3:.1f} km"
     line = one_line_error(r, "initial.state_file", str(state), "outside the spin-up state's footprint",
-                          "tolerance 20.", "km from the nearest state centroid")
+                          tol_text, "km from the nearest state centroid")
     far = float(line.split(" km from the nearest")[0].rsplit(" ", 1)[1])
     assert far > 100.0 and (shift_km < 1000 or far > 3000.0), line
     assert not out.exists(), "refused before the output folder and the mesh"
