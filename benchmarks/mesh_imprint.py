@@ -300,9 +300,20 @@ def git_commit() -> str:
 
 
 # -- cyclone over a disk ----------------------------------------------------------------
+def made_by(run: Path) -> str:
+    """The commit whose code made ``run`` (written next to it by this script since 2026-11-29;
+    "unknown" for older runs)."""
+    f = run.parent / f"{run.name}.commit"
+    return f.read_text().strip() if f.exists() else "unknown"
+
+
 def run_cyclone(out: Path, variant: str, rot: float, extra_sets=()):
     run = out / f"cyclone_{variant}_r{rot:g}"
     if run_finished(run):
+        by, head = made_by(run), git_commit()
+        if by != head:   # a finished run is reused, never silently: say which code made it
+            print(f"mesh_imprint: reusing {run.name}, made by commit {by[:10]} (HEAD {head[:10]}); delete the "
+                  f"folder to make it again with this code", flush=True)
         return run
     sets = [*variant_sets(variant), f"domain.rotate_deg={rot:g}", "run.progress=false", *extra_sets]
     cmd = [sys.executable, "-m", "lagice.cli", "run", str(ROOT / "examples" / "imprint_cyclone_disk.toml"),
@@ -313,6 +324,7 @@ def run_cyclone(out: Path, variant: str, rot: float, extra_sets=()):
     print(f"mesh_imprint: run {run.name}", flush=True)
     with open(out / f"{run.name}.log", "w") as log:
         subprocess.run(cmd, check=True, stdout=log, stderr=subprocess.STDOUT, cwd=ROOT)
+    (out / f"{run.name}.commit").write_text(git_commit() + "\n")
     print(f"mesh_imprint: {run.name} done in {time.perf_counter() - t0:.0f} s", flush=True)
     return run
 
@@ -603,8 +615,12 @@ def main(argv=None):
             res = analyse_cyclone(out, v)
             allres.setdefault("cyclone", {})[v] = _strip(res)
             prov = allres.setdefault("provenance", {})
-            if made or f"cyclone/{v}" not in prov:   # the commit whose code made the runs
-                prov[f"cyclone/{v}"] = {"git_commit": git_commit(), "date": time.strftime("%Y-%m-%d")}
+            if made or f"cyclone/{v}" not in prov:   # the commit(s) whose code made the runs
+                by = sorted({made_by(out / f"cyclone_{v}_r{rot:g}") for rot in ROTATIONS})
+                if len(by) > 1:
+                    print(f"mesh_imprint: WARNING: the rotations of {v} were made by different code ({', '.join(by)}): "
+                          f"the rotation test compares meshes and code at once", flush=True)
+                prov[f"cyclone/{v}"] = {"git_commit": by[0] if len(by) == 1 else by, "date": time.strftime("%Y-%m-%d")}
             for field, per in res.items():
                 for rot, s in per.items():
                     sh = s.get("shift_vs_r0", {})
