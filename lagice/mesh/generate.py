@@ -111,16 +111,17 @@ def check_mesh_algorithm(algorithm, key: str = "algorithm") -> int:
     return algorithm
 
 
-def set_size_options(gmsh, algorithm: int, size_max_m: float, from_boundary: bool) -> None:
+def set_size_options(gmsh, algorithm: int, size_max_m: float) -> None:
     """gmsh's 2-D algorithm and every size option (they persist across models, so all are set
-    each time): no minimum, ``size_max_m`` as the maximum, sizes from the points and extended
-    from the boundary's pieces only if ``from_boundary``, none from curvature."""
+    each time): no minimum, ``size_max_m`` as the maximum (a constant size, or 1e22 under a size
+    callback), and no size from the points, the boundary's pieces or the curvature: the size
+    is the target alone (docs/remeshing.md §7.1)."""
     opt = gmsh.option
     opt.setNumber("Mesh.Algorithm", algorithm)
     opt.setNumber("Mesh.MeshSizeMin", 0.0)
     opt.setNumber("Mesh.MeshSizeMax", size_max_m)
-    opt.setNumber("Mesh.MeshSizeFromPoints", int(from_boundary))
-    opt.setNumber("Mesh.MeshSizeExtendFromBoundary", int(from_boundary))
+    opt.setNumber("Mesh.MeshSizeFromPoints", 0)
+    opt.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
     opt.setNumber("Mesh.MeshSizeFromCurvature", 0)
 
 
@@ -166,12 +167,11 @@ def generate_mesh(polygon: Polygon, size, *, segments: dict | None = None,
                               f"{off[k]:.3g} m from it (tolerance {tol:.3g} m); give the boundary's own "
                               f"vertices, with the same coordinates")
 
-    lc0 = size_v if not callable(size_v) else 1.0
     with gmsh_session() as gmsh:
         geo = gmsh.model.geo
         loops = []
         for ring in _rings(polygon):
-            pts = [geo.addPoint(float(x), float(y), 0.0, lc0) for x, y in ring]
+            pts = [geo.addPoint(float(x), float(y), 0.0) for x, y in ring]   # sizes: set_size_options
             lines = [geo.addLine(pts[i], pts[(i + 1) % len(pts)]) for i in range(len(pts))]
             loops.append(geo.addCurveLoop(lines))
         geo.addPlaneSurface(loops)
@@ -179,7 +179,7 @@ def generate_mesh(polygon: Polygon, size, *, segments: dict | None = None,
         # the size comes from ``size`` alone, never from the boundary's pieces: gmsh would
         # otherwise spread the pieces it cuts a coast into (shorter than the size where the
         # coast's vertices are closer) over the whole domain (docs/remeshing.md §7.1)
-        set_size_options(gmsh, algorithm, 1e22 if callable(size_v) else float(size_v), from_boundary=False)
+        set_size_options(gmsh, algorithm, 1e22 if callable(size_v) else float(size_v))
         if callable(size_v):
             def cb(dim, tag, x, y, z, lc):
                 return float(np.asarray(size_v(np.array([x]), np.array([y]))).ravel()[0])

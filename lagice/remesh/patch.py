@@ -144,7 +144,7 @@ def element_area_per_size2(algorithm: int) -> float:
             geo.synchronize()
             for ln in lines:
                 gmsh.model.mesh.setTransfiniteCurve(ln, n + 1)
-            set_size_options(gmsh, algorithm, 1.0, from_boundary=False)
+            set_size_options(gmsh, algorithm, 1.0)
             gmsh.model.mesh.generate(2)
             etypes, _, enodes = gmsh.model.mesh.getElements(2)
         n_tri = len(enodes[list(etypes).index(2)]) // 3
@@ -207,7 +207,7 @@ def mesh_patch(mesh: Mesh, bnd: PatchBoundary, size_field, algorithm: int = 6, s
         geo.synchronize()
         for ln in lines_all:
             gmsh.model.mesh.setTransfiniteCurve(ln, 2)
-        set_size_options(gmsh, algorithm, float(size_field) if const else 1e22, from_boundary=False)
+        set_size_options(gmsh, algorithm, float(size_field) if const else 1e22)
         if not const:
             def cb(dim, tag, x, y, z, lc_):
                 return float(evaluate_size(size_field, np.array([x]), np.array([y]))[0])
