@@ -179,7 +179,7 @@ def restart_unstarted(out, config: dict) -> Path:
 
 def prepare(out, config: dict | None = None) -> list[Path]:
     """Create ``out``, prove it writable (by writing the marker ``lagice_run.json``:
-    scene, lagice version, command, parent checkpoint of a branch, ensemble member; or, when it
+    scene, lagice version and git commit, command, parent checkpoint of a branch, ensemble member; or, when it
     exists, a probe file), and remove stale temporary files of killed writes.
     Raises OutputError naming the folder."""
     out = Path(out)
@@ -191,11 +191,14 @@ def prepare(out, config: dict | None = None) -> list[Path]:
     marker = out / MARKER
     if not marker.exists():  # a resumed run keeps the marker of its start
         from . import __version__
+        from .io.cf import git_commit
 
         cfg = config or {}
         info = {"scene": cfg.get("scene", {}).get("name"), "source": cfg.get("scene", {}).get("source"),
                 "lagice_version": __version__, "written": datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
                 "command": " ".join(sys.argv) if sys.argv and sys.argv[0] else None}
+        if git_commit():   # the code that made the run, when lagice runs from a git checkout
+            info["git_commit"] = git_commit()
         if cfg.get("scene"):
             info["fingerprint"] = settings_fingerprint(cfg)
         if cfg.get("_parent"):

@@ -336,6 +336,21 @@ def test_run_lock_in_one_process(tmp_path):
     assert (notes / LOCK).read_text() == "another tool's lock"
 
 
+def test_run_folder_marker_names_the_code_that_made_the_run(tmp_path):
+    """The marker of a run folder records the commit of the code (what a benchmark reads before
+    it reuses a finished run instead of making it again)."""
+    from lagice.io.cf import git_commit
+    from lagice.rundir import MARKER, prepare
+
+    prepare(tmp_path / "run")
+    info = json.loads((tmp_path / "run" / MARKER).read_text())
+    assert info.get("git_commit") == git_commit()
+    if (Path(__file__).resolve().parents[1] / ".git").exists():   # a checkout: the commit is known
+        assert info["git_commit"].split("-")[0] == subprocess.run(
+            ["git", "rev-parse", "HEAD"], cwd=Path(__file__).resolve().parents[1], capture_output=True,
+            text=True).stdout.strip()
+
+
 def test_a_run_waits_out_the_probe_of_plot_beside_it(tmp_path):
     """``lagice plot`` / ``diagnose`` probe a run folder's lock with a shared flock
     (``running_holder``) that they release at once. A run that starts in that moment is not
