@@ -2264,6 +2264,8 @@ def analyse(name: str, run: Path, days: float, buffer_m: float = 100e3) -> dict:
             "window_rates_per_day": rates,
             "mean_total_deformation_rate_per_day_window_mean": float(np.mean(rates)) if rates else float("nan"),
             "remesh_events": r["remesh_events"],
+            # the commit that made the run (validate.analyse_run warns when its model code changed since)
+            "made_by": r["made_by"], "model_code_changed": r["model_code_changed"],
             "remesh_count": summ.get("remesh_count", r["remesh_events"]), "wall_s": r["wall_s"],
             "outflow_m3": r["outflow_m3"], "mean_speed_m_s": float(np.mean(r["mean_speed_m_s"][1:])),
             "drift": drift(run, days),

@@ -213,7 +213,7 @@ def analyse_run(run: Path, days: float, buffer_m: float, window_days: float = 3.
             "rgps_view": {"tracking_error_m": ws["rgps_tracking_error_m"], "cell_m": RGPS_CELL_M,
                           "median": ws["median_rgps"], "median_cells": ws["median_rgps_cells"]},
             "resolution_m": run_resolution_m(run), "run_command": cfg.get("command"), "run_dir": str(run),
-            "drift_km": drift_km(run, days), "drift_response": drift_response(run)}
+            "drift_km": drift_km(run, days), "drift_response": drift_response(run), **reuse_notice(run)}
 
 
 def drift_response(run: Path) -> dict | None:
@@ -277,6 +277,68 @@ def git_commit() -> dict:
 
     changed = git("status", "--porcelain", "--untracked-files=no", "--", ".", ":(exclude)docs")
     return {"commit": git("rev-parse", "HEAD"), "dirty": bool(changed)}
+
+
+#: the folders whose code decides a run's result (the model); a reused run made by another commit
+#: is the same run as one made now only if none of them changed in between
+MODEL_CODE = ("lagice", "forcing", "thermo")
+
+
+def run_made_by(run: Path) -> str | None:
+    """The commit of the code that made ``run``: the run folder's marker (``lagice_run.json``,
+    ``git_commit``, since 2026-11-29), else the ``lagice_git_commit`` attribute of its first
+    snapshot (every snapshot carries it); None where neither is known. A commit ending in
+    ``-dirty`` was made from a modified work tree (the marker names the files since 2026-11-29)."""
+    import xarray as xr
+
+    c = _marker(run).get("git_commit")
+    if c:
+        return c
+    idx = run / "snapshots" / "index.json"
+    if not idx.exists():
+        return None
+    first = json.loads(idx.read_text())[0]["file"]
+    with xr.open_dataset(run / "snapshots" / first, decode_times=False) as ds:
+        return ds.attrs.get("lagice_git_commit")
+
+
+def _marker(run: Path) -> dict:
+    m = run / "lagice_run.json"
+    return json.loads(m.read_text()) if m.exists() else {}
+
+
+def model_code_changes(commit: str | None, modified=None) -> list | None:
+    """The files of the model's code (:data:`MODEL_CODE`) that differ between the code that made a
+    run and the work tree now (committed or not): [] where none does. For a run made from a
+    modified work tree (``commit`` ending in ``-dirty``) the files it had modified are counted as
+    changed, when ``modified`` names them; None where it cannot be told (an unknown commit, or a
+    modified work tree whose files were not recorded, as before 2026-11-29)."""
+    if not commit:
+        return None
+    base, dirty = commit.removesuffix("-dirty"), commit.endswith("-dirty")
+    if dirty and modified is None:
+        return None
+    p = subprocess.run(["git", "diff", "--name-only", base, "--", *MODEL_CODE], cwd=ROOT, capture_output=True,
+                       text=True, check=False)
+    if p.returncode != 0:
+        return None
+    own = [f for f in (modified or ()) if f.split("/")[0] in MODEL_CODE]
+    return sorted(set(p.stdout.split()) | set(own))
+
+
+def reuse_notice(run: Path) -> dict:
+    """Who made a finished run that is about to be read, and which model files changed since
+    (printed when any did, or when it cannot be told): ``{"made_by": ..., "model_code_changed":
+    [files] or None}``. Whether those changes matter is for the reader: the files are named."""
+    by = run_made_by(run)
+    changed = model_code_changes(by, _marker(run).get("git_modified_files"))
+    if changed != []:
+        why = (f"the model code differs in {', '.join(changed)}" if changed else
+               "made from a modified work tree whose files were not recorded" if str(by).endswith("-dirty") else
+               "the code that made it is not known")
+        print(f"validate: NOTE: reading {run.name}, made by commit {str(by)[:10]}: {why}; delete the folder to make "
+              f"it again with this code", flush=True)
+    return {"made_by": by, "model_code_changed": changed}
 
 
 def basin_imprint(run: Path, days: float, buffer_m: float) -> dict:
@@ -781,6 +843,51 @@ def headline(res: dict) -> list[str]:
     return lines
 
 
+def runs_provenance(res) -> dict:
+    """Every analysed run in ``res`` (a dict with ``run_dir`` and ``made_by``, at any depth):
+    ``{commit: [run names]}``, and the runs whose model code changed since they were made or
+    cannot be told (``"changed"``, ``"unknown"``)."""
+    out = {"by_commit": {}, "changed": [], "unknown": []}
+
+    def walk(o):
+        if isinstance(o, dict):
+            if "run_dir" in o and "made_by" in o:
+                name = Path(o["run_dir"]).name
+                out["by_commit"].setdefault(str(o["made_by"]), []).append(name)
+                if o.get("model_code_changed") is None:
+                    out["unknown"].append(name)
+                elif o["model_code_changed"]:
+                    out["changed"].append(name)
+                    out.setdefault("files", set()).update(o["model_code_changed"])
+            for v in o.values():
+                walk(v)
+        elif isinstance(o, list):
+            for v in o:
+                walk(v)
+
+    walk(res)
+    for k in out["by_commit"]:
+        out["by_commit"][k] = sorted(set(out["by_commit"][k]))
+    out["changed"], out["unknown"] = sorted(set(out["changed"])), sorted(set(out["unknown"]))
+    out["files"] = sorted(out.get("files", ()))
+    return out
+
+
+def provenance_line(prov: dict) -> str:
+    """The report's sentence on which code made the runs it reads."""
+    if not prov["by_commit"]:
+        return ""
+    made = "; ".join(f"`{c[:10]}` ({len(v)} run{'s' if len(v) > 1 else ''})" for c, v in prov["by_commit"].items())
+    if prov["changed"] or prov["unknown"]:
+        return (f"Runs made by the code of {made}. The model code (lagice/, forcing/, thermo/) of this commit differs "
+                f"from that of {len(prov['changed'])} of the runs, in {', '.join(f'`{f}`' for f in prov['files'])}, "
+                f"and is not known for {len(prov['unknown'])}: their figures describe the code that made them "
+                f"(written by `benchmarks/validate.py` from `git diff`; whether the change matters is said in the "
+                f"summary).")
+    return (f"Runs made by the code of {made}; the model code (lagice/, forcing/, thermo/) is the same in this "
+            f"commit, so every run read here is the run this code makes (checked by `git diff` at writing).")
+
+
 def write_report(res: dict, md: Path, figs: dict):
     cmd = "python benchmarks/validate.py" + (" --quick" if res["quick"] else "") + (
         f" --analyse-only --from-physics --evp-km {res['evp_km']:g}" if res.get("from_physics") else " --sensitivity")
@@ -788,6 +895,8 @@ def write_report(res: dict, md: Path, figs: dict):
              f"Written by `{cmd}` on {res['date']} from the code of commit `{res['git_commit']['commit'][:10]}`"
              f"{' (work tree modified)' if res['git_commit']['dirty'] else ''}. Method: `docs/diagnostics.md`, "
              f"physics: `docs/physics.md`; all numbers in `{res['json']}`.", "",
+             *([provenance_line(res["runs_provenance"]), ""] if res.get("runs_provenance", {}).get("by_commit")
+               else []),
              "## Headline (for README)", "", "Flagship scene `winter_basin_pack` (one parameter set, docs/physics.md "
              "§4), 28 days; ✓ inside the observed band, ✗ outside:", ""]
     lines += headline(res) + [""]
@@ -1228,6 +1337,9 @@ def main(argv=None):
            "targets": {k: list(v) for k, v in TARGETS.items()},
            "json": str((args.fig_dir.resolve() / "validation.json").relative_to(ROOT))
            if args.fig_dir.resolve().is_relative_to(ROOT) else str(args.fig_dir / "validation.json")}
+    res["runs_provenance"] = runs_provenance({k: res[k] for k in ("basin", "sensitivity", "weather_ensemble")})
+    for name in res["runs_provenance"]["changed"] + res["runs_provenance"]["unknown"]:
+        print(f"validate: WARNING: {name}: made by other model code than this commit's (or unknown)", flush=True)
     if args.discussion.exists():
         text = args.discussion.read_text()
         head, _, tail = text.partition("<!-- misses -->")

@@ -191,7 +191,7 @@ def prepare(out, config: dict | None = None) -> list[Path]:
     marker = out / MARKER
     if not marker.exists():  # a resumed run keeps the marker of its start
         from . import __version__
-        from .io.cf import git_commit
+        from .io.cf import git_commit, git_modified_files
 
         cfg = config or {}
         info = {"scene": cfg.get("scene", {}).get("name"), "source": cfg.get("scene", {}).get("source"),
@@ -199,6 +199,8 @@ def prepare(out, config: dict | None = None) -> list[Path]:
                 "command": " ".join(sys.argv) if sys.argv and sys.argv[0] else None}
         if git_commit():   # the code that made the run, when lagice runs from a git checkout
             info["git_commit"] = git_commit()
+            if git_modified_files():   # "-dirty": which tracked files differed from that commit
+                info["git_modified_files"] = git_modified_files()
         if cfg.get("scene"):
             info["fingerprint"] = settings_fingerprint(cfg)
         if cfg.get("_parent"):

@@ -339,12 +339,15 @@ def test_run_lock_in_one_process(tmp_path):
 def test_run_folder_marker_names_the_code_that_made_the_run(tmp_path):
     """The marker of a run folder records the commit of the code (what a benchmark reads before
     it reuses a finished run instead of making it again)."""
-    from lagice.io.cf import git_commit
+    from lagice.io.cf import git_commit, git_modified_files
     from lagice.rundir import MARKER, prepare
 
     prepare(tmp_path / "run")
     info = json.loads((tmp_path / "run" / MARKER).read_text())
     assert info.get("git_commit") == git_commit()
+    # a modified work tree: "-dirty", and the marker names the modified files
+    assert bool(info.get("git_modified_files")) == str(info.get("git_commit")).endswith("-dirty")
+    assert info.get("git_modified_files", []) == git_modified_files()
     if (Path(__file__).resolve().parents[1] / ".git").exists():   # a checkout: the commit is known
         assert info["git_commit"].split("-")[0] == subprocess.run(
             ["git", "rev-parse", "HEAD"], cwd=Path(__file__).resolve().parents[1], capture_output=True,

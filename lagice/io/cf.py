@@ -26,10 +26,19 @@ def crs_variable(crs):
 
 
 _COMMIT = None
+_MODIFIED: list = []
+
+
+def git_modified_files() -> list:
+    """The tracked files of the lagice source tree that differ from its commit (what makes
+    :func:`git_commit` end in ``-dirty``), as paths relative to the tree; [] if none or unknown."""
+    git_commit()
+    return list(_MODIFIED)
 
 
 def git_commit() -> str | None:
-    """The commit of the lagice source tree, when it is a git checkout (else None)."""
+    """The commit of the lagice source tree, when it is a git checkout (else None); ``-dirty``
+    appended when tracked files differ from it (:func:`git_modified_files` names them)."""
     global _COMMIT
     if _COMMIT is None:
         root = Path(__file__).resolve().parents[2]
@@ -42,6 +51,7 @@ def git_commit() -> str | None:
                                        capture_output=True, text=True, timeout=5)
                 if dirty.returncode == 0 and dirty.stdout.strip():
                     _COMMIT += "-dirty"
+                    _MODIFIED[:] = [line[3:] for line in dirty.stdout.splitlines() if len(line) > 3]
         except (OSError, subprocess.SubprocessError):
             _COMMIT = ""
     return _COMMIT or None
