@@ -988,7 +988,8 @@ def analyse_ensemble(physics: Path, days: float, buffer_m: float, basin: dict) -
             a = own if own is not None and Path(own["run_dir"]).resolve() == r.resolve() else analyse_run(r, days,
                                                                                                          buffer_m)
             members[n] = {"median": a["median"], "remesh_events": a["remesh_events"], "drift_km": a["drift_km"],
-                          "rgps_median": a["rgps_view"]["median"], "drift_response": a.get("drift_response")}
+                          "rgps_median": a["rgps_view"]["median"], "drift_response": a.get("drift_response"),
+                          **{k: a.get(k) for k in ("run_dir", "made_by", "model_code_changed")}}
         out[scene] = {"members": members, "metrics": _member_stats(members, "median"),
                       "rgps_metrics": _member_stats(members, "rgps_median")}
     return out
@@ -1372,6 +1373,16 @@ def rotation_test_summary(mi: dict) -> dict:
             idx = " / ".join(f"{s.get('index', float('nan')):.2f}" for s in per.values())
             parts.append(f"{variant} {field}: index {idx} at rotations {', '.join(per)}°")
         out["variants"][variant] = v
+    floor = mi.get("rotation_floor") or {}
+    if floor:   # the same test against the noise of four disorder realisations (mesh_imprint.py floor)
+        out["noise_floor"] = {}
+        for variant, fields in floor.items():
+            out["noise_floor"][variant] = {
+                f: {k: r.get(k) for k in ("verdict", "test_stat_median", "null_stat_median", "null_stat_p90",
+                                          "same_mesh_other_disorder_corr", "turns")}
+                for f, r in fields.items() if isinstance(r, dict) and "verdict" in r}
+            parts.append(f"{variant} against the noise of {len(fields.get('seeds', []))} disorder draws: "
+                         + ", ".join(f"{f} {r['verdict']}" for f, r in out["noise_floor"][variant].items()))
     out["summary"] = "; ".join(parts)
     return out
 

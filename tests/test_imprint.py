@@ -133,6 +133,14 @@ def test_rotation_shift():
     assert orientation_shift_deg(a, w, (a + 20) % 180, w)["shift_deg"] == pytest.approx(20.0, abs=2.5)
     b = np.concatenate([rng.normal(40, 4, 500), rng.normal(130, 4, 300)]) % 180
     assert orientation_shift_deg(a, w, b, w)["shift_deg"] == pytest.approx(0.0, abs=2.5)
+    # turned by 15°: the correlation at exactly 15° is the best, near 1, and above that at 0
+    r = orientation_shift_deg(a, w, (b + 15) % 180, w, rotation_deg=15.0)
+    assert r["corr_at_exact_rotation"] == pytest.approx(r["corr_at_shift"]) and r["corr_at_exact_rotation"] > 0.9
+    assert r["corr_at_zero"] < r["corr_at_exact_rotation"] - 0.3
+    # not turned: at 15° lower than at 0, while the best of 15°, 75° and 135° can only be higher
+    r = orientation_shift_deg(a, w, b, w, rotation_deg=15.0)
+    assert r["corr_at_exact_rotation"] < r["corr_at_zero"] - 0.3
+    assert r["corr_at_rotation"] >= r["corr_at_exact_rotation"]
 
 
 def test_index_definition():

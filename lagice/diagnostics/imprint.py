@@ -241,7 +241,10 @@ def orientation_shift_deg(angles_ref, weights_ref, angles_rot, weights_rot, bin_
     correlation at δ and at 0. δ ≈ 0: directions independent of the mesh; δ ≈ the
     lattice rotation: directions follow the mesh. With ``rotation_deg`` also the
     correlation at the lattice rotation (best of rotation + k × ``lattice_period_deg``):
-    ``corr_at_rotation`` > ``corr_at_zero`` means the directions follow the mesh."""
+    ``corr_at_rotation`` > ``corr_at_zero`` means the directions follow the mesh. The best of
+    the rotation's lattice-period candidates is biased upwards against the single value at 0;
+    ``corr_at_exact_rotation`` (the rotation itself, one value) is not, for a mesh that is the
+    same mesh turned (gmsh meshes the unrotated domain, :func:`lagice.scenes.builder.build_mesh`)."""
     _, h0 = orientation_histogram(angles_ref, weights_ref, bin_deg)
     _, h1 = orientation_histogram(angles_rot, weights_rot, bin_deg)
     nb = h0.size
@@ -265,6 +268,7 @@ def orientation_shift_deg(angles_ref, weights_ref, angles_rot, weights_rot, bin_
     if rotation_deg is not None:
         cands = [(rotation_deg + k * lattice_period_deg) % 180.0 for k in range(int(round(180 / lattice_period_deg)))]
         out["corr_at_rotation"] = float(max(corr[int(round(c / bin_deg)) % nb] for c in cands))
+        out["corr_at_exact_rotation"] = float(corr[int(round((rotation_deg % 180.0) / bin_deg)) % nb])
     return out
 
 
