@@ -704,3 +704,40 @@ def test_benchmark_runs_without_outputs_take_any_step_and_runs_with_outputs_keep
     assert sim.model.clock.iteration == 1
     with pytest.raises(ConfigError, match=r"output\.every = '6h'.*whole number"):
         scene_simulation("wind_square", ov, outputs=True)
+
+
+def test_a_run_made_again_from_its_folder_record_is_the_same_bit_for_bit(tmp_path):
+    """benchmarks/rerun_check.py makes a finished run again from the command its folder's marker
+    records and compares every snapshot: a real `lagice run` is reproduced bit for bit (and
+    validate.py reads who made it), while one changed value in a copy is found."""
+    import json
+    import shutil
+    import subprocess
+
+    import xarray as xr
+    from rerun_check import RECORD, check, compare_runs
+    from validate import reuse_notice
+
+    from lagice.io.cf import git_commit
+
+    run = tmp_path / "run"
+    cmd = [sys.executable, "-m", "lagice.cli", "run", "shear_box", "--out", str(run)]
+    for s in ("run.duration=800.0", "solver.dt=40.0", "output.every=400.0", "domain.resolution_m=50e3",
+              "run.progress=false", "output.plot=false"):
+        cmd += ["--set", s]
+    subprocess.run(cmd, check=True, capture_output=True, cwd=tmp_path)
+    res = check(run)
+    assert res["max_abs_difference"] == 0 and res["snapshots"] == 3 and res["differ"] == []
+    assert json.loads((run / RECORD).read_text())["reproduced_by"] == git_commit()
+    assert reuse_notice(run)["made_by"] == git_commit()
+    # a copy with one stress value changed by 1 Pa in the last snapshot: found, and named
+    copy = tmp_path / "copy"
+    shutil.copytree(run, copy)
+    last = copy / "snapshots" / json.loads((copy / "snapshots" / "index.json").read_text())[-1]["file"]
+    with xr.open_dataset(last, decode_times=False) as ds:
+        ds = ds.load()
+    name = next(v for v in ds.data_vars if "stress" in v and np.issubdtype(ds[v].dtype, np.floating))
+    ds[name].values.flat[0] += 1.0
+    ds.to_netcdf(last)
+    diff = compare_runs(run, copy)
+    assert diff["differ"] == [name] and diff["max_abs_difference"] == pytest.approx(1.0, rel=1e-6)
