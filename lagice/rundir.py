@@ -28,6 +28,7 @@ import hashlib
 import json
 import logging
 import os
+import shlex
 import shutil
 import socket
 import sys
@@ -196,7 +197,7 @@ def prepare(out, config: dict | None = None) -> list[Path]:
         cfg = config or {}
         info = {"scene": cfg.get("scene", {}).get("name"), "source": cfg.get("scene", {}).get("source"),
                 "lagice_version": __version__, "written": datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
-                "command": " ".join(sys.argv) if sys.argv and sys.argv[0] else None}
+                "command": shlex.join(sys.argv) if sys.argv and sys.argv[0] else None}   # shell-quoted
         if git_commit():   # the code that made the run, when lagice runs from a git checkout
             info["git_commit"] = git_commit()
             if git_modified_files():   # "-dirty": which tracked files differed from that commit
@@ -402,7 +403,7 @@ class RunLock:
             raise RunFolderLocked(f"cannot lock the run folder {folder}: its lock file {self.path} keeps changing")
         info = {"pid": os.getpid(), "host": socket.gethostname(),
                 "started": datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
-                "command": " ".join(sys.argv) if sys.argv and sys.argv[0] else None}
+                "command": shlex.join(sys.argv) if sys.argv and sys.argv[0] else None}   # shell-quoted
         try:
             os.ftruncate(fd, 0)
             os.pwrite(fd, (json.dumps(info) + "\n").encode(), 0)

@@ -336,14 +336,20 @@ def test_run_lock_in_one_process(tmp_path):
     assert (notes / LOCK).read_text() == "another tool's lock"
 
 
-def test_run_folder_marker_names_the_code_that_made_the_run(tmp_path):
+def test_run_folder_marker_names_the_code_that_made_the_run(tmp_path, monkeypatch):
     """The marker of a run folder records the commit of the code (what a benchmark reads before
-    it reuses a finished run instead of making it again)."""
+    it reuses a finished run instead of making it again), and the command shell-quoted, so that
+    it can be run again word for word (benchmarks/rerun_check.py)."""
+    import shlex
+
     from lagice.io.cf import git_commit, git_modified_files
     from lagice.rundir import MARKER, prepare
 
+    argv = ["lagice", "run", "shear_box", "--set", 'output.timeseries.every="1 steps"', "--out", "a b"]
+    monkeypatch.setattr(sys, "argv", argv)
     prepare(tmp_path / "run")
     info = json.loads((tmp_path / "run" / MARKER).read_text())
+    assert shlex.split(info["command"]) == argv
     assert info.get("git_commit") == git_commit()
     # a modified work tree: "-dirty", and the marker names the modified files
     assert bool(info.get("git_modified_files")) == str(info.get("git_commit")).endswith("-dirty")
