@@ -886,7 +886,8 @@ def provenance_line(prov: dict) -> str:
     """The report's sentence on which code made the runs it reads."""
     if not prov["by_commit"]:
         return ""
-    made = "; ".join(f"`{c[:10]}` ({len(v)} run{'s' if len(v) > 1 else ''})" for c, v in prov["by_commit"].items())
+    made = "; ".join(f"`{c[:10]}`{' (a modified work tree)' if c.endswith('-dirty') else ''} ({len(v)} "
+                     f"run{'s' if len(v) > 1 else ''})" for c, v in prov["by_commit"].items())
     if prov["changed"] or prov["unknown"]:
         return (f"Runs made by the code of {made}. The model code (lagice/, forcing/, thermo/) of this commit differs "
                 f"from that of {len(prov['changed'])} of the runs, in {', '.join(f'`{f}`' for f in prov['files'])}, "
