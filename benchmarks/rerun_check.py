@@ -78,8 +78,6 @@ def compare_runs(a: Path, b: Path) -> dict:
 
 
 def check(run: Path) -> dict:
-    from lagice.io.cf import git_commit, git_modified_files
-
     run = run.resolve()
     with tempfile.TemporaryDirectory(prefix=f"rerun-{run.name}-") as tmp:
         out = Path(tmp) / run.name
@@ -91,7 +89,10 @@ def check(run: Path) -> dict:
         if p.returncode != 0:
             raise SystemExit(f"rerun_check: {run.name} failed:\n{p.stderr[-2000:]}")
         res = compare_runs(run, out)
-    res.update({"run": run.name, "reproduced_by": git_commit(), "modified_files": git_modified_files(),
+        # the code that made the run again: its own marker (the checkout may have moved on since it began)
+        made = json.loads((out / "lagice_run.json").read_text())
+    res.update({"run": run.name, "reproduced_by": made.get("git_commit"),
+                "modified_files": made.get("git_modified_files", []),
                 "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
                 "numba_threads": env["NUMBA_NUM_THREADS"], "wall_s": time.perf_counter() - t0})
     (run / RECORD).write_text(json.dumps(res, indent=1) + "\n")
