@@ -2240,6 +2240,12 @@ for _key, _lo, _hi, _what in SENSITIVITY_CHANGES:
 add_month_own_spinup("P-vcrj1-m10", PMAX + CR_KAPPA1,
                      "neXtSIM's compressive term, Crouzeix-Raviart velocities (jump penalty 1), own spin-up, "
                      "meshed at domain.resolution_m")
+# Result (2026-11-29, 15:47 UTC): the claim is kept; the prediction fails on the |divergence| tail. Closed /
+# strait: beta 0.187 / 0.22 (8 km mesh 0.182 / 0.197), shear tail 2.63 / 2.45 (2.88 / 2.66), |divergence|
+# tail 2.48 / 3.2 (2.92 / 2.62: moved by 0.44 and 0.58, past the stated 0.4), half-shear area 5.8 % / 5.8 %
+# (5.6 / 4.9), R2 0.66 / 0.626 (0.635 / 0.608), rate 0.00786 / 0.00848 per day (x1.11 / x1.28), wind factor
+# 0.0053 / 0.0058 (0.0050 / 0.0057), 834 / 866 remeshes, 3 / 2 bands (2 / 3). beta in its band in the closed
+# basin and 0.22 (above it) in the strait. 5085 / 4836 s on one thread, two runs and other work on 2 cores.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
