@@ -344,9 +344,10 @@ def reuse_notice(run: Path) -> dict:
         why = (f"the model code differs in {', '.join(changed)}" if changed else
                "made from a modified work tree whose files were not recorded" if str(by).endswith("-dirty") else
                "the code that made it is not known")
-        print(f"validate: NOTE: reading {run.name}, made by commit {str(by)[:10]}: {why}; delete the folder to make "
-              f"it again with this code", flush=True)
-    # made_by: the code that made the run, or that made it again bit for bit (made_first then the original)
+        print(f"validate: NOTE: reading {run.name}, made by commit {str(by)[:10]}: {why}; benchmarks/rerun_check.py "
+              f"makes it again and compares, or delete the folder to replace it", flush=True)
+    # made_by: the code that made the run, or the code that made it again bit for bit; then made_first_by
+    # names the original maker
     return {"made_by": by, "model_code_changed": changed, **({"made_first_by": made} if made != by else {})}
 
 
