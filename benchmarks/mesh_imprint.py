@@ -307,10 +307,14 @@ def git_commit() -> str:
 
 # -- cyclone over a disk ----------------------------------------------------------------
 def made_by(run: Path) -> str:
-    """The commit whose code made ``run`` (written next to it by this script since 2026-11-29;
-    "unknown" for older runs)."""
+    """The commit whose code made ``run``: what the run recorded itself (``validate.run_made_by``:
+    its folder's marker, else its snapshots), else the ``RUN.commit`` file this script wrote next
+    to runs on 2026-11-29 before runs recorded it; "unknown" otherwise."""
+    from validate import run_made_by
+
+    by = run_made_by(run)
     f = run.parent / f"{run.name}.commit"
-    return f.read_text().strip() if f.exists() else "unknown"
+    return by or (f.read_text().strip() if f.exists() else "unknown")
 
 
 def cyclone_run_name(variant: str, rot: float, seed=None) -> str:
@@ -322,10 +326,9 @@ def cyclone_run_name(variant: str, rot: float, seed=None) -> str:
 def run_cyclone(out: Path, variant: str, rot: float, extra_sets=(), seed=None):
     run = out / cyclone_run_name(variant, rot, seed)
     if run_finished(run):
-        by, head = made_by(run), git_commit()
-        if by != head:   # a finished run is reused, never silently: say which code made it
-            print(f"mesh_imprint: reusing {run.name}, made by commit {by[:10]} (HEAD {head[:10]}); delete the "
-                  f"folder to make it again with this code", flush=True)
+        from validate import reuse_notice
+
+        reuse_notice(run)   # a finished run is reused, never silently: said when its model code differs
         return run
     sets = [*variant_sets(variant), f"domain.rotate_deg={rot:g}", "run.progress=false", *extra_sets,
             *([] if seed is None else [f"run.seed={seed}"])]
@@ -337,7 +340,6 @@ def run_cyclone(out: Path, variant: str, rot: float, extra_sets=(), seed=None):
     print(f"mesh_imprint: run {run.name}", flush=True)
     with open(out / f"{run.name}.log", "w") as log:
         subprocess.run(cmd, check=True, stdout=log, stderr=subprocess.STDOUT, cwd=ROOT)
-    (out / f"{run.name}.commit").write_text(git_commit() + "\n")
     print(f"mesh_imprint: {run.name} done in {time.perf_counter() - t0:.0f} s", flush=True)
     return run
 

@@ -197,7 +197,7 @@ def analyse_run(run: Path, days: float, buffer_m: float, window_days: float = 3.
     for part in ("median", "min", "max", "median_all_elements", "median_rgps", "median_rgps_cells"):
         v = ws[part].pop("mean_total_s")
         ws[part]["mean_total_deformation_rate_per_day"] = None if v is None else v * DAY
-    cfg = json.loads((run / "lagice_run.json").read_text()) if (run / "lagice_run.json").exists() else {}
+    cfg = _marker(run)
     for s in ws["skipped"]:
         print(f"validate: {run.name}: {s['reason']}", flush=True)
     idx = read_index(run)
