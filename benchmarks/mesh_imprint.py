@@ -8,6 +8,10 @@ Runs through the scene builder and Simulation (``lagice run`` subprocesses):
   polygon has a vertex every degree, so only the lattice turns). Fracture field:
   damage ≥ 0.5 at day 3, and the top decile of the shear rate at day 3
   (docs/physics.md §3).
+* ``floor``: the same at 0°, 15°, 30° and 60° with several disorder draws each (the rotation
+  test against its noise; rule above ``FLOOR_ROTATIONS``).
+* ``turn``: ensembles of 12 draws at 0°, 15° and 30° with disjoint seeds, judged at exactly the
+  turn with a bootstrap interval (rule above ``TURN_SEEDS``); figure ``mesh_imprint_turn.png``.
 * ``compression``: the uniaxial compression test of Dansereau et al. (2016) §4
   (``examples/uniaxial_compression.toml``, N elements across) as
   ``benchmarks/validate.py`` runs it, with a mesh option; fault angles (active faults
@@ -28,6 +32,7 @@ combine with ``+``, e.g. ``delaunay+meanstress``.
 
     python benchmarks/mesh_imprint.py cyclone --variants base jitter delaunay
     python benchmarks/mesh_imprint.py compression --n-across 40 80 --variants base jitter delaunay
+    python benchmarks/mesh_imprint.py turn --variants base delaunay --jobs 2 --out benchmarks/out/mesh_imprint_floor
     python benchmarks/mesh_imprint.py report          # figure + JSON from the runs in --out
     python benchmarks/mesh_imprint.py cyclone --variants delaunay delaunay+nl16 --figure mesh_imprint_cyclone_nonlocal
     python benchmarks/mesh_imprint.py zoom --variants delaunay delaunay+nl16 --figure nonlocal_damage_zoom
@@ -474,6 +479,101 @@ def analyse_floor(out: Path, variant: str, seeds) -> dict:
     return res
 
 
+
+# -- the rotation test at exactly the turn, on ensembles ----------------------------------
+#: The rotation test on ensembles (thirty-seventh session). Stated 2026-11-29 16:08 UTC, before the
+#: runs (``mesh_imprint.py turn --variants base delaunay --jobs 2 --out
+#: benchmarks/out/mesh_imprint_floor``):
+#:
+#: * Why a new rule: the thirty-sixth session's statistic took the best of three lattice-period
+#:   candidates against one value at no shift (biased upwards on a mesh with no lattice), and its
+#:   test pairs included a seed against itself, whose strength disorder (drawn per element from the
+#:   node ids, ``lagice.strength.element_uniforms``) turns with the mesh. Here the ensembles at 0,
+#:   15 and 30 deg use disjoint disorder seeds (:data:`TURN_SEEDS`, 12 runs each; the 0 deg set
+#:   reuses the floor's seeds 12-15), so only the mesh turns between them.
+#: * The statistic: :func:`lagice.diagnostics.imprint.ensemble_turn_test` on the runs' direction
+#:   histograms (2.5 deg bins, 5 deg smoothing; damage >= 0.5 and the shear rate's top decile at
+#:   day 3, as before): D = corr(exactly the turn) - corr(no shift) of the ensemble means, with a 90 %
+#:   interval from resampling each ensemble's runs (2000 resamples, generator 0).
+#: * Verdict per variant and field: "follows the mesh" if the interval lies above 0 at both turns
+#:   (15 and 30 deg); "does not follow the mesh" if it lies below 0 at both; otherwise "undecided"
+#:   (then the interval's upper end bounds how far the directions can turn with the mesh).
+#: * Predicted: base (frontal) follows for damage and for the shear rate (the power check: last
+#:   session its damage turned at exactly the turn, +0.12/+0.13 against -0.16/-0.19); Delaunay
+#:   does not follow for either field, D below 0 at both turns.
+TURN_SEEDS = {0.0: tuple(range(12, 24)), 15.0: tuple(range(24, 36)), 30.0: tuple(range(36, 48))}
+
+
+def analyse_turn(out: Path, variant: str) -> dict:
+    """The ensemble rotation test of the rule above :data:`TURN_SEEDS` on the runs of ``variant``:
+    per field and turn, :func:`lagice.diagnostics.imprint.ensemble_turn_test`, the verdict, and the
+    ensembles' mean histograms (for the figure)."""
+    from lagice.diagnostics.imprint import ensemble_turn_test, imprint_summary, orientation_histogram
+
+    res = {}
+    for field in ("damage", "shear"):
+        hists, local, damaged = {}, [], []
+        for rot, seeds in TURN_SEEDS.items():
+            hh = []
+            for sd in seeds:
+                nodes, tri, d, sh = load_last(out / cyclone_run_name(variant, rot, sd))
+                s = imprint_summary(nodes, tri, d if field == "damage" else sh,
+                                    **({"threshold": 0.5} if field == "damage" else {"quantile": 0.9}))
+                centres, h = orientation_histogram(s["_angles"], s["_weights"], 2.5)
+                hh.append(h)
+                local.append(s["local_index"])
+                damaged.append(float(np.mean(d > 0.5)))
+            hists[rot] = np.array(hh)
+        turns = {f"{th:g}": ensemble_turn_test(hists[0.0], hists[th], th) for th in (15.0, 30.0)}
+        above = all(t["d_low"] > 0 for t in turns.values())
+        below = all(t["d_high"] < 0 for t in turns.values())
+        res[field] = {"turns": turns,
+                      "verdict": "follows the mesh" if above else ("does not follow the mesh" if below
+                                                                   else "undecided"),
+                      "local_index_range": [float(min(local)), float(max(local))],
+                      "damaged_fraction_range": [float(min(damaged)), float(max(damaged))],
+                      "mean_histogram_deg": centres.tolist(),
+                      "mean_histogram": {f"{r:g}": h.mean(axis=0).tolist() for r, h in hists.items()}}
+    return res
+
+
+def figure_turn(res: dict, path: Path):
+    """The ensembles' mean direction histograms at 0, 15 and 30 deg, one panel per variant and field,
+    the turned ones drawn also turned back by the mesh's turn (where they would lie if the
+    directions followed the mesh, they fall on the 0 deg curve)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    variants = list(res)
+    fig, ax = plt.subplots(len(variants), 2, figsize=(12, 3.8 * len(variants)), squeeze=False)
+    colours = {"0": "k", "15": "tab:blue", "30": "tab:red"}
+    for i, v in enumerate(variants):
+        for j, field in enumerate(("damage", "shear")):
+            r = res[v][field]
+            c = np.array(r["mean_histogram_deg"])
+            a = ax[i, j]
+            for rot, h in r["mean_histogram"].items():
+                h = np.array(h) / (c[1] - c[0])
+                a.plot(c, h, color=colours[rot], lw=1.8,
+                       label=f"mesh at {rot} deg ({len(TURN_SEEDS[float(rot)])} runs)")
+                if rot != "0":
+                    back = np.roll(h, -int(round(float(rot) / (c[1] - c[0]))))
+                    t = r["turns"][rot]
+                    a.plot(c, back, color=colours[rot], lw=1.0, ls="--",
+                           label=f"{rot} deg turned back; D = {t['d']:+.2f} [{t['d_low']:+.2f}, {t['d_high']:+.2f}]")
+            a.set_title(f"{v}: {'damage >= 0.5' if field == 'damage' else 'shear rate, top decile'} "
+                        f"- {r['verdict']}", fontsize=10)
+            a.set_xlabel("fracture direction [deg]")
+            a.set_ylabel("density [1/deg]")
+            a.set_xlim(0, 180)
+            a.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 # -- uniaxial compression ---------------------------------------------------------------
 def run_key(variant: str, seed: int) -> str:
     """A compression run's name in the records: the variant, with ``_sSEED`` for a seed other than 0."""
@@ -699,14 +799,14 @@ def figure_cyclone(out: Path, variants, path: Path):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("what", choices=("cyclone", "floor", "compression", "report", "final-faults", "zoom"))
+    ap.add_argument("what", choices=("cyclone", "floor", "turn", "compression", "report", "final-faults", "zoom"))
     ap.add_argument("--variants", nargs="+", default=["base"])
     ap.add_argument("--n-across", type=int, nargs="+", default=[40])
     ap.add_argument("--max-strain", type=float, default=1e-3)
     ap.add_argument("--seed", type=int, nargs="+", default=[0],
                     help="compression, final-faults: run.seed (the cohesion disorder), one run per seed; "
                          "results keyed VARIANT_sSEED when not 0; floor: the disorder seeds (at least 2)")
-    ap.add_argument("--jobs", type=int, default=1, help="floor: runs at a time (each one lagice subprocess)")
+    ap.add_argument("--jobs", type=int, default=1, help="floor, turn: runs at a time (each one lagice subprocess)")
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "out" / "mesh_imprint")
     ap.add_argument("--fig-dir", type=Path, default=ROOT / "docs" / "figures")
     ap.add_argument("--figure", default=None, metavar="NAME",
@@ -774,6 +874,28 @@ def main(argv=None):
                                   f"{th} deg {t['corr_at_exact_rotation_median']:+.2f}" for th, t in r["turns"].items())
                 print(f"      same mesh, other disorder: corr {sm['median']:+.2f} [{sm['min']:+.2f}, "
                       f"{sm['max']:+.2f}]; {turns}", flush=True)
+    elif args.what == "turn":   # the rotation test on ensembles (the rule above TURN_SEEDS)
+        from concurrent.futures import ThreadPoolExecutor
+
+        todo = [(v, rot, sd) for v in args.variants for rot, seeds in TURN_SEEDS.items() for sd in seeds]
+        with ThreadPoolExecutor(max_workers=args.jobs) as pool:
+            list(pool.map(lambda t: run_cyclone(out, t[0], t[1], seed=t[2]), todo))
+        res = {}
+        for v in args.variants:
+            by = sorted({made_by(out / cyclone_run_name(v, rot, sd)) for rot, seeds in TURN_SEEDS.items()
+                         for sd in seeds})
+            res[v] = analyse_turn(out, v)
+            allres.setdefault("rotation_turn", {})[v] = _strip(res[v]) | {
+                "seeds": {f"{r:g}": list(sds) for r, sds in TURN_SEEDS.items()},
+                "git_commit": by[0] if len(by) == 1 else by, "date": time.strftime("%Y-%m-%d")}
+            for field, r in res[v].items():
+                tt = "; ".join(f"turned {th} deg: corr at no shift {t['corr_at_zero']:+.2f}, at the turn "
+                               f"{t['corr_at_exact_rotation']:+.2f}, D {t['d']:+.2f} [{t['d_low']:+.2f}, "
+                               f"{t['d_high']:+.2f}]" for th, t in r["turns"].items())
+                print(f"  turn {v:10s} {field:7s}: {r['verdict']}; {tt}; split-half corr of the 0 deg ensemble "
+                      f"{r['turns']['15']['split_half_corr_ref']:+.2f}; local index "
+                      f"{r['local_index_range'][0]:.2f}-{r['local_index_range'][1]:.2f}", flush=True)
+        figure_turn(res, args.fig_dir / f"{args.figure or 'mesh_imprint_turn'}.png")
     elif args.what == "compression":
         for n in args.n_across:
             results = {}

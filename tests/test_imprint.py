@@ -5,14 +5,18 @@ import pytest
 
 from lagice.diagnostics.imprint import (
     edge_orientations,
+    ensemble_turn_test,
     fracture_orientations,
+    histogram_correlation,
     imprint_index,
     imprint_summary,
     local_alignment,
     mesh_directions,
     mesh_edges,
+    orientation_histogram,
     orientation_shift_deg,
 )
+from lagice.errors import ConfigError
 from lagice.mesh import generate_mesh, rectangle_domain
 
 H = 5e3
@@ -141,6 +145,42 @@ def test_rotation_shift():
     r = orientation_shift_deg(a, w, b, w, rotation_deg=15.0)
     assert r["corr_at_exact_rotation"] < r["corr_at_zero"] - 0.3
     assert r["corr_at_rotation"] >= r["corr_at_exact_rotation"]
+
+
+def _runs(rng, centres, n_runs, turn=0.0, spread=25.0, n=60):
+    """Per-run normalised histograms (2.5° bins) of realisations whose directions are drawn around
+    ``centres`` + ``turn`` with one realisation's scatter: each run has few, noisy segments."""
+    out = []
+    for _ in range(n_runs):
+        a = np.concatenate([rng.normal(c + turn, spread, n) for c in centres]) % 180
+        out.append(orientation_histogram(a, np.ones_like(a), 2.5)[1])
+    return np.array(out)
+
+
+def test_histogram_correlation_is_circular():
+    """A histogram correlates 1 with itself turned by the bins it was turned by."""
+    h = orientation_histogram(np.array([30.0, 31.0, 100.0]), None, 2.5)[1]
+    c = histogram_correlation(h, np.roll(h, 6))
+    assert c[6] == pytest.approx(1.0) and np.argmax(c) == 6
+
+
+def test_ensemble_turn_test():
+    """Realisations whose own histograms barely agree (few segments each) still decide the test
+    as ensembles: directions turned with the mesh give an interval above 0, directions that stay
+    with the scene one below 0, directions with no preference one that holds 0."""
+    rng = np.random.default_rng(11)
+    ref = _runs(rng, [40.0, 130.0], 12)
+    one = histogram_correlation(ref[0], ref[1])[0]
+    assert one < 0.9   # one realisation against another: not the same histogram
+    turned = ensemble_turn_test(ref, _runs(rng, [40.0, 130.0], 12, turn=15.0), 15.0, n_boot=400)
+    assert turned["d_low"] > 0 and turned["corr_at_exact_rotation"] > turned["corr_at_zero"]
+    stayed = ensemble_turn_test(ref, _runs(rng, [40.0, 130.0], 12), 15.0, n_boot=400)
+    assert stayed["d_high"] < 0 and stayed["split_half_corr_ref"] > 0.5
+    flat = ensemble_turn_test(_runs(rng, [0.0], 12, spread=1e4),
+                              _runs(rng, [0.0], 12, spread=1e4), 15.0, n_boot=400)
+    assert flat["d_low"] < 0 < flat["d_high"]
+    with pytest.raises(ConfigError, match="at least 2 runs"):
+        ensemble_turn_test(ref[:1], ref, 15.0)
 
 
 def test_index_definition():

@@ -28,7 +28,8 @@ along those rows instead of the directions the stress selects. This module measu
 4. :func:`orientation_shift_deg`: the rotation test. For the same physical scene on
    meshes whose lattice is rotated by α, the shift δ that best maps the fracture
    direction histogram of the unrotated mesh onto the rotated one is ≈ 0 when physics
-   sets the directions and ≈ α when the mesh does.
+   sets the directions and ≈ α when the mesh does. :func:`ensemble_turn_test` asks the
+   same of the mean histograms of many realisations, with a bootstrap interval.
 
 Physically preferred directions can coincide with mesh directions (e.g. Coulomb faults
 at 27.5° from a y-axis load lie at 62.5° and 117.5° from x, near a lattice's 60° and
@@ -234,6 +235,66 @@ def imprint_index(angles_deg, weights, mesh_dirs_deg, half_width_deg=7.5) -> dic
     return {"index": (f - f0) / (1.0 - f0), "fraction": f, "chance": f0, "n_segments": int(a.size)}
 
 
+def histogram_correlation(h_ref, h_rot, bin_deg=2.5, smooth_deg=5.0) -> np.ndarray:
+    """Circular cross-correlation of two 180°-periodic direction histograms (same bins of
+    ``bin_deg``), each smoothed by a Gaussian of ``smooth_deg`` and standardised: element j is
+    the correlation when ``h_ref`` is turned by j × ``bin_deg`` (1 for identical shapes, 0 for
+    unrelated ones; a flat histogram correlates 0 with anything)."""
+    h0 = np.asarray(h_ref, np.float64)
+    h1 = np.asarray(h_rot, np.float64)
+    if h0.shape != h1.shape or h0.ndim != 1:
+        raise ConfigError(f"histogram_correlation: histograms of shapes {h0.shape} and {h1.shape}; expected two "
+                          "1-D histograms on the same bins")
+    nb = h0.size
+    k = np.arange(nb)
+    d = np.minimum(k, nb - k) * bin_deg
+    g = np.exp(-0.5 * (d / smooth_deg) ** 2)
+    fg = np.fft.fft(g / g.sum())
+
+    def standard(h):  # circular convolution with the Gaussian, then zero mean and unit variance
+        s = np.real(np.fft.ifft(np.fft.fft(h) * fg))
+        return (s - s.mean()) / (s.std() or 1.0)
+
+    s0, s1 = standard(h0), standard(h1)
+    return np.array([np.mean(np.roll(s0, j) * s1) for j in range(nb)])
+
+
+def ensemble_turn_test(hists_ref, hists_rot, rotation_deg, bin_deg=2.5, smooth_deg=5.0, n_boot=2000, seed=0,
+                       level=0.90) -> dict:
+    """The rotation test on ensembles (thirty-seventh session): ``hists_ref`` are the normalised
+    direction histograms (:func:`orientation_histogram`, bins of ``bin_deg``) of runs on one mesh,
+    ``hists_rot`` those of *other* realisations on the same mesh turned by ``rotation_deg``.
+    Averaging over runs removes most of what one realisation adds. The statistic is
+    D = corr(exactly the turn) − corr(no shift) of the ensemble means (:func:`histogram_correlation`):
+    D > 0 when the directions turned with the mesh, D < 0 when they stayed with the scene, D ≈ 0 when
+    the ensembles cannot tell (no common direction, or equal pulls). Its ``level`` interval comes from
+    resampling the runs of each ensemble with replacement (``n_boot`` times, generator ``seed``).
+    Also the split-half correlation at no shift of the reference ensemble (its first against its
+    second half of runs): how reproducible the ensemble's direction histogram is at all."""
+    h0 = np.asarray(hists_ref, np.float64)
+    h1 = np.asarray(hists_rot, np.float64)
+    if h0.ndim != 2 or h1.ndim != 2 or h0.shape[1] != h1.shape[1] or min(h0.shape[0], h1.shape[0]) < 2:
+        raise ConfigError(f"ensemble_turn_test: histogram arrays of shapes {h0.shape} and {h1.shape}; expected "
+                          "(runs, bins) with at least 2 runs each and the same bins")
+    nb = h0.shape[1]
+    j_turn = int(round((float(rotation_deg) % 180.0) / bin_deg)) % nb
+
+    def stat(a, b):
+        c = histogram_correlation(a.mean(axis=0), b.mean(axis=0), bin_deg, smooth_deg)
+        return c[j_turn] - c[0], c[0], c[j_turn]
+
+    d, c0, ct = stat(h0, h1)
+    rng = np.random.default_rng(seed)
+    boot = np.array([stat(h0[rng.integers(0, h0.shape[0], h0.shape[0])],
+                          h1[rng.integers(0, h1.shape[0], h1.shape[0])])[0] for _ in range(int(n_boot))])
+    lo, hi = np.percentile(boot, [50.0 * (1.0 - level), 50.0 * (1.0 + level)])
+    half = h0.shape[0] // 2
+    split = histogram_correlation(h0[:half].mean(axis=0), h0[half:].mean(axis=0), bin_deg, smooth_deg)[0]
+    return {"rotation_deg": float(rotation_deg), "d": float(d), "corr_at_zero": float(c0),
+            "corr_at_exact_rotation": float(ct), "d_low": float(lo), "d_high": float(hi), "level": float(level),
+            "n_ref": int(h0.shape[0]), "n_rot": int(h1.shape[0]), "split_half_corr_ref": float(split)}
+
+
 def orientation_shift_deg(angles_ref, weights_ref, angles_rot, weights_rot, bin_deg=2.5, smooth_deg=5.0,
                           rotation_deg=None, lattice_period_deg=60.0):
     """Shift δ ∈ (−90°, 90°] that best maps the reference direction histogram onto the
@@ -248,18 +309,7 @@ def orientation_shift_deg(angles_ref, weights_ref, angles_rot, weights_rot, bin_
     _, h0 = orientation_histogram(angles_ref, weights_ref, bin_deg)
     _, h1 = orientation_histogram(angles_rot, weights_rot, bin_deg)
     nb = h0.size
-    k = np.arange(nb)
-    d = np.minimum(k, nb - k) * bin_deg
-    g = np.exp(-0.5 * (d / smooth_deg) ** 2)
-    fg = np.fft.fft(g / g.sum())
-
-    def smooth(h):  # circular convolution with the Gaussian
-        return np.real(np.fft.ifft(np.fft.fft(h) * fg))
-
-    s0, s1 = smooth(h0), smooth(h1)
-    s0 = (s0 - s0.mean()) / (s0.std() or 1.0)
-    s1 = (s1 - s1.mean()) / (s1.std() or 1.0)
-    corr = np.array([np.mean(np.roll(s0, j) * s1) for j in range(nb)])
+    corr = histogram_correlation(h0, h1, bin_deg, smooth_deg)
     j = int(np.argmax(corr))
     shift = j * bin_deg
     if shift > 90.0:
