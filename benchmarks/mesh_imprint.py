@@ -183,6 +183,9 @@ VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.me
             # It separates the two causes the thirty-fifth session named for the worse imprint on
             # the 8 km disk (wider bands, weaker elements). Rule: above FLOOR_ROTATIONS.
             "str52": ["rheology.strength_lab_pa=3.46e6"],
+            # the disk meshed at 5.24 km, the median edge of the thirty-fifth session's 5.2 km disk
+            # (thirty-seventh session; rule above TURN_SEEDS)
+            "h52": ["domain.resolution_m=5.24e3"],
             "nl16": ["rheology.damage_nonlocal_radius_m=16e3"],
             "nl10": ["rheology.damage_nonlocal_radius_m=10e3"],
             # The same R at two resolutions (twenty-fourth session), the test that the fault does
@@ -481,7 +484,7 @@ def analyse_floor(out: Path, variant: str, seeds) -> dict:
 
 
 # -- the rotation test at exactly the turn, on ensembles ----------------------------------
-#: The rotation test on ensembles (thirty-seventh session). Stated 2026-11-29 16:08 UTC, before the
+#: The rotation test on ensembles (thirty-seventh session). Stated 2026-11-29 16:07 UTC, before the
 #: runs (``mesh_imprint.py turn --variants base delaunay --jobs 2 --out
 #: benchmarks/out/mesh_imprint_floor``):
 #:
@@ -501,6 +504,24 @@ def analyse_floor(out: Path, variant: str, seeds) -> dict:
 #: * Predicted: base (frontal) follows for damage and for the shear rate (the power check: last
 #:   session its damage turned at exactly the turn, +0.12/+0.13 against -0.16/-0.19); Delaunay
 #:   does not follow for either field, D below 0 at both turns.
+#:
+#: Result (2026-11-29, 16:23 UTC; 64 new runs of 20-22 s, two at a time, the 0 deg seeds 12-15 the
+#: floor's): base damage follows the mesh (D +0.91 [+0.59, +1.06] at 15 deg, +1.17 [+0.62, +1.40] at
+#: 30 deg), base shear undecided (+0.47 [-0.07, +0.70], +0.38 [-0.16, +0.70]); Delaunay damage
+#: follows the mesh (+0.61 [+0.27, +0.74], +1.01 [+0.48, +1.12]), Delaunay shear undecided (+0.91
+#: [+0.30, +1.12], +0.13 [-0.15, +0.38]). Split-half correlation of the 0 deg ensembles 0.35-0.73.
+#: The prediction failed for base shear (undecided, not follows) and for Delaunay (damage follows;
+#: shear turns at 15 deg and is undecided at 30 deg): on the 8 km disk the damage directions turn
+#: with the mesh on gmsh's Delaunay mesh too.
+#:
+#: The same on the disk meshed at 5.24 km (``turn --variants delaunay+h52``; the scaled strength
+#: then follows the smaller elements). Stated 2026-11-29 16:25 UTC, before the runs:
+#: * the verdicts by the rule above, for both fields;
+#: * "the damage directions turn less with the mesh at the finer size" if D of damage at 5.24 km is
+#:   below D at 8 km at both turns and the 5.24 km verdict for damage is not "follows the mesh".
+#: * Predicted: it holds (Delaunay's local index of damage was 0.24-0.31 on the 5.2 km disk of the
+#:   thirty-fifth session against 0.42-0.52 at 8 km), with damage "undecided" and the shear rate
+#:   "undecided" at 5.24 km.
 TURN_SEEDS = {0.0: tuple(range(12, 24)), 15.0: tuple(range(24, 36)), 30.0: tuple(range(36, 48))}
 
 
