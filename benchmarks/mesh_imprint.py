@@ -505,7 +505,7 @@ def analyse_floor(out: Path, variant: str, seeds) -> dict:
 #:   session its damage turned at exactly the turn, +0.12/+0.13 against -0.16/-0.19); Delaunay
 #:   does not follow for either field, D below 0 at both turns.
 #:
-#: Result (2026-11-29, 16:23 UTC; 64 new runs of 20-22 s, two at a time, the 0 deg seeds 12-15 the
+#: Result (2026-11-29, 16:20 UTC; 64 new runs of 20-22 s, two at a time, the 0 deg seeds 12-15 the
 #: floor's): base damage follows the mesh (D +0.91 [+0.59, +1.06] at 15 deg, +1.17 [+0.62, +1.40] at
 #: 30 deg), base shear undecided (+0.47 [-0.07, +0.70], +0.38 [-0.16, +0.70]); Delaunay damage
 #: follows the mesh (+0.61 [+0.27, +0.74], +1.01 [+0.48, +1.12]), Delaunay shear undecided (+0.91
@@ -515,7 +515,7 @@ def analyse_floor(out: Path, variant: str, seeds) -> dict:
 #: with the mesh on gmsh's Delaunay mesh too.
 #:
 #: The same on the disk meshed at 5.24 km (``turn --variants delaunay+h52``; the scaled strength
-#: then follows the smaller elements). Stated 2026-11-29 16:25 UTC, before the runs:
+#: then follows the smaller elements). Stated 2026-11-29 16:21 UTC, before the runs:
 #: * the verdicts by the rule above, for both fields;
 #: * "the damage directions turn less with the mesh at the finer size" if D of damage at 5.24 km is
 #:   below D at 8 km at both turns and the 5.24 km verdict for damage is not "follows the mesh".
