@@ -522,6 +522,14 @@ def analyse_floor(out: Path, variant: str, seeds) -> dict:
 #: * Predicted: it holds (Delaunay's local index of damage was 0.24-0.31 on the 5.2 km disk of the
 #:   thirty-fifth session against 0.42-0.52 at 8 km), with damage "undecided" and the shear rate
 #:   "undecided" at 5.24 km.
+#:
+#: Result (2026-11-29, 16:42 UTC; 36 runs of 62-64 s, 26 810 elements, 4.97 km median edges): damage
+#: undecided (D +0.18 [-0.17, +0.44] at 15 deg, -0.03 [-0.32, +0.32] at 30 deg; 8 km: +0.61, +1.01),
+#: the shear rate does not follow the mesh (D -0.11 [-0.17, -0.05], -0.58 [-0.66, -0.50]; correlation
+#: at no shift 0.98 and 0.97, split-half 0.99: a broad peak near 110 deg set by the cyclone). The
+#: claim holds: the damage directions turn less with the mesh at the finer size. The prediction held
+#: for damage and failed for the shear rate in the better direction ("does not follow", not
+#: "undecided"). Local index 0.20-0.37 (damage) and 0.26-0.35 (shear); damaged 0.30-0.34.
 TURN_SEEDS = {0.0: tuple(range(12, 24)), 15.0: tuple(range(24, 36)), 30.0: tuple(range(36, 48))}
 
 

@@ -1394,6 +1394,19 @@ def rotation_test_summary(mi: dict) -> dict:
                 for f, r in fields.items() if isinstance(r, dict) and "verdict" in r}
             parts.append(f"{variant} against the noise of {len(fields.get('seeds', []))} disorder draws: "
                          + ", ".join(f"{f} {r['verdict']}" for f, r in out["noise_floor"][variant].items()))
+    turn = mi.get("rotation_turn") or {}
+    if turn:   # ensembles of 12 disjoint draws per rotation, judged at exactly the turn (mesh_imprint.py turn)
+        out["ensemble_turn"] = {}
+        for variant, fields in turn.items():
+            out["ensemble_turn"][variant] = {
+                f: {"verdict": r.get("verdict"),
+                    "turns": {th: {k: t.get(k) for k in ("d", "d_low", "d_high", "corr_at_zero",
+                                                         "corr_at_exact_rotation")}
+                              for th, t in (r.get("turns") or {}).items()}}
+                for f, r in fields.items() if isinstance(r, dict) and "verdict" in r}
+            verdicts = ", ".join(f"{f} {r['verdict']}" for f, r in out["ensemble_turn"][variant].items())
+            parts.append(f"{variant}, ensembles of {len((fields.get('seeds') or {}).get('0', []))} draws at exactly "
+                         f"the turn: {verdicts}")
     out["summary"] = "; ".join(parts)
     return out
 
