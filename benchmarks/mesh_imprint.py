@@ -532,7 +532,7 @@ def analyse_floor(out: Path, variant: str, seeds) -> dict:
 #: "undecided"). Local index 0.20-0.37 (damage) and 0.26-0.35 (shear); damaged 0.30-0.34.
 #:
 #: The control: the frontal mesh at 5.24 km (``turn --variants base+h52``). Stated 2026-11-29
-#: 16:49 UTC, before the runs: the verdicts by the rule above; "the shear rate's independence at
+#: 16:44 UTC, before the runs: the verdicts by the rule above; "the shear rate's independence at
 #: 5.24 km comes from the size, not from Delaunay" if base+h52's shear verdict is "does not follow
 #: the mesh". Predicted: it holds for the shear rate, and the frontal mesh's damage still follows
 #: its lattice at 5.24 km (one lattice over the whole disk keeps pulling the one-element bands).
