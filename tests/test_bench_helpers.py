@@ -741,3 +741,26 @@ def test_a_run_made_again_from_its_folder_record_is_the_same_bit_for_bit(tmp_pat
     ds.to_netcdf(last)
     diff = compare_runs(run, copy)
     assert diff["differ"] == [name] and diff["max_abs_difference"] == pytest.approx(1.0, rel=1e-6)
+
+
+def test_rotation_summary_carries_the_ensemble_verdicts_and_their_intervals():
+    """validate.py's mesh-imprint summary takes each variant's ensemble rotation test
+    (mesh_imprint.py turn) with its verdict and the interval of D at each turn, and names it in the
+    summary line; a file without the ensembles gives no such key."""
+    from validate import rotation_test_summary
+
+    t15 = {"d": 0.61, "d_low": 0.27, "d_high": 0.74, "corr_at_zero": -0.03, "corr_at_exact_rotation": 0.58,
+           "split_half_corr_ref": 0.55}
+    t30 = {"d": -0.58, "d_low": -0.66, "d_high": -0.50, "corr_at_zero": 0.97, "corr_at_exact_rotation": 0.39}
+    mi = {"rotation_turn": {"delaunay": {"damage": {"verdict": "follows the mesh", "turns": {"15": t15}},
+                                         "shear": {"verdict": "does not follow the mesh", "turns": {"30": t30}},
+                                         "seeds": {"0": list(range(12, 24))}, "git_commit": "abc"}}}
+    out = rotation_test_summary(mi)
+    et = out["ensemble_turn"]["delaunay"]
+    assert set(et) == {"damage", "shear"}
+    assert et["damage"]["verdict"] == "follows the mesh" and et["damage"]["turns"]["15"]["d_low"] == 0.27
+    assert et["shear"]["turns"]["30"] == {k: t30[k] for k in ("d", "d_low", "d_high", "corr_at_zero",
+                                                              "corr_at_exact_rotation")}
+    assert "delaunay, ensembles of 12 draws at exactly the turn: damage follows the mesh, shear does not follow" \
+        in out["summary"]
+    assert "ensemble_turn" not in rotation_test_summary({})
