@@ -536,6 +536,13 @@ def analyse_floor(out: Path, variant: str, seeds) -> dict:
 #: 5.24 km comes from the size, not from Delaunay" if base+h52's shear verdict is "does not follow
 #: the mesh". Predicted: it holds for the shear rate, and the frontal mesh's damage still follows
 #: its lattice at 5.24 km (one lattice over the whole disk keeps pulling the one-element bands).
+#:
+#: Result (2026-11-29, 17:00 UTC; 36 runs of 48-57 s, 23 940 elements, 5.24 km median edges): damage
+#: follows the mesh (D +1.04 [+0.84, +1.12], +1.25 [+0.95, +1.42]) and so does the shear rate (D +0.73
+#: [+0.66, +0.78], +0.53 [+0.44, +0.61]; split-half 0.99): both ensembles' histograms are spikes at the
+#: lattice's three directions. The claim fails: the shear rate's independence at 5.24 km is
+#: Delaunay's at that size, not the size's. The prediction held for damage and failed for the shear
+#: rate. Local index 0.29-0.45 (damage), 0.45-0.56 (shear); damaged 0.28-0.36.
 TURN_SEEDS = {0.0: tuple(range(12, 24)), 15.0: tuple(range(24, 36)), 30.0: tuple(range(36, 48))}
 
 
