@@ -261,7 +261,7 @@ def histogram_correlation(h_ref, h_rot, bin_deg=2.5, smooth_deg=5.0) -> np.ndarr
 
 def ensemble_turn_test(hists_ref, hists_rot, rotation_deg, bin_deg=2.5, smooth_deg=5.0, n_boot=2000, seed=0,
                        level=0.90) -> dict:
-    """The rotation test on ensembles (thirty-seventh session): ``hists_ref`` are the normalised
+    """The rotation test on ensembles: ``hists_ref`` are the normalised
     direction histograms (:func:`orientation_histogram`, bins of ``bin_deg``) of runs on one mesh,
     ``hists_rot`` those of *other* realisations on the same mesh turned by ``rotation_deg``.
     Averaging over runs removes most of what one realisation adds. The statistic is
