@@ -23,6 +23,7 @@ import shlex
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -46,8 +47,18 @@ def rerun_command(run: Path, out: Path) -> list:
     return [a for a in argv if a not in ("--overwrite", "--resume")]
 
 
+#: netCDF4/HDF5 is not safe to call from two threads at once: with ``--jobs 2`` two comparisons that
+#: overlapped ended one of them in "NetCDF: HDF error" (2026-11-29), so they take turns.
+_NETCDF_LOCK = threading.Lock()
+
+
 def compare_runs(a: Path, b: Path) -> dict:
     """Every numeric variable of every snapshot of ``a`` against ``b`` (same index order)."""
+    with _NETCDF_LOCK:
+        return _compare_runs(a, b)
+
+
+def _compare_runs(a: Path, b: Path) -> dict:
     import xarray as xr
 
     ia = json.loads((a / "snapshots" / "index.json").read_text())
