@@ -352,6 +352,15 @@ def run_cyclone(out: Path, variant: str, rot: float, extra_sets=(), seed=None):
     return run
 
 
+def run_cyclones(out: Path, todo, jobs: int):
+    """:func:`run_cyclone` for each (variant, rotation, seed) of ``todo``, ``jobs`` at a time (each one
+    ``lagice run`` subprocess)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        list(pool.map(lambda t: run_cyclone(out, t[0], t[1], seed=t[2]), todo))
+
+
 def load_last(run: Path):
     import xarray as xr
 
@@ -362,21 +371,28 @@ def load_last(run: Path):
         return nodes, tri, ds["damage"].values[0].copy(), ds["shear_rate"].values[0].copy()
 
 
-def analyse_cyclone(out: Path, variant: str):
-    from lagice.diagnostics.imprint import imprint_summary, orientation_shift_deg
+def fracture_summaries(run: Path) -> dict:
+    """The imprint summary (:func:`lagice.diagnostics.imprint.imprint_summary`) of a cyclone run's last
+    snapshot for each fracture field, read once: ``damage`` (elements with d >= 0.5) and ``shear`` (the
+    shear rate's top decile), each with the run's ``damaged_fraction`` (d >= 0.5)."""
+    from lagice.diagnostics.imprint import imprint_summary
 
+    nodes, tri, d, sh = load_last(run)
+    out = {"damage": imprint_summary(nodes, tri, d, threshold=0.5),
+           "shear": imprint_summary(nodes, tri, sh, quantile=0.9)}
+    for s in out.values():
+        s["damaged_fraction"] = float(np.mean(d > 0.5))
+    return out
+
+
+def analyse_cyclone(out: Path, variant: str):
+    from lagice.diagnostics.imprint import orientation_shift_deg
+
+    summaries = {rot: fracture_summaries(out / f"cyclone_{variant}_r{rot:g}") for rot in ROTATIONS
+                 if run_finished(out / f"cyclone_{variant}_r{rot:g}")}
     res = {}
     for field in ("damage", "shear"):
-        per = {}
-        for rot in ROTATIONS:
-            run = out / f"cyclone_{variant}_r{rot:g}"
-            if not run_finished(run):
-                continue
-            nodes, tri, d, sh = load_last(run)
-            s = imprint_summary(nodes, tri, d if field == "damage" else sh,
-                                **({"threshold": 0.5} if field == "damage" else {"quantile": 0.9}))
-            s["damaged_fraction"] = float(np.mean(d > 0.5))
-            per[rot] = s
+        per = {rot: s[field] for rot, s in summaries.items()}
         if 0.0 in per:
             for rot, s in per.items():
                 s["shift_vs_r0"] = orientation_shift_deg(per[0.0]["_angles"], per[0.0]["_weights"], s["_angles"],
@@ -438,18 +454,13 @@ def analyse_floor(out: Path, variant: str, seeds) -> dict:
     :data:`FLOOR_ROTATIONS` for every seed): per field, the test and null statistics, their
     medians and the null's 90th percentile, the verdict, and per run the index, the local index
     and the damaged fraction."""
-    from lagice.diagnostics.imprint import imprint_summary, orientation_shift_deg
+    from lagice.diagnostics.imprint import orientation_shift_deg
 
+    summaries = {(rot, sd): fracture_summaries(out / cyclone_run_name(variant, rot, sd))
+                 for rot in FLOOR_ROTATIONS for sd in seeds}
     res = {}
     for field in ("damage", "shear"):
-        runs = {}
-        for rot in FLOOR_ROTATIONS:
-            for sd in seeds:
-                nodes, tri, d, sh = load_last(out / cyclone_run_name(variant, rot, sd))
-                s = imprint_summary(nodes, tri, d if field == "damage" else sh,
-                                    **({"threshold": 0.5} if field == "damage" else {"quantile": 0.9}))
-                s["damaged_fraction"] = float(np.mean(d > 0.5))
-                runs[(rot, sd)] = s
+        runs = {key: s[field] for key, s in summaries.items()}
         test = [_floor_stat(runs[(0.0, a)], runs[(th, b)], th) for th in (15.0, 30.0) for a in seeds for b in seeds]
         null = [_floor_stat(runs[(0.0, a)], runs[(60.0, b)], th) for th in (15.0, 30.0) for a in seeds for b in seeds]
         # beyond the rule (added after the runs, 2026-11-29): the noise of one realisation on the same
@@ -480,7 +491,6 @@ def analyse_floor(out: Path, variant: str, seeds) -> dict:
             "runs": {f"r{rot:g}_s{sd}": {k: s[k] for k in ("index", "local_index", "damaged_fraction", "n_segments")}
                      for (rot, sd), s in runs.items()}}
     return res
-
 
 
 # -- the rotation test at exactly the turn, on ensembles ----------------------------------
@@ -550,22 +560,20 @@ def analyse_turn(out: Path, variant: str) -> dict:
     """The ensemble rotation test of the rule above :data:`TURN_SEEDS` on the runs of ``variant``:
     per field and turn, :func:`lagice.diagnostics.imprint.ensemble_turn_test`, the verdict, and the
     ensembles' mean histograms (for the figure)."""
-    from lagice.diagnostics.imprint import ensemble_turn_test, imprint_summary, orientation_histogram
+    from lagice.diagnostics.imprint import ensemble_turn_test, orientation_histogram
 
+    summaries = {rot: [fracture_summaries(out / cyclone_run_name(variant, rot, sd)) for sd in seeds]
+                 for rot, seeds in TURN_SEEDS.items()}
     res = {}
     for field in ("damage", "shear"):
-        hists, local, damaged = {}, [], []
-        for rot, seeds in TURN_SEEDS.items():
-            hh = []
-            for sd in seeds:
-                nodes, tri, d, sh = load_last(out / cyclone_run_name(variant, rot, sd))
-                s = imprint_summary(nodes, tri, d if field == "damage" else sh,
-                                    **({"threshold": 0.5} if field == "damage" else {"quantile": 0.9}))
-                centres, h = orientation_histogram(s["_angles"], s["_weights"], 2.5)
-                hh.append(h)
-                local.append(s["local_index"])
-                damaged.append(float(np.mean(d > 0.5)))
-            hists[rot] = np.array(hh)
+        every = [s[field] for ss in summaries.values() for s in ss]
+        local = [s["local_index"] for s in every]
+        damaged = [s["damaged_fraction"] for s in every]
+        hists = {}
+        for rot, ss in summaries.items():
+            hh = [orientation_histogram(s[field]["_angles"], s[field]["_weights"], 2.5) for s in ss]
+            centres = hh[0][0]
+            hists[rot] = np.array([h for _, h in hh])
         turns = {f"{th:g}": ensemble_turn_test(hists[0.0], hists[th], th) for th in (15.0, 30.0)}
         above = all(t["d_low"] > 0 for t in turns.values())
         below = all(t["d_high"] < 0 for t in turns.values())
@@ -886,13 +894,10 @@ def main(argv=None):
                           f"{sh.get('corr_at_rotation', float('nan')):.2f})  damaged {s['damaged_fraction']:.2f}")
         figure_cyclone(out, args.variants, args.fig_dir / f"{args.figure or 'mesh_imprint_cyclone'}.png")
     elif args.what == "floor":   # the rotation test against its noise floor (the rule above FLOOR_ROTATIONS)
-        from concurrent.futures import ThreadPoolExecutor
-
         if len(args.seed) < 2:
             ap.error("floor needs at least two --seed values (the noise floor compares realisations)")
         todo = [(v, rot, sd) for v in args.variants for sd in args.seed for rot in FLOOR_ROTATIONS]
-        with ThreadPoolExecutor(max_workers=args.jobs) as pool:
-            list(pool.map(lambda t: run_cyclone(out, t[0], t[1], seed=t[2]), todo))
+        run_cyclones(out, todo, args.jobs)
         for v in args.variants:
             by = sorted({made_by(out / cyclone_run_name(v, rot, sd)) for rot in FLOOR_ROTATIONS for sd in args.seed})
             if len(by) > 1:
@@ -917,11 +922,8 @@ def main(argv=None):
                 print(f"      same mesh, other disorder: corr {sm['median']:+.2f} [{sm['min']:+.2f}, "
                       f"{sm['max']:+.2f}]; {turns}", flush=True)
     elif args.what == "turn":   # the rotation test on ensembles (the rule above TURN_SEEDS)
-        from concurrent.futures import ThreadPoolExecutor
-
-        todo = [(v, rot, sd) for v in args.variants for rot, seeds in TURN_SEEDS.items() for sd in seeds]
-        with ThreadPoolExecutor(max_workers=args.jobs) as pool:
-            list(pool.map(lambda t: run_cyclone(out, t[0], t[1], seed=t[2]), todo))
+        run_cyclones(out, [(v, rot, sd) for v in args.variants for rot, seeds in TURN_SEEDS.items() for sd in seeds],
+                     args.jobs)
         res = {}
         for v in args.variants:
             by = sorted({made_by(out / cyclone_run_name(v, rot, sd)) for rot, seeds in TURN_SEEDS.items()
