@@ -186,6 +186,8 @@ VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.me
             # the disk meshed at 5.24 km, the median edge of the thirty-fifth session's 5.2 km disk
             # (thirty-seventh session; rule above TURN_SEEDS)
             "h52": ["domain.resolution_m=5.24e3"],
+            # the disk meshed at 4 km (thirty-eighth session; rule above TURN_SEEDS)
+            "h40": ["domain.resolution_m=4.0e3"],
             "nl16": ["rheology.damage_nonlocal_radius_m=16e3"],
             "nl10": ["rheology.damage_nonlocal_radius_m=10e3"],
             # The same R at two resolutions (twenty-fourth session), the test that the fault does
@@ -553,6 +555,16 @@ def analyse_floor(out: Path, variant: str, seeds) -> dict:
 #: lattice's three directions. The claim fails: the shear rate's independence at 5.24 km is
 #: Delaunay's at that size, not the size's. The prediction held for damage and failed for the shear
 #: rate. Local index 0.29-0.45 (damage), 0.45-0.56 (shear); damaged 0.28-0.36.
+#:
+#: A finer disk: Delaunay at 4 km (``turn --variants delaunay+h40``, thirty-eighth session; the
+#: scaled strength follows the smaller elements, the cyclone and the disk are unchanged). Stated
+#: 2026-11-29 18:47 UTC, before the runs:
+#: * the verdicts by the rule above, for both fields;
+#: * "on Delaunay the damage directions stop turning with the mesh as the elements shrink" if the
+#:   4 km damage verdict is "does not follow the mesh"; "the imprint falls with the size" (weaker) if
+#:   D of damage at 4 km is below D at 5.24 km at both turns and its verdict is not "follows".
+#: * Predicted: the shear rate does not follow (as at 5.24 km); damage is "undecided", with D below
+#:   the 5.24 km values at both turns, so the weaker claim holds and the stronger one does not.
 TURN_SEEDS = {0.0: tuple(range(12, 24)), 15.0: tuple(range(24, 36)), 30.0: tuple(range(36, 48))}
 
 
