@@ -2265,6 +2265,11 @@ add_month_own_spinup("P-vcrj1-m10", PMAX + CR_KAPPA1,
 # 0.13-0.19, tails 2.5-2.9, R2 0.63-0.68); the candidate has heavier tails (both within 0.3 of 2.2-2.5),
 # R2 higher by 0.03-0.08, the wind factor x1.2-1.5 (0.006-0.009) and beta lower by 0.00-0.05, so (i) holds
 # in 2 of 3 months and the candidate is a lead by 1-3 bands.
+# Added 2026-11-29 18:54 UTC, before any run: the ratio was refused with max_pressure_pa until now. The
+# combination is implemented as neXtSIM's compressive term acting on each part with its own relaxation
+# time: where the mean stress is compressive the deviator relaxes with lambda/(lambda + dt (1 - P~)) and the
+# mean with lambda_m/(lambda_m + dt (1 - P~)), lambda_m = r lambda (lagice.solvers.explicit, tested in
+# tests/test_explicit.py against those factors). The rule above is unchanged.
 add_screen_20km("P-vcrj1-m20", PMAX + CR_KAPPA1,
                 "20 km: neXtSIM's compressive term, Crouzeix-Raviart velocities (jump penalty 1), own spin-up, "
                 "meshed at domain.resolution_m")

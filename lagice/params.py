@@ -71,7 +71,9 @@ class MaxwellEBParams:
             viscosity G λ: Hibler's (1979) viscous-plastic ratio is e² = 4. Large ratios approach
             the kept mean stress and its volumetric locking (docs/solvers.md). A diagnostic of
             lagice (2026-11-28, thirtieth session); explicit CPU stepper only, with the whole stress
-            relaxing (relax_mean_stress true, no max_pressure_pa)
+            relaxing (relax_mean_stress true). With ``max_pressure_pa`` (since the thirty-eighth
+            session) the compressive term's 1 − P̃ multiplies Δt_s in both parts' relaxation
+            factors, λ/(λ + Δt_s (1 − P̃)) and λ_m/(λ_m + Δt_s (1 − P̃))
         dilatancy_angle_deg: ψ [degrees] ∈ [0, 45) of a dilatant Maxwell viscous flow (None or 0:
             off, the default; a diagnostic of lagice, 2026-11-27; docs/physics.md §4, "Broken ice
             that dilates as it shears"). The viscous (permanent) strain rate K⁻¹σ/(Eλ) of
@@ -186,15 +188,14 @@ class MaxwellEBParams:
         if self.bulk_shear_viscosity_ratio is not None:
             check_range("bulk_shear_viscosity_ratio (ζ/η)", self.bulk_shear_viscosity_ratio, 0.0, 1.0e6,
                         low_open=True)
-            others = {"relax_mean_stress": self.relax_mean_stress, "max_pressure_pa": self.max_pressure_pa,
+            others = {"relax_mean_stress": self.relax_mean_stress,
                       "dilatancy_angle_deg": self.dilatancy_angle_deg,
                       "damage_nonlocal_radius_m": self.damage_nonlocal_radius_m}
-            if not self.relax_mean_stress or self.max_pressure_pa or self.dilatancy_angle_deg \
-                    or self.damage_nonlocal_radius_m:
+            if not self.relax_mean_stress or self.dilatancy_angle_deg or self.damage_nonlocal_radius_m:
                 raise ConfigError(f"rheology.bulk_shear_viscosity_ratio = {self.bulk_shear_viscosity_ratio!r} is "
                                   f"implemented with the whole stress relaxing only (relax_mean_stress = true, no "
-                                  f"max_pressure_pa, dilatancy_angle_deg or damage_nonlocal_radius_m); it is set "
-                                  f"with {others}")
+                                  f"dilatancy_angle_deg or damage_nonlocal_radius_m; max_pressure_pa may be set); "
+                                  f"it is set with {others}")
         if self.stress_correction not in STRESS_CORRECTIONS:
             raise ConfigError(f"rheology.stress_correction = {self.stress_correction!r}: expected one of "
                               f"{list(STRESS_CORRECTIONS)}")

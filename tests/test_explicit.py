@@ -857,7 +857,8 @@ def test_bulk_shear_viscosity_ratio_relaxes_the_mean_stress_with_its_own_time():
     sub-step relaxes the deviator by γ = λ/(λ + Δt_s) and the mean stress by
     γ_m = λ_m/(λ_m + Δt_s), λ_m = r λ with r = (ζ/η)(1 − ν)/(1 + ν), to round-off; the
     default (None) relaxes both by γ, and the kept mean (relax_mean_stress false) not at all.
-    ζ/η = (1 + ν)/(1 − ν), the ratio of one λ, gives r = 1. Steppers without it refuse it."""
+    ζ/η = (1 + ν)/(1 − ν), the ratio of one λ, gives r = 1. With neXtSIM's compressive term
+    both parts relax with Δt_s (1 − P̃). Steppers without it refuse it."""
     from lagice.solvers.explicit import mean_relaxation_ratio
 
     rng = np.random.default_rng(5)
@@ -876,11 +877,11 @@ def test_bulk_shear_viscosity_ratio_relaxes_the_mean_stress_with_its_own_time():
     tri = np.zeros((m, 3), np.int32)
     zeros3 = np.zeros((m, 3))
 
-    def one(keep):
+    def one(keep, pmax=None):
         sg, dm, flag = sigma0.copy(), d.copy(), np.zeros(m, np.int8)
         element_stress_damage_kernel_serial(
             tri, zeros3, zeros3, np.zeros((1, 2)), sg, dm, np.ones(m), np.full(m, 1e15), kc, kt,
-            np.full(m, 20.0), np.zeros(m), dt_s * E, g, None, keep, None, None, None, None, dt_s, *rheo.K[0, :2],
+            np.full(m, 20.0), np.zeros(m), dt_s * E, g, pmax, keep, None, None, None, None, dt_s, *rheo.K[0, :2],
             rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag, None)
         assert np.array_equal(dm, d)
         return 0.5 * (sg[:, 0] + sg[:, 1]), np.column_stack([0.5 * (sg[:, 0] - sg[:, 1]), sg[:, 2]])
@@ -893,8 +894,20 @@ def test_bulk_shear_viscosity_ratio_relaxes_the_mean_stress_with_its_own_time():
         assert np.allclose(mean, gm * m0, rtol=1e-12, atol=1e-12 * np.abs(m0).max())
         assert np.allclose(dev, g[:, None] * s0, rtol=1e-12, atol=1e-12 * np.abs(s0).max())
     assert np.all(lam_m / (lam_m + dt_s) > g)  # the mean relaxes more slowly than the deviator
+    # with neXtSIM's compressive term: where the previous mean stress is compressive, P̃ =
+    # min(1, P_max/(−m)) and each part relaxes with Δt_s (1 − P̃), the deviator with λ, the mean
+    # with λ_m; tensile elements as without the term
+    pmax = np.abs(m0) * rng.uniform(0.0, 1.5, m)
+    omp = np.where(m0 < 0, 1.0 - np.minimum(1.0, pmax / np.maximum(-m0, 1e-300)), 1.0)
+    mean, dev = one(r, pmax)
+    assert np.allclose(mean, lam_m / (lam_m + dt_s * omp) * m0, rtol=1e-12, atol=1e-12 * np.abs(m0).max())
+    assert np.allclose(dev, (lam / (lam + dt_s * omp))[:, None] * s0, rtol=1e-12, atol=1e-12 * np.abs(s0).max())
+    assert np.sum((m0 < 0) & (omp < 1.0)) > m // 4 and np.sum(omp == 0.0) > m // 10  # both cases occur
+    mean_c, _ = one(None, pmax)  # the default with the term: one factor for the whole stress
+    assert np.allclose(mean_c, lam / (lam + dt_s * omp) * m0, rtol=1e-12, atol=1e-12 * np.abs(m0).max())
     with pytest.raises(ConfigError, match="bulk_shear_viscosity_ratio = 4.0 is implemented with the whole stress"):
         MaxwellEB(bulk_shear_viscosity_ratio=4.0, relax_mean_stress=False)
+    MaxwellEB(bulk_shear_viscosity_ratio=4.0, max_pressure_pa=10e3)  # allowed since the thirty-eighth session
     for stepper in ("implicit", "explicit_cuda"):
         with pytest.raises(ConfigError, match="bulk_shear_viscosity_ratio"):
             rheo.require_stepper(stepper)

@@ -305,7 +305,9 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     σ − m I only (m = (σxx + σyy)/2 after the elastic increment), and the mean m relaxes with
     λ_m = r λ (rheology.bulk_shear_viscosity_ratio), or, for r = inf
     (relax_mean_stress false), is kept or, with pmax, scaled by the compressive term's factor
-    (it creeps in tension and above P_max).
+    (it creeps in tension and above P_max). A finite r with pmax: the deviator relaxes with
+    λ/(λ + Δt_s (1 − P̃)) and the mean with λ_m/(λ_m + Δt_s (1 − P̃)), neXtSIM's factor applied to
+    each part with its own relaxation time (thirty-eighth session).
     theta: None (rheology.stress_correction = "origin", the default; pruned as pmax is): a
     super-critical stress is scaled towards the origin. A float θ ∈ (0, 2]
     (``"mean_stress"``, θ = ``stress_correction_mean_fraction``): it is brought back along
@@ -348,11 +350,13 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
         ed = e_dt[e]
         g = gamma[e]
         gp = g
+        omp = 1.0  # 1 − P̃ of the compressive term (1: it does not act)
         if pmax is not None:
             sn = -0.5 * (sigma[e, 0] + sigma[e, 1])
             if sn > 0.0:
                 pt = min(1.0, pmax[e] / sn)
-                gp = g / (g + (1.0 - g) * (1.0 - pt))
+                omp = 1.0 - pt
+                gp = g / (g + (1.0 - g) * omp)
         if keep_mean is None:
             sxx = (sigma[e, 0] + ed * (kxx * exx + kxy * eyy)) * gp
             syy = (sigma[e, 1] + ed * (kxy * exx + kxx * eyy)) * gp
@@ -371,15 +375,21 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
                 axx += mc - am
                 ayy += mc - am
                 am = mc
+            gd = g
             if pmax is not None:
-                gm = gp
+                if keep_mean == math.inf:  # the kept mean: only the compressive term's factor
+                    gm = gp
+                else:  # ζ/η with the compressive term: each part's λ, both times 1 − P̃
+                    gmr = keep_mean * g / (keep_mean * g + (1.0 - g))
+                    gm = gmr if omp == 1.0 else gmr / (gmr + (1.0 - gmr) * omp)
+                    gd = gp
             elif keep_mean == math.inf:  # relax_mean_stress = false: the mean is kept
                 gm = 1.0
             else:  # rheology.bulk_shear_viscosity_ratio: λ_m = r λ, so γ_m = r γ/(r γ + 1 − γ)
                 gm = keep_mean * g / (keep_mean * g + (1.0 - g))
-            sxx = (axx - am) * g + am * gm
-            syy = (ayy - am) * g + am * gm
-            sxy = (sigma[e, 2] + ed * (kss * exy)) * g
+            sxx = (axx - am) * gd + am * gm
+            syy = (ayy - am) * gd + am * gm
+            sxy = (sigma[e, 2] + ed * (kss * exy)) * gd
         # damage and stress correction: rheology.damage_step (both healing forms, by the sign of
         # heal_rate), as in rheology.damage_update_kernel.
         # Cheap test first: strictly inside the envelope (s1 < σT and q s1 − s2 < σc) _dcrit
