@@ -565,6 +565,14 @@ def analyse_floor(out: Path, variant: str, seeds) -> dict:
 #:   D of damage at 4 km is below D at 5.24 km at both turns and its verdict is not "follows".
 #: * Predicted: the shear rate does not follow (as at 5.24 km); damage is "undecided", with D below
 #:   the 5.24 km values at both turns, so the weaker claim holds and the stronger one does not.
+#:
+#: Result (2026-11-29, 19:36 UTC; 36 runs of 149-161 s, 48 062 elements, 3.68 km median edges): damage
+#: undecided (D +0.16 [+0.01, +0.27] at 15 deg, -0.23 [-0.48, +0.04] at 30 deg; 5.24 km: +0.18, -0.03), the
+#: shear rate undecided (D -0.09 [-0.18, +0.01], -0.44 [-0.58, -0.29]; 5.24 km: "does not follow"). The
+#: weaker claim holds (damage's D lower at both turns, its verdict not "follows"); the stronger one fails.
+#: The prediction held for damage and failed for the shear rate, whose 15 deg interval reaches +0.01.
+#: Split-half correlation 0.91 (damage) and 0.95 (shear); local index 0.34-0.43 (damage), 0.36-0.43
+#: (shear). Figure: docs/figures/mesh_imprint_turn_h40.png (``--figure mesh_imprint_turn_h40``).
 TURN_SEEDS = {0.0: tuple(range(12, 24)), 15.0: tuple(range(24, 36)), 30.0: tuple(range(36, 48))}
 
 
