@@ -2304,6 +2304,22 @@ add_months_20km("Pz-vcrj1-m20", "20 km, compressive term, Crouzeix-Raviart and z
 # R2 near 0.6, so neither set-up is near the flagship's goal; the 10 km months were not run (about 1.5 h
 # each with Crouzeix-Raviart velocities, after a 30-min spin-up).
 
+# --- 2026-11-29 (thirty-ninth session): half the bulk viscosity on the best-beta set-up at 10 km -------------
+# Written 2026-11-29 21:32 UTC, before the runs. The 20 km eight months above made Pz-vcrj1 (P-vcrj1 with
+# zeta/eta = 0.93, a calibration) a lead for the 10 km months: 2 bands inside against 1, beta 0.203, the drift
+# in its band. Here its validation month at 10 km in both basins, from its own 10 km spin-up on the mesh at
+# domain.resolution_m (H1125-Pz-vcrj1-m10), against P-vcrj1-m10 (closed / strait: beta 0.187 / 0.22, tails
+# shear 2.63 / 2.45, |div| 2.48 / 3.20, half-shear area 5.8 / 5.8 %, R2 0.66 / 0.626, rate 0.0079 / 0.0085 per
+# day, wind factor 0.0053 / 0.0058; 3 / 2 bands inside). The candidate is a lead for the 10 km weather
+# ensemble if, summed over the two basins, it puts more bands inside than the reference (5), with beta in
+# 0.14-0.23 in both basins and the wind factor in 0.006-0.010 in at least one. Predicted from the 20 km
+# months: the rate x1.2-1.4 (into its band, 0.010-0.011 per day, in both), the wind factor x1.2-1.4
+# (0.006-0.008), beta lower by 0.00-0.03, the shear tail 0.1-0.4 lighter, R2 within 0.03: 3 and 3 bands, so
+# a lead by one band. Only one month per basin, so the result is a screen, not a flagship claim.
+add_month_own_spinup("Pz-vcrj1-m10", PMAX + CR_KAPPA1 + ["rheology.bulk_shear_viscosity_ratio=0.9286"],
+                     "neXtSIM's compressive term, Crouzeix-Raviart velocities (jump penalty 1), zeta/eta = 0.93, "
+                     "own spin-up, meshed at domain.resolution_m")
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
