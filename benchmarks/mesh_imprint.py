@@ -11,7 +11,8 @@ Runs through the scene builder and Simulation (``lagice run`` subprocesses):
 * ``floor``: the same at 0°, 15°, 30° and 60° with several disorder draws each (the rotation
   test against its noise; rule above ``FLOOR_ROTATIONS``).
 * ``turn``: ensembles of 12 draws at 0°, 15° and 30° with disjoint seeds, judged at exactly the
-  turn with a bootstrap interval (rule above ``TURN_SEEDS``); figure ``mesh_imprint_turn.png``.
+  turn with a bootstrap interval (rule above ``TURN_SEEDS``); figure ``mesh_imprint_turn.png`` for the
+  variants ``base delaunay``, ``mesh_imprint_turn_VARIANTS.png`` for any other set (or ``--figure``).
 * ``compression``: the uniaxial compression test of Dansereau et al. (2016) §4
   (``examples/uniaxial_compression.toml``, N elements across) as
   ``benchmarks/validate.py`` runs it, with a mesh option; fault angles (active faults
@@ -607,6 +608,19 @@ def analyse_turn(out: Path, variant: str) -> dict:
     return res
 
 
+#: the variants of the published figure ``mesh_imprint_turn.png`` (the 8 km rotation test)
+TURN_FIGURE_VARIANTS = ("base", "delaunay")
+
+
+def turn_figure_name(variants) -> str:
+    """The default figure name of ``turn``: ``mesh_imprint_turn`` for the published variants, and
+    otherwise one named after the variants, so that another set does not overwrite the published
+    figure (it did once, thirty-eighth session)."""
+    if sorted(variants) == sorted(TURN_FIGURE_VARIANTS):
+        return "mesh_imprint_turn"
+    return "mesh_imprint_turn_" + "_".join(v.replace("+", "-") for v in variants)
+
+
 def figure_turn(res: dict, path: Path):
     """The ensembles' mean direction histograms at 0, 15 and 30 deg, one panel per variant and field,
     the turned ones drawn also turned back by the mesh's turn (where they would lie if the
@@ -880,7 +894,8 @@ def main(argv=None):
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "out" / "mesh_imprint")
     ap.add_argument("--fig-dir", type=Path, default=ROOT / "docs" / "figures")
     ap.add_argument("--figure", default=None, metavar="NAME",
-                    help="cyclone: FIG_DIR/NAME.png instead of mesh_imprint_cyclone.png; "
+                    help="cyclone: FIG_DIR/NAME.png instead of mesh_imprint_cyclone.png; turn: instead of "
+                         "mesh_imprint_turn.png (variants base and delaunay) or mesh_imprint_turn_VARIANTS.png; "
                          "compression: also FIG_DIR/NAME.png, the variants side by side (stress, rate, damage); "
                          "final-faults: the stress and the final damage of each run")
     args = ap.parse_args(argv)
@@ -959,7 +974,7 @@ def main(argv=None):
                 print(f"  turn {v:10s} {field:7s}: {r['verdict']}; {tt}; split-half corr of the 0 deg ensemble "
                       f"{r['turns']['15']['split_half_corr_ref']:+.2f}; local index "
                       f"{r['local_index_range'][0]:.2f}-{r['local_index_range'][1]:.2f}", flush=True)
-        figure_turn(res, args.fig_dir / f"{args.figure or 'mesh_imprint_turn'}.png")
+        figure_turn(res, args.fig_dir / f"{args.figure or turn_figure_name(args.variants)}.png")
     elif args.what == "compression":
         for n in args.n_across:
             results = {}

@@ -764,3 +764,32 @@ def test_rotation_summary_carries_the_ensemble_verdicts_and_their_intervals():
     assert "delaunay, ensembles of 12 draws at exactly the turn: damage follows the mesh, shear does not follow" \
         in out["summary"]
     assert "ensemble_turn" not in rotation_test_summary({})
+
+
+def test_band_set_holds_the_share_and_nodes_are_followed_by_their_ids():
+    """benchmarks/band_persistence.py: the fastest elements that hold half of Σ rate·area (the one
+    that crosses the share included), and positions at another snapshot found by node id, NaN
+    where a remesh removed the node."""
+    from band_persistence import _positions_of, band_set
+
+    area = np.ones(6)
+    assert band_set(np.array([1.0, 10.0, 1.0, 1.0, 1.0, 1.0]), area).tolist() == [False, True] + [False] * 4
+    # equal rates: the first three hold exactly half, so three elements; the choice among ties is stable
+    assert band_set(np.ones(6), area).sum() == 3
+    # the set is taken by rate, and an element's share of the shear is rate × area
+    assert band_set(np.array([3.0, 2.0, 1.0]), np.ones(3)).tolist() == [True, False, False]
+    assert band_set(np.array([3.0, 2.0, 1.0]), np.array([1.0, 4.0, 1.0])).tolist() == [True, True, False]
+    ids_there = np.array([7, 3, 5])
+    xy_there = np.array([[70.0, 0.0], [30.0, 0.0], [50.0, 0.0]])
+    got = _positions_of(np.array([3, 4, 7]), xy_there, ids_there)
+    assert got[0].tolist() == [30.0, 0.0] and got[2].tolist() == [70.0, 0.0] and np.isnan(got[1]).all()
+
+
+def test_turn_figure_keeps_the_published_name_for_the_published_variants_only():
+    """benchmarks/mesh_imprint.py turn: another set of variants must not overwrite the published
+    figure mesh_imprint_turn.png (it did once, in the thirty-eighth session)."""
+    from mesh_imprint import turn_figure_name
+
+    assert turn_figure_name(["delaunay", "base"]) == "mesh_imprint_turn"
+    assert turn_figure_name(["delaunay+h40"]) == "mesh_imprint_turn_delaunay-h40"
+    assert turn_figure_name(["base"]) != "mesh_imprint_turn"
