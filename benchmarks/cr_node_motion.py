@@ -182,6 +182,20 @@ def _medians(rows: list[dict], field: str) -> dict:
     return {k: float(np.nanmedian([r[field][k] for r in rows])) for k in STAT_KEYS}
 
 
+def paired_differences(rows: list[dict], n_boot: int = 2000) -> dict:
+    """Per statistic: the median over the blocks of rheology − mesh, a 90 % bootstrap interval of
+    that median (blocks resampled, seed 0), and the share of blocks where it is > 0."""
+    rng = np.random.default_rng(0)
+    out = {}
+    for k in STAT_KEYS:
+        d = np.array([r["rheology"][k] - r["mesh"][k] for r in rows], dtype=float)
+        d = d[np.isfinite(d)]
+        boot = np.median(rng.choice(d, (n_boot, d.size)), axis=1)
+        out[k] = {"median": float(np.median(d)), "low": float(np.percentile(boot, 5)),
+                  "high": float(np.percentile(boot, 95)), "share_positive": float(np.mean(d > 0))}
+    return out
+
+
 def print_statistics(blocks: list[dict], storm_from: float) -> None:
     print("\n| variant | field | blocks | β | shear tail | \\|div\\| tail | half-shear area | R² "
           "| mean total rate (day⁻¹) |")
@@ -198,6 +212,10 @@ def print_statistics(blocks: list[dict], storm_from: float) -> None:
                       f"{m['pdf_tail_exponent_shear']:.2f} | {m['pdf_tail_exponent_divergence']:.2f} | "
                       f"{100 * m['localisation_half_shear_area_fraction']:.1f} % | {m['shear_divergence_r2']:.2f} | "
                       f"{m['mean_total_s'] * DAY_S:.4f} |")
+            d = paired_differences(rows)
+            print(f"| {name} ({label}) | rheology − mesh, median [90 %] | {len(rows)} | "
+                  + " | ".join(f"{d[k]['median'] * f:+.3f} [{d[k]['low'] * f:+.3f}, {d[k]['high'] * f:+.3f}]"
+                               for k, f in zip(STAT_KEYS, (1, 1, 1, 100, 1, DAY_S))) + " |")
 
 
 def main(argv=None) -> None:
@@ -215,9 +233,14 @@ def main(argv=None) -> None:
     ap.add_argument("--variants", choices=("both", "linear", "cr"), default="both",
                     help="the velocity elements run (default both)")
     ap.add_argument("--json", type=Path, help="--statistics: write the per-block values here")
+    ap.add_argument("--from-json", type=Path, nargs="+", metavar="FILE",
+                    help="--statistics: print the tables from files written by --json instead of running")
     args = ap.parse_args(argv)
     if args.block_steps < 1 or args.steps < args.block_steps:
         ap.error(f"--block-steps {args.block_steps}: expected 1 to --steps ({args.steps})")
+    if args.from_json:
+        print_statistics([b for f in args.from_json for b in json.loads(f.read_text())["blocks"]], args.storm_from)
+        return
     extra = dict(s.split("=", 1) for s in args.sets)
     variants = [v for v in VARIANTS if args.variants == "both" or (args.variants == "cr") == (v[0] != "linear")]
     print(f"winter_basin_pack from its shipped spun-up state, {args.steps} outer steps"
