@@ -77,6 +77,20 @@ from lagice.scenes.config import load_scene
 # (the roughness is in the shear and divergence alike). One-hour blocks are not the 3-day windows, so
 # neither field is compared with the observed bands.
 
+# Result (21:45 UTC): both claims fail, against the prediction for (a). The mesh's field has the heavier tails
+# (rheology - mesh: +0.15 shear, +0.17 |div|), the higher R2 (-0.053) and the higher beta (-0.094 in every one
+# of 122 blocks: 0.056 against 0.157) and a third more deformation; the linear element's differences are 0.
+# docs/physics.md s4, "What the best-beta set-up's statistics measure".
+#
+# Rule, written before the runs (2026-11-29, 21:47 UTC). If the mesh's extra beta is slip in the velocity jumps
+# across edges, it must shrink as the jump penalty kappa grows. Runs: winter_basin_pack at 20 km from the 20 km
+# spin-up of the best-beta set-up (spinup-H20-P-vcrj1-m20, made with kappa = 1; the same start for every kappa,
+# so this is a diagnostic of the mechanism, not a screen of kappa), 1440 outer steps, one-hour blocks,
+# kappa = 0.1, 0.3, 1, 3 and 10. Claim: the median block difference mesh - rheology in beta falls monotonically
+# from kappa = 0.1 to 10 (a tolerance of 0.01 between neighbours) and is at least 3 times smaller at 10 than
+# at 0.1; the same for the rate's relative difference. Predicted: it holds; at kappa = 10 the beta gap is
+# under 0.03 and the mesh's beta falls with kappa (the rheology's changes less).
+
 #: the statistics ``--statistics`` compares (keys of rate_statistics), with the mean total rate
 STAT_KEYS = ("beta_space", "pdf_tail_exponent_shear", "pdf_tail_exponent_divergence",
              "localisation_half_shear_area_fraction", "shear_divergence_r2", "mean_total_s")
