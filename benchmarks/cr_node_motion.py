@@ -263,6 +263,9 @@ def main(argv=None) -> None:
     print("|---|---|---|---|---|---|")
     triggers, blocks = [], []
     for name, ov in variants:
+        if "solver.jump_penalty" in ov and "solver.jump_penalty" in extra:  # name the penalty the run has
+            name = name.replace(f"jump_penalty {ov['solver.jump_penalty']:g}",
+                                f"jump_penalty {extra['solver.jump_penalty']}")
         cfg = load_scene("winter_basin_pack", [f"{k}={v}" for k, v in {**ov, **extra}.items()]
                          + ["run.progress=false", "output.plot=false", "run.duration=100d", "output.every=100d",
                             "checkpoint.every=100d"])
