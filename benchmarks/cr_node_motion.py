@@ -91,6 +91,12 @@ from lagice.scenes.config import load_scene
 # at 0.1; the same for the rate's relative difference. Predicted: it holds; at kappa = 10 the beta gap is
 # under 0.03 and the mesh's beta falls with kappa (the rheology's changes less).
 
+# Result (22:02 UTC): the claim fails, and so does the prediction. The beta gap (rheology - mesh, all blocks) is
+# -0.173 / -0.156 / -0.138 / -0.135 / -0.109 at kappa 0.1 / 0.3 / 1 / 3 / 10: monotonic, but only 1.6 times
+# smaller at 10 (the rate's relative gap +44 % -> +24 %, 1.8 times). In the storm (from day 7) the rheology's shear
+# tails are 1.47-1.53 at every kappa and the mesh's 2.72-3.52. So most of the gap is the vertex mean of a
+# non-conforming field, whatever kappa; docs/physics.md s4, "What the best-beta set-up's statistics measure".
+
 #: the statistics ``--statistics`` compares (keys of rate_statistics), with the mean total rate
 STAT_KEYS = ("beta_space", "pdf_tail_exponent_shear", "pdf_tail_exponent_divergence",
              "localisation_half_shear_area_fraction", "shear_divergence_r2", "mean_total_s")
@@ -210,6 +216,21 @@ def paired_differences(rows: list[dict], n_boot: int = 2000) -> dict:
     return out
 
 
+def summary(blocks: list[dict], storm_from: float) -> dict:
+    """Per variant and phase ("all", "from day D"): the blocks, both fields' medians and the
+    paired differences (what :func:`print_statistics` prints)."""
+    out = {}
+    for name in dict.fromkeys(r["variant"] for r in blocks):
+        mine = [r for r in blocks if r["variant"] == name]
+        for label, rows in (("all", mine), (f"from day {storm_from:g}",
+                                            [r for r in mine if r["start_day"] >= storm_from - 1e-9])):
+            if rows:
+                out.setdefault(name, {})[label] = {"blocks": len(rows), "rheology": _medians(rows, "rheology"),
+                                                   "mesh": _medians(rows, "mesh"),
+                                                   "rheology_minus_mesh": paired_differences(rows)}
+    return out
+
+
 def print_statistics(blocks: list[dict], storm_from: float) -> None:
     print("\n| variant | field | blocks | β | shear tail | \\|div\\| tail | half-shear area | R² "
           "| mean total rate (day⁻¹) |")
@@ -249,11 +270,20 @@ def main(argv=None) -> None:
     ap.add_argument("--json", type=Path, help="--statistics: write the per-block values here")
     ap.add_argument("--from-json", type=Path, nargs="+", metavar="FILE",
                     help="--statistics: print the tables from files written by --json instead of running")
+    ap.add_argument("--summary-json", type=Path,
+                    help="with --from-json: write the tables' numbers (medians, paired differences) here")
     args = ap.parse_args(argv)
     if args.block_steps < 1 or args.steps < args.block_steps:
         ap.error(f"--block-steps {args.block_steps}: expected 1 to --steps ({args.steps})")
     if args.from_json:
-        print_statistics([b for f in args.from_json for b in json.loads(f.read_text())["blocks"]], args.storm_from)
+        docs = [json.loads(f.read_text()) for f in args.from_json]
+        blocks = [b for d in docs for b in d["blocks"]]
+        print_statistics(blocks, args.storm_from)
+        if args.summary_json:
+            args.summary_json.write_text(json.dumps({"commands": [d["command"] for d in docs],
+                                                     "block_steps": sorted({d["block_steps"] for d in docs}),
+                                                     "summary": summary(blocks, args.storm_from)}, indent=1) + "\n")
+            print(f"wrote {args.summary_json}")
         return
     extra = dict(s.split("=", 1) for s in args.sets)
     variants = [v for v in VARIANTS if args.variants == "both" or (args.variants == "cr") == (v[0] != "linear")]
@@ -266,6 +296,8 @@ def main(argv=None) -> None:
         if "solver.jump_penalty" in ov and "solver.jump_penalty" in extra:  # name the penalty the run has
             name = name.replace(f"jump_penalty {ov['solver.jump_penalty']:g}",
                                 f"jump_penalty {extra['solver.jump_penalty']}")
+        if "domain.resolution_m" in extra:
+            name += f", {float(extra['domain.resolution_m']) / 1e3:g} km"
         cfg = load_scene("winter_basin_pack", [f"{k}={v}" for k, v in {**ov, **extra}.items()]
                          + ["run.progress=false", "output.plot=false", "run.duration=100d", "output.every=100d",
                             "checkpoint.every=100d"])
