@@ -97,6 +97,17 @@ from lagice.scenes.config import load_scene
 # tails are 1.47-1.53 at every kappa and the mesh's 2.72-3.52. So most of the gap is the vertex mean of a
 # non-conforming field, whatever kappa; docs/physics.md s4, "What the best-beta set-up's statistics measure".
 
+# Rule, written before the runs (2026-11-29, 22:04 UTC). Could another node motion carry the rheology's statistics?
+# Any node motion is a continuous linear field. The one whose strain is nearest the rheology's (least squares,
+# area-weighted, the same norm as `mismatch`; prescribed components held) is the best any node motion can do;
+# what it misses is the non-conforming part of the Crouzeix-Raviart strain. --statistics now also computes that
+# field ("fit", per block, from the block's mean strain). Runs: as the kappa sweep, kappa = 1, 20 km. Claim: a node
+# motion fitted to the strains would carry the rheology's statistics if the median paired beta difference fit -
+# rheology lies within 0.03 over all blocks AND the storm blocks' (from day 7) median shear tail of the fit lies
+# within 0.3 of the rheology's. Otherwise no node motion can, and the gap is the field's non-conforming part.
+# Predicted: the fit lies between the two, nearer the mesh's (beta gap >= 0.06), since the rheology's strain is
+# rough at the element scale (0.85-0.90) and most of that roughness is non-conforming.
+
 #: the statistics ``--statistics`` compares (keys of rate_statistics), with the mean total rate
 STAT_KEYS = ("beta_space", "pdf_tail_exponent_shear", "pdf_tail_exponent_divergence",
              "localisation_half_shear_area_fraction", "shear_divergence_r2", "mean_total_s")
