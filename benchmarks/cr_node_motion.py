@@ -154,6 +154,40 @@ def step_measures(sim) -> dict | None:
             "shear_ratio": float(np.sum(area * invariants(eps_mesh)[1]) / np.sum(area * invariants(eps)[1]))}
 
 
+def strain_fit(xy, tri, eps: np.ndarray, fixed: np.ndarray, held: np.ndarray) -> np.ndarray:
+    """The nodal velocity (n, 2) whose linear strain rate is nearest ``eps`` (m, 3: ε̇xx, ε̇yy, ε̇xy)
+    in Σ A |ε̇(U) − ε̇|², |ε̇|² = ε̇xx² + ε̇yy² + 2 ε̇xy² (the norm of ``mismatch``), with the
+    components flagged in ``fixed`` (n, 2) held at ``held`` (n, 2). The best any node motion can do;
+    the rest is the non-conforming part of a Crouzeix–Raviart strain. Normal equations solved with
+    scipy's sparse LU."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.linalg import spsolve
+
+    n, m = len(xy), len(tri)
+    b, c, area = shape_gradients(xy, tri)
+    # rows ε̇xx, ε̇yy, √2 ε̇xy of each element against its six dofs (u0, u1, u2, v0, v1, v2)
+    B = np.zeros((m, 3, 6))
+    B[:, 0, :3] = b
+    B[:, 1, 3:] = c
+    B[:, 2, :3] = c / np.sqrt(2.0)
+    B[:, 2, 3:] = b / np.sqrt(2.0)
+    target = np.column_stack([eps[:, 0], eps[:, 1], np.sqrt(2.0) * eps[:, 2]])
+    ke = area[:, None, None] * np.einsum("mki,mkj->mij", B, B)
+    fe = area[:, None] * np.einsum("mki,mk->mi", B, target)
+    dof = np.concatenate([tri, tri + n], axis=1)            # u of node i is dof i, v is n + i
+    rows = np.repeat(dof, 6, axis=1).ravel()
+    cols = np.tile(dof, (1, 6)).ravel()
+    K = coo_matrix((ke.ravel(), (rows, cols)), shape=(2 * n, 2 * n)).tocsr()
+    F = np.bincount(dof.ravel(), weights=fe.ravel(), minlength=2 * n)
+    held_flat = np.concatenate([held[:, 0], held[:, 1]])
+    is_fixed = np.concatenate([fixed[:, 0], fixed[:, 1]]).astype(bool)
+    U = np.where(is_fixed, held_flat, 0.0)
+    free = ~is_fixed
+    rhs = F[free] - K[free][:, is_fixed] @ U[is_fixed]
+    U[free] = spsolve(K[free][:, free].tocsc(), rhs)
+    return np.column_stack([U[:n], U[n:]])
+
+
 def block_statistics(xy, tri, inside, eps_mean: np.ndarray) -> dict:
     """The statistics of the interior elements ``inside`` for a mean strain rate ``eps_mean``
     (m, 3: ε̇xx, ε̇yy, ε̇xy [s⁻¹]) on the mesh ``xy``, ``tri``. The gradient handed to the
@@ -170,9 +204,9 @@ def block_statistics(xy, tri, inside, eps_mean: np.ndarray) -> dict:
     return {k: float(st[k]) for k in STAT_KEYS}
 
 
-def run_statistics(name: str, sim, steps: int, block: int) -> list[dict]:
+def run_statistics(name: str, sim, steps: int, block: int, fit: bool = False) -> list[dict]:
     """Per block of ``block`` outer steps without a remesh: the statistics of the rheology's
-    field and of the mesh's (see the module's docstring)."""
+    field and of the mesh's (see the module's docstring); with ``fit`` also of :func:`strain_fit`'s."""
     blocks, acc, acc_mesh, k, n0 = [], None, None, 0, None
     for _ in range(steps):
         mesh = sim.model.mesh
@@ -203,6 +237,11 @@ def run_statistics(name: str, sim, steps: int, block: int) -> list[dict]:
                    "n_interior": int(inside.sum())}
             row["rheology"] = block_statistics(mesh.nodes, mesh.triangles, inside, acc / block)
             row["mesh"] = block_statistics(mesh.nodes, mesh.triangles, inside, acc_mesh / block)
+            if fit:
+                b, c, _ = shape_gradients(mesh.nodes, mesh.triangles)
+                u_fit = strain_fit(mesh.nodes, mesh.triangles, acc / block, st.nodes.fixed, st.transport_velocity)
+                row["fit"] = block_statistics(mesh.nodes, mesh.triangles, inside,
+                                              strain_rate(mesh.triangles, b, c, u_fit))
             blocks.append(row)
             print(f"  {name} day {row['end_day']:.2f}: tails shear {row['rheology']['pdf_tail_exponent_shear']:.2f}"
                   f" / {row['mesh']['pdf_tail_exponent_shear']:.2f} (rheology / mesh)", flush=True)
@@ -213,13 +252,13 @@ def _medians(rows: list[dict], field: str) -> dict:
     return {k: float(np.nanmedian([r[field][k] for r in rows])) for k in STAT_KEYS}
 
 
-def paired_differences(rows: list[dict], n_boot: int = 2000) -> dict:
-    """Per statistic: the median over the blocks of rheology − mesh, a 90 % bootstrap interval of
-    that median (blocks resampled, seed 0), and the share of blocks where it is > 0."""
+def paired_differences(rows: list[dict], n_boot: int = 2000, a: str = "rheology", b: str = "mesh") -> dict:
+    """Per statistic: the median over the blocks of field ``a`` − field ``b``, a 90 % bootstrap
+    interval of that median (blocks resampled, seed 0), and the share of blocks where it is > 0."""
     rng = np.random.default_rng(0)
     out = {}
     for k in STAT_KEYS:
-        d = np.array([r["rheology"][k] - r["mesh"][k] for r in rows], dtype=float)
+        d = np.array([r[a][k] - r[b][k] for r in rows], dtype=float)
         d = d[np.isfinite(d)]
         boot = np.median(rng.choice(d, (n_boot, d.size)), axis=1)
         out[k] = {"median": float(np.median(d)), "low": float(np.percentile(boot, 5)),
@@ -236,9 +275,12 @@ def summary(blocks: list[dict], storm_from: float) -> dict:
         for label, rows in (("all", mine), (f"from day {storm_from:g}",
                                             [r for r in mine if r["start_day"] >= storm_from - 1e-9])):
             if rows:
-                out.setdefault(name, {})[label] = {"blocks": len(rows), "rheology": _medians(rows, "rheology"),
-                                                   "mesh": _medians(rows, "mesh"),
-                                                   "rheology_minus_mesh": paired_differences(rows)}
+                res = {"blocks": len(rows), "rheology": _medians(rows, "rheology"), "mesh": _medians(rows, "mesh"),
+                       "rheology_minus_mesh": paired_differences(rows)}
+                if all("fit" in r for r in rows):
+                    res["fit"] = _medians(rows, "fit")
+                    res["fit_minus_rheology"] = paired_differences(rows, a="fit", b="rheology")
+                out.setdefault(name, {})[label] = res
     return out
 
 
@@ -252,16 +294,18 @@ def print_statistics(blocks: list[dict], storm_from: float) -> None:
                                                          and r["start_day"] >= storm_from - 1e-9])):
             if not rows:
                 continue
-            for field in ("rheology", "mesh"):
+            has_fit = all("fit" in r for r in rows)
+            for field in ("rheology", "mesh") + (("fit",) if has_fit else ()):
                 m = _medians(rows, field)
                 print(f"| {name} ({label}) | {field} | {len(rows)} | {m['beta_space']:.3f} | "
                       f"{m['pdf_tail_exponent_shear']:.2f} | {m['pdf_tail_exponent_divergence']:.2f} | "
                       f"{100 * m['localisation_half_shear_area_fraction']:.1f} % | {m['shear_divergence_r2']:.2f} | "
                       f"{m['mean_total_s'] * DAY_S:.4f} |")
-            d = paired_differences(rows)
-            print(f"| {name} ({label}) | rheology − mesh, median [90 %] | {len(rows)} | "
-                  + " | ".join(f"{d[k]['median'] * f:+.3f} [{d[k]['low'] * f:+.3f}, {d[k]['high'] * f:+.3f}]"
-                               for k, f in zip(STAT_KEYS, (1, 1, 1, 100, 1, DAY_S))) + " |")
+            for a, b in (("rheology", "mesh"),) + ((("fit", "rheology"),) if has_fit else ()):
+                d = paired_differences(rows, a=a, b=b)
+                print(f"| {name} ({label}) | {a} − {b}, median [90 %] | {len(rows)} | "
+                      + " | ".join(f"{d[k]['median'] * f:+.3f} [{d[k]['low'] * f:+.3f}, {d[k]['high'] * f:+.3f}]"
+                                   for k, f in zip(STAT_KEYS, (1, 1, 1, 100, 1, DAY_S))) + " |")
 
 
 def main(argv=None) -> None:
@@ -279,6 +323,8 @@ def main(argv=None) -> None:
     ap.add_argument("--variants", choices=("both", "linear", "cr"), default="both",
                     help="the velocity elements run (default both)")
     ap.add_argument("--json", type=Path, help="--statistics: write the per-block values here")
+    ap.add_argument("--fit", action="store_true",
+                    help="--statistics: also the node motion fitted to the rheology's strain (strain_fit)")
     ap.add_argument("--from-json", type=Path, nargs="+", metavar="FILE",
                     help="--statistics: print the tables from files written by --json instead of running")
     ap.add_argument("--summary-json", type=Path,
@@ -316,7 +362,7 @@ def main(argv=None) -> None:
         with tempfile.TemporaryDirectory() as tmp:
             sim = build_simulation(cfg, Path(tmp) / "run")
             if args.statistics:
-                blocks += run_statistics(name, sim, args.steps, args.block_steps)
+                blocks += run_statistics(name, sim, args.steps, args.block_steps, args.fit)
                 continue
             for _ in range(args.steps):
                 n0 = sim.model.state.counters.get("remesh_count", 0)
