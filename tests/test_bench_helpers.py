@@ -793,3 +793,45 @@ def test_turn_figure_keeps_the_published_name_for_the_published_variants_only():
     assert turn_figure_name(["delaunay", "base"]) == "mesh_imprint_turn"
     assert turn_figure_name(["delaunay+h40"]) == "mesh_imprint_turn_delaunay-h40"
     assert turn_figure_name(["base"]) != "mesh_imprint_turn"
+
+
+def test_strain_fit_recovers_a_linear_field_and_fits_a_rough_strain_by_least_squares():
+    """benchmarks/cr_node_motion.py: the node motion whose strain is nearest a given element strain.
+    A continuous linear field's own strain, with its boundary values held, gives the field back;
+    for any strain the fit's residual is orthogonal to every admissible change (the normal
+    equations), so no other node motion with the same held values fits better."""
+    from cr_node_motion import strain_fit
+
+    from lagice.fem import shape_gradients, strain_rate
+
+    nx = 7
+    gx, gy = np.meshgrid(np.linspace(0.0, 6e3, nx), np.linspace(0.0, 6e3, nx))
+    xy = np.column_stack([gx.ravel(), gy.ravel()])
+    xy[:, 0] += 150.0 * np.sin(xy[:, 1] / 900.0)  # not a lattice
+    idx = np.arange(nx * nx).reshape(nx, nx)
+    a, b_, c_, d = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel()
+    tri = np.concatenate([np.column_stack([a, b_, d]), np.column_stack([a, d, c_])])
+    b, c, area = shape_gradients(xy, tri)
+    assert np.all(area > 0)
+    boundary = (gx.ravel() == 0) | (gx.ravel() == 6e3) | (gy.ravel() == 0) | (gy.ravel() == 6e3)
+    fixed = np.repeat(boundary[:, None], 2, axis=1).astype(np.int8)
+    u = np.column_stack([1e-3 * np.sin(xy[:, 0] / 2e3) + 2e-4 * np.cos(xy[:, 1] / 1.5e3),
+                         5e-4 * np.cos(xy[:, 0] / 2.5e3) * np.sin(xy[:, 1] / 3e3)])
+    eps = strain_rate(tri, b, c, u)
+    got = strain_fit(xy, tri, eps, fixed, u)
+    assert np.allclose(got, u, rtol=0, atol=1e-12)
+    # a strain no node motion has: the fit's misfit cannot be lowered by moving any free node
+    rng = np.random.default_rng(3)
+    rough = eps + 1e-7 * rng.standard_normal(eps.shape)
+    fit = strain_fit(xy, tri, rough, fixed, u)
+
+    def misfit(v):
+        e = strain_rate(tri, b, c, v) - rough
+        return float(np.sum(area * (e[:, 0] ** 2 + e[:, 1] ** 2 + 2.0 * e[:, 2] ** 2)))
+
+    base = misfit(fit)
+    for trial in range(5):
+        dv = 1e-6 * rng.standard_normal(u.shape)
+        dv[boundary] = 0.0
+        assert misfit(fit + dv) > base
+    assert np.allclose(fit[boundary], u[boundary], rtol=0, atol=0)
