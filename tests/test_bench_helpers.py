@@ -830,7 +830,7 @@ def test_strain_fit_recovers_a_linear_field_and_fits_a_rough_strain_by_least_squ
         return float(np.sum(area * (e[:, 0] ** 2 + e[:, 1] ** 2 + 2.0 * e[:, 2] ** 2)))
 
     base = misfit(fit)
-    for trial in range(5):
+    for _ in range(5):
         dv = 1e-6 * rng.standard_normal(u.shape)
         dv[boundary] = 0.0
         assert misfit(fit + dv) > base
