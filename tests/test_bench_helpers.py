@@ -835,3 +835,38 @@ def test_strain_fit_recovers_a_linear_field_and_fits_a_rough_strain_by_least_squ
         dv[boundary] = 0.0
         assert misfit(fit + dv) > base
     assert np.allclose(fit[boundary], u[boundary], rtol=0, atol=0)
+
+
+@pytest.mark.parametrize("moves", [False, True])
+def test_band_persistence_tells_a_band_that_stays_from_one_that_moves(tmp_path, moves):
+    """benchmarks/band_persistence.py on a real run with daily snapshots: a shear band prescribed
+    at one place for two days keeps its half-shear set (overlap near 1, far above chance); one that
+    moves by 100 km after the first day keeps none of it."""
+    from band_persistence import day_pair
+
+    from lagice.lagrangian import MeshMotion
+    from lagice.mesh import generate_mesh, rectangle_domain
+    from lagice.model import Model
+    from lagice.simulation import Simulation
+    from lagice.solvers import PrescribedStepper
+    from lagice.state import IceState
+
+    side = 400e3
+    poly, _ = rectangle_domain(side, side)
+    mesh = generate_mesh(poly, 20e3, exterior_tag="free")
+
+    def velocity(t, x, y):
+        y0 = 150e3 if (not moves or t < 86400.0) else 250e3
+        return 0.05 * np.tanh((y - y0) / 10e3), 0.0 * x
+
+    st = IceState.uniform(mesh, thickness_m=1.0, concentration=1.0, cohesion_pa=1e9)
+    sim = Simulation(Model(st, solver=PrescribedStepper(mesh=mesh, velocity=velocity), mover=MeshMotion()), dt="3h",
+                     stop="2d", progress=False)
+    sim.output(every="1d", path=tmp_path / "run" / "snapshots", crs=None)
+    sim.run()
+    r = day_pair(tmp_path / "run", 0.0)
+    assert r["chance"] < 0.3
+    if moves:
+        assert r["overlap"] < 0.05
+    else:
+        assert r["overlap"] > 0.9 and r["spearman"] > 0.9
