@@ -2319,6 +2319,13 @@ add_months_20km("Pz-vcrj1-m20", "20 km, compressive term, Crouzeix-Raviart and z
 add_month_own_spinup("Pz-vcrj1-m10", PMAX + CR_KAPPA1 + ["rheology.bulk_shear_viscosity_ratio=0.9286"],
                      "neXtSIM's compressive term, Crouzeix-Raviart velocities (jump penalty 1), zeta/eta = 0.93, "
                      "own spin-up, meshed at domain.resolution_m")
+# Result (2026-11-29, 23:06 UTC): not a lead; the rule fails, and so does the prediction. Closed / strait: beta
+# 0.205 / 0.216 (in 0.14-0.23 in both), tails shear 4.36 / 2.77 and |div| 3.39 / 2.91, half-shear area 4.8 / 4.1 %
+# (inside), R2 0.594 / 0.629, rate 0.0121 / 0.0103 per day (inside; x1.53 / x1.21), wind factor 0.0065 / 0.0070
+# (inside both; x1.23 / x1.21), 856 / 923 remeshes: 2 + 2 bands inside against the reference's 3 + 2. The closed
+# basin's shear tail went 1.73 lighter (predicted 0.1-0.4) and its R2 fell by 0.066. 3862 / 3958 s on one thread,
+# two at a time. The same session found the Crouzeix-Raviart runs' statistics to be mostly the mesh's
+# (cr_node_motion.py), so these numbers describe the node motion of a non-conforming field.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
