@@ -9,8 +9,8 @@ are alike and the PDF tail gets lighter. This script measures how much of each d
 where the previous day's fell.
 
 For every pair of consecutive days (k → k+1, k+1 → k+2) of a run's daily snapshots it follows the
-elements of day k's mesh whose three nodes still exist at days k+1 and k+2 (by ``node_id``, as
-:func:`lagice.io.snapshots.load_window` does), keeps those whose centroid lies at least 100 km from
+elements of day k's mesh whose three nodes still exist at days k+1 and k+2 (by ``node_id``, with
+:func:`lagice.io.snapshots.load_window`), keeps those whose centroid lies at least 100 km from
 the boundary (the published windows' buffer), and computes each day's Lagrangian shear rate
 (:func:`lagice.diagnostics.strain.lagrangian_velocity_gradients`, mid-day geometry). Then:
 
@@ -38,13 +38,12 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import xarray as xr
 from scipy.stats import rankdata, spearmanr
 
 from lagice.diagnostics.faults import interior_triangles
 from lagice.diagnostics.strain import lagrangian_velocity_gradients, shear_rate, triangle_geometry
 from lagice.errors import ConfigError
-from lagice.io.snapshots import read_index, snapshot_dir
+from lagice.io.snapshots import load_window, read_index
 
 ROOT = Path(__file__).resolve().parents[1]
 RUNS = ROOT / "benchmarks" / "out" / "physics"
@@ -60,29 +59,6 @@ BUFFER_M = 100e3
 SHARE = 0.5
 
 
-def _snapshot(run_dir: Path, day: float):
-    """(positions (n, 2) m, node ids (n,), triangles (m, 3)) of the snapshot nearest ``day``;
-    ConfigError when none lies within an hour of it."""
-    idx = read_index(run_dir)
-    times = np.array([e["time_s"] for e in idx])
-    i = int(np.argmin(np.abs(times - day * DAY_S)))
-    if abs(times[i] - day * DAY_S) > 3600.0:
-        raise ConfigError(f"{run_dir}: no snapshot within an hour of day {day:g}")
-    with xr.open_dataset(snapshot_dir(run_dir) / idx[i]["file"], decode_times=False) as ds:
-        if "node_id" not in ds:
-            raise ConfigError(f"{run_dir}: snapshot {idx[i]['file']} has no node_id to follow nodes by")
-        return (np.column_stack([ds["mesh_node_x"].values, ds["mesh_node_y"].values]),
-                ds["node_id"].values.astype(np.int64), ds["mesh_face_nodes"].values.astype(np.int64))
-
-
-def _positions_of(ids: np.ndarray, xy: np.ndarray, ids_there: np.ndarray):
-    """Positions at another snapshot of the nodes ``ids`` (NaN where a remesh removed one)."""
-    order = np.argsort(ids_there)
-    pos = np.minimum(np.searchsorted(ids_there[order], ids), ids_there.size - 1)
-    found = ids_there[order][pos] == ids
-    return np.where(found[:, None], xy[order[pos]], np.nan)
-
-
 def band_set(rate: np.ndarray, area: np.ndarray, share: float = SHARE) -> np.ndarray:
     """Mask of the fastest elements that hold ``share`` of Σ rate·area (the element that crosses
     the share included)."""
@@ -96,9 +72,11 @@ def band_set(rate: np.ndarray, area: np.ndarray, share: float = SHARE) -> np.nda
 
 def day_pair(run_dir: Path, day: float) -> dict:
     """The persistence measures of days ``day`` → ``day`` + 1 → ``day`` + 2."""
-    xy0, ids0, tri = _snapshot(run_dir, day)
-    xy1 = _positions_of(ids0, *_snapshot(run_dir, day + 1)[:2])
-    xy2 = _positions_of(ids0, *_snapshot(run_dir, day + 2)[:2])
+    one, two = (load_window(run_dir, day * DAY_S, (day + k) * DAY_S) for k in (1, 2))
+    for w, k in ((one, 1), (two, 2)):
+        if abs(w["end_s"] - (day + k) * DAY_S) > 3600.0 or abs(w["start_s"] - day * DAY_S) > 3600.0:
+            raise ConfigError(f"{run_dir}: no snapshots within an hour of days {day:g} and {day + k:g}")
+    (xy0, tri), xy1, xy2 = one["start_mesh"], one["start_nodes_at_end"], two["start_nodes_at_end"]
     inside = interior_triangles(xy0, tri, BUFFER_M)
     followed = np.all(np.isfinite(xy1[tri]).all(axis=2) & np.isfinite(xy2[tri]).all(axis=2), axis=1)
     sub = tri[inside & followed]

@@ -41,7 +41,9 @@ the two fields are compared with each other, not with the observed bands.
     NUMBA_NUM_THREADS=2 python benchmarks/cr_node_motion.py --statistics --steps 1440 --variants cr \
         --set rheology.max_pressure_pa=10e3 --set rheology.max_pressure_thickness_exponent=1.5 \
         --set initial.state_file=benchmarks/out/physics/spinup-H1125-P-vcrj1-m10.npz \
-        --json docs/figures/cr_rate_statistics.json
+        --json benchmarks/out/cr_stats/cr.json
+    python benchmarks/cr_node_motion.py --statistics --from-json benchmarks/out/cr_stats/*.json \
+        --summary-json docs/figures/cr_rate_statistics.json
 """
 from __future__ import annotations
 
@@ -243,8 +245,7 @@ def run_statistics(name: str, sim, steps: int, block: int, fit: bool = False) ->
                    "n_interior": int(inside.sum())}
             row["rheology"] = block_statistics(mesh.nodes, mesh.triangles, inside, acc / block)
             row["mesh"] = block_statistics(mesh.nodes, mesh.triangles, inside, acc_mesh / block)
-            if fit:
-                b, c, _ = shape_gradients(mesh.nodes, mesh.triangles)
+            if fit:  # b, c: this step's geometry, the one the block's statistics use
                 u_fit = strain_fit(mesh.nodes, mesh.triangles, acc / block, st.nodes.fixed, st.transport_velocity)
                 row["fit"] = block_statistics(mesh.nodes, mesh.triangles, inside,
                                               strain_rate(mesh.triangles, b, c, u_fit))

@@ -766,11 +766,10 @@ def test_rotation_summary_carries_the_ensemble_verdicts_and_their_intervals():
     assert "ensemble_turn" not in rotation_test_summary({})
 
 
-def test_band_set_holds_the_share_and_nodes_are_followed_by_their_ids():
+def test_band_set_holds_the_share_of_the_shear():
     """benchmarks/band_persistence.py: the fastest elements that hold half of Σ rate·area (the one
-    that crosses the share included), and positions at another snapshot found by node id, NaN
-    where a remesh removed the node."""
-    from band_persistence import _positions_of, band_set
+    that crosses the share included)."""
+    from band_persistence import band_set
 
     area = np.ones(6)
     assert band_set(np.array([1.0, 10.0, 1.0, 1.0, 1.0, 1.0]), area).tolist() == [False, True] + [False] * 4
@@ -779,10 +778,6 @@ def test_band_set_holds_the_share_and_nodes_are_followed_by_their_ids():
     # the set is taken by rate, and an element's share of the shear is rate × area
     assert band_set(np.array([3.0, 2.0, 1.0]), np.ones(3)).tolist() == [True, False, False]
     assert band_set(np.array([3.0, 2.0, 1.0]), np.array([1.0, 4.0, 1.0])).tolist() == [True, True, False]
-    ids_there = np.array([7, 3, 5])
-    xy_there = np.array([[70.0, 0.0], [30.0, 0.0], [50.0, 0.0]])
-    got = _positions_of(np.array([3, 4, 7]), xy_there, ids_there)
-    assert got[0].tolist() == [30.0, 0.0] and got[2].tolist() == [70.0, 0.0] and np.isnan(got[1]).all()
 
 
 def test_turn_figure_keeps_the_published_name_for_the_published_variants_only():
