@@ -2327,6 +2327,34 @@ add_month_own_spinup("Pz-vcrj1-m10", PMAX + CR_KAPPA1 + ["rheology.bulk_shear_vi
 # two at a time. The same session found the Crouzeix-Raviart runs' statistics to be mostly the mesh's
 # (cr_node_motion.py), so these numbers describe the node motion of a non-conforming field.
 
+# --- 2026-11-29/30 (fortieth session): broken ice that keeps some viscosity, not cohesion ----------------
+# Written 2026-11-29 23:29 UTC, before the runs. With the effective envelope (EFFECTIVE) broken ice keeps no
+# cohesion, beta and the rate come into their bands, but the floes drift almost freely (wind factor 0.013):
+# in the storm window broken ice (damage 0.986) has a relaxation time lambda0 (1 - d)^(alpha - 1) of 27 s and
+# a viscosity E0 lambda0 (1 - d)^alpha 4e-8 of intact ice's, so the friction the envelope keeps never acts.
+# The damage cap 0.9 bound the floes (wind factor 0.0072) but gave broken ice back a tenth of its cohesion
+# and stiffness too, and beta fell to 0.049. Dansereau et al. (2016, "A Maxwell elasto-brittle rheology for
+# sea ice modelling", Sect. 3.1.5) set alpha = 4 and bound it below only by alpha > 2 (inertia negligible
+# once damage is large); Astrom and Benn (2019, "Effective rheology across the fragmentation transition for
+# sea ice and ice shelves") find the viscosity of fragmented ice 3-5 orders of magnitude below intact ice's,
+# not vanishing. A smaller alpha keeps broken ice viscous (at d = 0.986: x71 at alpha = 3, x600 at 2.5)
+# without any cohesion: does the drift slow while beta stays? 20 km, closed basin, the validation month,
+# each from its own 20 km spin-up, the current code (meshed at domain.resolution_m, strength_after_remesh
+# "new"): the reference eff-m20 (the effective envelope, alpha = 4) and the candidates eff-a3-m20 (alpha =
+# 3) and eff-a25-m20 (alpha = 2.5), both calibrations inside Dansereau et al.'s range, not sourced values.
+# (M) the mechanism: the wind factor (drift_response.py) falls from the reference to alpha = 3 to 2.5.
+# (L) a lead for the 10 km months: a candidate with the wind factor in 0.006-0.010, beta in 0.14-0.23 and
+#     at least 3 bands inside.
+# Predicted: (M) holds (wind factor about 0.013, 0.011, 0.009); (L) fails: as with the cap, the drift and
+#     beta move in opposite directions (alpha = 3: beta 0.14-0.18, 2 bands; alpha = 2.5: beta 0.10-0.14,
+#     1-2 bands), the tails stay lighter than observed.
+for _tag, _alpha in (("eff-m20", None), ("eff-a3-m20", "3"), ("eff-a25-m20", "2.5")):
+    add_screen_20km(_tag, EFFECTIVE + ([] if _alpha is None else [f"rheology.alpha={_alpha}"]),
+                    "20 km: the envelope judges the effective stress sigma/(1 - d)"
+                    + ("" if _alpha is None else f", alpha = {_alpha} (broken ice keeps some viscosity)")
+                    + ", own spin-up, meshed at domain.resolution_m")
+
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
