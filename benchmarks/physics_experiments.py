@@ -2353,6 +2353,17 @@ for _tag, _alpha in (("eff-m20", None), ("eff-a3-m20", "3"), ("eff-a25-m20", "2.
                     "20 km: the envelope judges the effective stress sigma/(1 - d)"
                     + ("" if _alpha is None else f", alpha = {_alpha} (broken ice keeps some viscosity)")
                     + ", own spin-up, meshed at domain.resolution_m")
+# Result (2026-11-29, 23:34 UTC): (M) fails and (L) fails; the prediction was wrong on the drift. Reference /
+# alpha = 3 / alpha = 2.5: wind factor 0.0132 / 0.0135 / 0.0136 (R2 0.94-0.95), beta 0.240 / 0.256 / 0.288,
+# tails shear 4.35 / 4.60 / 5.42 and |div| 4.44 / 4.78 / 4.76, half-shear area 13.4 / 15.9 / 17.2 %, R2 0.563 /
+# 0.479 / 0.449, rate 0.0269 / 0.0287 / 0.0342 per day, 309 / 363 / 453 remeshes: 1 band inside in each (the
+# rate). Why (beta_vs_damage.py --contrast 9, the storm): the active 5 % of the interior sits at damage 0.987 /
+# 0.998 / 1.000 and the rest at 0.969 / 0.994 / 0.999, with load ratios 0.00-0.02. Under the effective envelope
+# a loaded element's damage grows until its stress fits C (1 - d): a broken element made more viscous carries
+# more stress, so it breaks further, and at the damage it reaches its viscosity is lower, not higher: eta/eta0
+# = (1 - d)^alpha is 2.9e-8 in the reference's active band (d = 0.987), 8e-9 at alpha = 3 (d = 0.998) and at
+# most 6e-9 at alpha = 2.5 (d >= 0.9995). The drift is set by the envelope's residual strength, not by the
+# viscosity of broken ice. The 10 km runs are not made.
 
 
 def command(scene, overrides, res, days, out) -> list:

@@ -865,3 +865,41 @@ def test_band_persistence_tells_a_band_that_stays_from_one_that_moves(tmp_path, 
         assert r["overlap"] < 0.05
     else:
         assert r["overlap"] > 0.9 and r["spearman"] > 0.9
+
+
+def test_drift_beta_plane_families_points_and_counts():
+    """drift_beta_plane.py: a run's family is the first rule its overrides meet (Crouzeix–Raviart
+    before the effective envelope it may also carry; the nominal set catches the rest); only runs
+    with both a median β and a wind-factor fit become points; the summary counts the runs inside
+    each band and inside both."""
+    from drift_beta_plane import family_of, plane_points, summary
+
+    assert family_of(["initial.state_file=x.npz"]) == "nominal"
+    assert family_of(["solver.name=evp", "rheology.law=viscous_plastic"]) == "evp"
+    assert family_of(["rheology.failure_stress=effective", "rheology.alpha=3"]) == "effective"
+    assert family_of(["rheology.failure_stress=effective", "solver.velocity_element=crouzeix_raviart"]) == \
+        "crouzeix_raviart"
+    assert family_of(["rheology.max_pressure_pa=10e3"]) == "pressure"
+    assert family_of(["rheology.relax_mean_stress=false", "solver.volumetric_strain=nodal"]) == "nodal"
+    assert family_of(["rheology.damage_nonlocal_radius_m=14e3"]) == "nonlocal"
+    assert family_of(["rheology.damage_nonlocal_radius_m=0"]) == "nominal"
+
+    def rec(beta, overrides, inside):
+        return {"median": {"beta_space": beta}, "overrides": overrides, "resolution_m": 20e3,
+                "inside": {f"k{i}": i < inside for i in range(6)}}
+
+    records = {"a": rec(0.18, ["rheology.failure_stress=effective"], 2),   # β in, drift out
+               "b": rec(0.19, ["solver.velocity_element=crouzeix_raviart"], 3),  # both in
+               "c": rec(0.05, [], 4),                                            # drift in, β out
+               "d": rec(0.19, [], 1)}                                            # no fit: left out
+    fits = {"observed_thorndike_colony_1982_winter": {"factor": [0.006, 0.010]},
+            "a": {"fit": {"factor": 0.013}}, "b": {"fit": {"factor": 0.007}}, "c": {"fit": {"factor": 0.008}},
+            "e": {"fit": {"factor": 0.008}}}                                     # no record: left out
+    points = plane_points(records, fits)
+    assert sorted(p["name"] for p in points) == ["a", "b", "c"]
+    assert {p["name"]: p["bands_inside"] for p in points} == {"a": 2, "b": 3, "c": 4}
+    s = summary(points)
+    assert s["effective"]["beta_in_band"] == 1 and s["effective"]["wind_factor_in_band"] == 0
+    assert s["crouzeix_raviart"]["both_in_band_runs"] == ["b"]
+    assert s["nominal"]["both_in_band"] == 0 and s["nominal"]["wind_factor_in_band"] == 1
+    assert s["nominal"]["most_bands_inside"] == 4
