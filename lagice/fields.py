@@ -85,6 +85,9 @@ FIELDS: dict[str, FieldSpec] = {f.name: f for f in (
     FieldSpec("strength_factor", ELEMENT, "1",
               "spatially correlated strength factor (multiplies the cohesion; carried by the ice)",
               valid_min=0.0, optional=True),
+    FieldSpec("strain_accumulated", ELEMENT, "1",
+              "time integral of the strain rate the rheology used, since counters['strain_accumulated_since_s'] "
+              "(output.accumulate_strain)", components=("xx", "yy", "xy"), optional=True),
 )}
 
 

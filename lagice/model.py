@@ -21,7 +21,7 @@ import numpy as np
 from .budget import VolumeLedger
 from .clock import Clock
 from .components import ORDER
-from .errors import ConfigError
+from .errors import ConfigError, SolverError
 from .fields import FIELDS, checkpoint_arrays
 from .mesh import Mesh
 from .rheology import RHEOLOGIES, MaxwellEB
@@ -95,6 +95,9 @@ class Model:
         #: (transport velocity, strain rate) of the step that ended with a remesh, on the new
         #: mesh (:meth:`set_remeshed_transport`): the stepper dropped its own with the old mesh
         self._remeshed_transport = None
+        #: add Δt × the stepper's strain rate to ``state.strain_accumulated`` every step
+        #: (``output.accumulate_strain``; :meth:`step`)
+        self.accumulate_strain = False
 
     # -- the pieces ----------------------------------------------------------------
     @property
@@ -186,6 +189,7 @@ class Model:
         t1 = time.perf_counter()
         self.timings["dynamics"] += t1 - t0
         report = {"solver": info}
+        self._accumulate_strain(dt_s)
         if not np.all(np.isfinite(self.transport_velocity)):
             # the dynamics blew up: components must not consume a non-finite velocity
             # (mesh motion, gmsh); the simulation's NaN checker names the field and place
@@ -201,6 +205,31 @@ class Model:
         self.clock.tick(dt_s)
         self.last_report = report
         return report
+
+    def _accumulate_strain(self, dt_s: float) -> None:
+        """``state.strain_accumulated`` += Δt × the strain rate the stepper's rheology used over
+        the step (m, 3) [-], on the mesh before it moves (``output.accumulate_strain``). With
+        linear velocities it is the strain rate of the velocity that moves the nodes; with
+        Crouzeix–Raviart velocities it is the elements' own, which the nodes follow only in the
+        mean (docs/solvers.md, "What the mesh follows"), so a window's statistics can be taken
+        from both (``benchmarks/window_split.py``). Remeshing remaps it as an area-weighted mean
+        (∫ strain da is kept). The accumulation starts at the first step that asks for it
+        (``counters["strain_accumulated_since_s"]``, also after a resume from a checkpoint
+        without the field); a run that stops asking drops the field."""
+        st = self.state
+        if not self.accumulate_strain:
+            if st.strain_accumulated is not None:
+                st.strain_accumulated = None
+                st.counters.pop("strain_accumulated_since_s", None)
+            return
+        eps = self.stepper.last_strain_rate
+        if eps is None or len(eps) != self.mesh.n_elements:
+            raise SolverError(f"output.accumulate_strain: the {type(self.stepper).__name__} stepper reported no strain "
+                              f"rate for this mesh at step {self.clock.iteration}")
+        if st.strain_accumulated is None:
+            st.strain_accumulated = np.zeros((self.mesh.n_elements, 3))
+            st.counters["strain_accumulated_since_s"] = float(self.clock.time_s)
+        st.strain_accumulated += dt_s * np.asarray(eps, np.float64)
 
     def volume_budget(self) -> dict:
         """Ice volume budget [m³]: V(t) − V(0) = thermodynamic change − outflow + residual.

@@ -23,6 +23,9 @@ class IceState:
     ``snow`` hs snow volume per unit area [m]. ``strength_factor`` g [-]: the
     spatially correlated part of the strength (:mod:`lagice.strength`), carried by
     the ice and remapped like the other element fields; ``None`` without one.
+    ``strain_accumulated`` (m, 3) [-]: the time integral of the strain rate the
+    rheology used (ε̇xx, ε̇yy, ε̇xy; ``output.accumulate_strain``, :meth:`lagice.model.Model.step`),
+    remapped like the other element fields; ``None`` when not asked for.
     ``node_id`` (n,) int64: persistent node identifiers. Remeshing keeps the
     identifiers of the nodes it keeps and gives new nodes new ones
     (``counters["next_node_id"]``), so Lagrangian diagnostics can follow the
@@ -40,6 +43,7 @@ class IceState:
     snow: np.ndarray | None = None
     node_id: np.ndarray | None = None
     strength_factor: np.ndarray | None = None
+    strain_accumulated: np.ndarray | None = None
     counters: dict = field(default_factory=dict)
 
     @classmethod

@@ -147,6 +147,57 @@ def window_summary(run_dir, start_s: float, window_s: float, coast_buffer_m: flo
     return out
 
 
+def accumulated_strain_rates(run_dir, start_s: float, end_s: float, coast_buffer_m: float = 0.0):
+    """The mean strain rate the rheology used over a window, from the snapshots' accumulated
+    strain (``output.accumulate_strain``), on the triangles :func:`window_arrays` follows.
+
+    For each followed triangle, the accumulated strain S (ε̇xx, ε̇yy, ε̇xy integrated in time) at
+    the window's end is the area-weighted mean of the end snapshot's S over the triangle's end
+    position (:func:`lagice.remesh.remap.intersect_triangles`: exact for an element that is still
+    an element at the end; for one whose nodes survived a remesh around it, the mean of the
+    elements that now cover it), and its S at the start is the start snapshot's. Their
+    difference over the window's length is the rheology's mean strain rate [s⁻¹].
+
+    Returns ``(node_rates, rheology_rates, info)``: two
+    :class:`~lagice.diagnostics.strain.ElementStrainRates` of the same triangles on their
+    mid-window geometry (the node motion's Lagrangian gradient, as :func:`window_summary`
+    takes it; and the symmetric gradient ``[[ε̇xx, ε̇xy], [ε̇xy, ε̇yy]]`` of the rheology's rate,
+    which has the same divergence and maximum shear), and :func:`window_arrays`'s ``info``.
+    Raises :class:`~lagice.errors.ConfigError` when a snapshot lacks the field or the two
+    count it from different starts (a resume that switched it on inside the window)."""
+    from lagice.diagnostics.strain import ElementStrainRates, lagrangian_velocity_gradients, triangle_geometry
+    from lagice.io.snapshots import load_window
+    from lagice.remesh.remap import intersect_triangles, remap_field, remap_weights
+
+    xy0, xy1, tri, dt, info = window_arrays(run_dir, start_s, end_s, coast_buffer_m)
+    ds0, ds1 = load_window(run_dir, start_s, end_s)["datasets"]
+    names = [f"strain_accumulated_{c}" for c in ("xx", "yy", "xy")]
+    for ds, when in ((ds0, info["start_s"]), (ds1, info["end_s"])):
+        if any(n not in ds for n in names):
+            raise ConfigError(f"{run_dir}: the snapshot at {when / DAY_S:g} days has no accumulated strain; run the "
+                              f"scene with output.accumulate_strain = true")
+    s0, s1 = (ds.attrs.get("strain_accumulated_since_s") for ds in (ds0, ds1))
+    if s0 != s1:
+        raise ConfigError(f"{run_dir}: the accumulated strain of the window {info['start_s'] / DAY_S:g}-"
+                          f"{info['end_s'] / DAY_S:g} days starts at {s0} s in its first snapshot and at {s1} s in "
+                          f"its last (switched on by a resume inside the window); choose windows after it")
+    acc0 = np.column_stack([ds0[n].values[0] for n in names])[info["kept_elements"]]
+    acc1_mesh = np.column_stack([ds1[n].values[0] for n in names])
+    end_nodes = np.column_stack([ds1["mesh_node_x"].values, ds1["mesh_node_y"].values])
+    end_tri = ds1["mesh_face_nodes"].values.astype(np.int64)
+    i_old, j_new, w = intersect_triangles(end_nodes, end_tri, xy1, tri)
+    area_end = triangle_geometry(xy1, tri)[0]
+    weights = remap_weights(i_old, j_new, w, tri.shape[0], new_areas=area_end)
+    acc1 = remap_field(acc1_mesh, i_old, j_new, w, weights)
+    eps = (acc1 - acc0) / dt
+    nodes = lagrangian_velocity_gradients(xy0, xy1, tri, dt, geometry="mid")
+    grad = np.empty((tri.shape[0], 2, 2))
+    grad[:, 0, 0], grad[:, 1, 1] = eps[:, 0], eps[:, 1]
+    grad[:, 0, 1] = grad[:, 1, 0] = eps[:, 2]
+    rheo = ElementStrainRates(grad, nodes.area_m2, nodes.centroid_xy_m, nodes.bounds_m)
+    return nodes, rheo, info
+
+
 def window_starts_days(run_dir, window_days: float, start_day: float = 1.0, end_day: float | None = None):
     """Start days of the back-to-back windows of ``window_days`` from ``start_day`` that end
     by ``end_day`` (default: the last snapshot)."""

@@ -66,9 +66,11 @@ def snapshot_dataset(model, crs="EPSG:3413", start_date: str = "2000-01-01 00:00
         div, shear, tot = invariants(eps)
         for name, val in (("divergence_rate", div), ("shear_rate", shear), ("total_deformation_rate", tot)):
             ds[name] = (("time", "mesh_face"), val[None], cf_attrs(DIAGNOSTICS[name], gm))
+    since = ({"strain_accumulated_since_s": float(state.counters["strain_accumulated_since_s"])}
+             if state.strain_accumulated is not None and "strain_accumulated_since_s" in state.counters else {})
     ds.attrs.update(provenance(title, model.config, {
         "Conventions": CONVENTIONS_UGRID, "step": int(model.clock.iteration),
-        "mesh_epoch": int(state.counters.get("mesh_epoch", 0)), **(extra or {})}))
+        "mesh_epoch": int(state.counters.get("mesh_epoch", 0)), **since, **(extra or {})}))
     return ds
 
 

@@ -876,10 +876,15 @@ def build_model(cfg: dict, validated: bool = False) -> Model:
         # activity, a checkpoint or a remesh reads it (Model.needs_host_state, docs/gpu.md)
         solver = CudaExplicitSolver(rheo, mesh, bcs=bcs, forces=parts["forces"], heal_rate=heal, sync="explicit",
                                     **opts)
-    return Model(state, rheology=rheo, solver=solver, solver_options=opts, bcs=bcs,
-                 forces=parts["forces"], thermo=parts["thermo"], healing=parts["healing"],
-                 mover=parts["mover"], remesher=parts["remesher"], drifters=build_drifters(cfg, poly),
-                 config=cfg, fingerprint_config=physics_view(cfg), rng=rng)
+    model = Model(state, rheology=rheo, solver=solver, solver_options=opts, bcs=bcs,
+                  forces=parts["forces"], thermo=parts["thermo"], healing=parts["healing"],
+                  mover=parts["mover"], remesher=parts["remesher"], drifters=build_drifters(cfg, poly),
+                  config=cfg, fingerprint_config=physics_view(cfg), rng=rng)
+    model.accumulate_strain = bool(cfg["output"]["accumulate_strain"])
+    if model.accumulate_strain:  # zeros from the start, so the first snapshot holds the field
+        model.state.strain_accumulated = np.zeros((model.mesh.n_elements, 3))
+        model.state.counters["strain_accumulated_since_s"] = float(model.clock.time_s)
+    return model
 
 
 def build_drifters(cfg, poly):

@@ -129,7 +129,7 @@ SCHEMA = {
     "run": {"duration": (EXPR, None), "seed": (int, 0), "progress": (bool, True),
             "start_date": (str, "2000-01-01 00:00:00"), "max_speed_m_s": (NUM, 10.0)},
     "output": {"every": (EXPR, "1d"), "vtu": (bool, False), "plot": ((bool, str), True),
-               "grid_resolution_m": (NUM, None), "timeseries": (dict, None)},
+               "grid_resolution_m": (NUM, None), "timeseries": (dict, None), "accumulate_strain": (bool, False)},
     "checkpoint": {"every": (EXPR, None), "every_wall": (EXPR, None), "keep": (int, 3)},
     "drifters": {"positions_m": (list, None), "count": (int, 0)},
 }
