@@ -81,3 +81,23 @@ def test_accumulated_strain_through_remeshing_and_a_resume(tmp_path):
     # a window across the remeshes: every followed triangle gets the rheology's rate
     nodes, rheo, info = accumulated_strain_rates(tmp_path / "full", 0.0, 6000.0)
     assert info["remesh_events"] > 0 and np.all(np.isfinite(rheo.gradient_s))
+
+
+def test_accumulated_strain_switched_on_by_a_resume_counts_from_it(tmp_path):
+    """A run resumed with ``output.accumulate_strain`` from a checkpoint without the field counts
+    from the resume: the counter and the snapshots say so, and a window that begins before it is
+    refused by name, while one after it is split."""
+    from lagice.scenes.builder import resume_simulation
+
+    part = build_simulation(load_scene("shear_box", FAST), tmp_path / "run")
+    part.run(n_steps=20)  # checkpoint at step 20 (t = 800 s), no accumulated strain
+    assert part.model.state.strain_accumulated is None
+    del part
+    resumed = resume_simulation(tmp_path / "run" / "checkpoints", overrides={"output.accumulate_strain": True})
+    resumed.run()
+    st = resumed.model.state
+    assert st.counters["strain_accumulated_since_s"] == 800.0 and st.strain_accumulated is not None
+    with pytest.raises(ConfigError, match="no accumulated strain"):
+        accumulated_strain_rates(tmp_path / "run", 0.0, 1600.0)
+    nodes, rheo, _ = accumulated_strain_rates(tmp_path / "run", 800.0, 1600.0)
+    assert np.linalg.norm(rheo.shear_s - nodes.shear_s) < 1e-3 * np.linalg.norm(nodes.shear_s)

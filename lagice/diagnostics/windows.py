@@ -163,7 +163,9 @@ def accumulated_strain_rates(run_dir, start_s: float, end_s: float, coast_buffer
     mid-window geometry (the node motion's Lagrangian gradient, as :func:`window_summary`
     takes it; and the symmetric gradient ``[[ε̇xx, ε̇xy], [ε̇xy, ε̇yy]]`` of the rheology's rate,
     which has the same divergence and maximum shear), and :func:`window_arrays`'s ``info``.
-    Raises :class:`~lagice.errors.ConfigError` when a snapshot lacks the field or the two
+    A window that begins at the step from which the field counts (a resume that switched the
+    option on: the snapshot written then has no field) starts from zero. Raises
+    :class:`~lagice.errors.ConfigError` when a snapshot lacks the field otherwise, or the two
     count it from different starts (a resume that switched it on inside the window)."""
     from lagice.diagnostics.strain import ElementStrainRates, lagrangian_velocity_gradients, triangle_geometry
     from lagice.io.snapshots import load_window
@@ -172,16 +174,23 @@ def accumulated_strain_rates(run_dir, start_s: float, end_s: float, coast_buffer
     xy0, xy1, tri, dt, info = window_arrays(run_dir, start_s, end_s, coast_buffer_m)
     ds0, ds1 = load_window(run_dir, start_s, end_s)["datasets"]
     names = [f"strain_accumulated_{c}" for c in ("xx", "yy", "xy")]
-    for ds, when in ((ds0, info["start_s"]), (ds1, info["end_s"])):
-        if any(n not in ds for n in names):
+    has = [all(n in ds for n in names) for ds in (ds0, ds1)]
+    s1 = ds1.attrs.get("strain_accumulated_since_s")
+    # a resume that switched the option on counts from its first step: the snapshot written at
+    # that time (before the resume) has no field, and its value there is zero by definition
+    counts_from_start = has[1] and s1 is not None and float(s1) == info["start_s"]
+    for ok, when in ((has[0] or counts_from_start, info["start_s"]), (has[1], info["end_s"])):
+        if not ok:
             raise ConfigError(f"{run_dir}: the snapshot at {when / DAY_S:g} days has no accumulated strain; run the "
                               f"scene with output.accumulate_strain = true")
-    s0, s1 = (ds.attrs.get("strain_accumulated_since_s") for ds in (ds0, ds1))
+    s0 = ds0.attrs.get("strain_accumulated_since_s") if has[0] else s1
     if s0 != s1:
         raise ConfigError(f"{run_dir}: the accumulated strain of the window {info['start_s'] / DAY_S:g}-"
                           f"{info['end_s'] / DAY_S:g} days starts at {s0} s in its first snapshot and at {s1} s in "
                           f"its last (switched on by a resume inside the window); choose windows after it")
-    acc0 = np.column_stack([ds0[n].values[0] for n in names])[info["kept_elements"]]
+    kept = info["kept_elements"]
+    acc0 = (np.column_stack([ds0[n].values[0] for n in names])[kept] if has[0]
+            else np.zeros((len(kept), 3)))
     acc1_mesh = np.column_stack([ds1[n].values[0] for n in names])
     end_nodes = np.column_stack([ds1["mesh_node_x"].values, ds1["mesh_node_y"].values])
     end_tri = ds1["mesh_face_nodes"].values.astype(np.int64)
