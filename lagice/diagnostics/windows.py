@@ -46,7 +46,8 @@ WINDOW_KEYS = ("beta_space", "beta_space_stderr", "beta_space_r2", "beta_space_f
 RGPS_WINDOW_KEYS = tuple(k for k in WINDOW_KEYS if k not in ("pdf_shear", "pdf_divergence"))
 
 
-def window_arrays(run_dir, start_s: float, end_s: float, coast_buffer_m: float = 0.0, min_elements: int = 10):
+def window_arrays(run_dir, start_s: float, end_s: float, coast_buffer_m: float = 0.0, min_elements: int = 10,
+                  keep_datasets: bool = False):
     """Node positions at the snapshots nearest ``start_s`` and ``end_s`` [s] and the
     elements kept for the statistics.
 
@@ -57,7 +58,8 @@ def window_arrays(run_dir, start_s: float, end_s: float, coast_buffer_m: float =
     indexes ``triangles`` in the first mesh) plus ``interior``
     (mask of the triangles at least ``coast_buffer_m`` [m] from the boundary of the
     window's first mesh), ``n_elements`` (their number), ``n_elements_all``,
-    ``n_elements_folded`` and ``folded_elements`` (their indices in the first mesh).
+    ``n_elements_folded`` and ``folded_elements`` (their indices in the first mesh), and with
+    ``keep_datasets`` the two snapshots (``datasets``, as :func:`~lagice.io.snapshots.load_window`).
 
     The statistics take each element's gradient on its mid-window geometry
     ``(x0 + x1)/2`` (:mod:`lagice.diagnostics.strain`). The model keeps every element
@@ -100,6 +102,8 @@ def window_arrays(run_dir, start_s: float, end_s: float, coast_buffer_m: float =
                           f"from the boundary can be followed through the window ({w['remesh_events']} remesh "
                           f"event(s) replaced {w['n_elements_lost']} elements{folded}); choose other windows")
     info = {k: v for k, v in w.items() if k not in ("xy0", "xy1", "triangles", "datasets")}
+    if keep_datasets:  # the two snapshots as xarray Datasets (accumulated_strain_rates reads their fields)
+        info["datasets"] = w["datasets"]
     info.update(kept_elements=kept, n_elements=int(keep.sum()), n_elements_all=int(tri.shape[0]), interior=keep,
                 n_elements_folded=n_folded, n_interior_folded=n_interior_folded, folded_elements=folded_elements)
     return xy0, xy1, tri, dt, info
@@ -168,11 +172,10 @@ def accumulated_strain_rates(run_dir, start_s: float, end_s: float, coast_buffer
     :class:`~lagice.errors.ConfigError` when a snapshot lacks the field otherwise, or the two
     count it from different starts (a resume that switched it on inside the window)."""
     from lagice.diagnostics.strain import ElementStrainRates, lagrangian_velocity_gradients, triangle_geometry
-    from lagice.io.snapshots import load_window
     from lagice.remesh.remap import intersect_triangles, remap_field, remap_weights
 
-    xy0, xy1, tri, dt, info = window_arrays(run_dir, start_s, end_s, coast_buffer_m)
-    ds0, ds1 = load_window(run_dir, start_s, end_s)["datasets"]
+    xy0, xy1, tri, dt, info = window_arrays(run_dir, start_s, end_s, coast_buffer_m, keep_datasets=True)
+    ds0, ds1 = info.pop("datasets")
     names = [f"strain_accumulated_{c}" for c in ("xx", "yy", "xy")]
     has = [all(n in ds for n in names) for ds in (ds0, ds1)]
     s1 = ds1.attrs.get("strain_accumulated_since_s")
