@@ -58,7 +58,7 @@ import numpy as np
 from lagice.deformation import invariants
 from lagice.diagnostics.faults import interior_triangles
 from lagice.diagnostics.report import rate_statistics
-from lagice.diagnostics.strain import ElementStrainRates
+from lagice.diagnostics.strain import ElementStrainRates, symmetric_gradient
 from lagice.fem import shape_gradients, strain_rate
 from lagice.scenes.builder import build_simulation
 from lagice.scenes.config import load_scene
@@ -201,12 +201,8 @@ def block_statistics(xy, tri, inside, eps_mean: np.ndarray) -> dict:
     (m, 3: ε̇xx, ε̇yy, ε̇xy [s⁻¹]) on the mesh ``xy``, ``tri``. The gradient handed to the
     estimators is the symmetric one, which has the same divergence and maximum shear."""
     sub = tri[inside]
-    e = eps_mean[inside]
-    grad = np.empty((len(sub), 2, 2))
-    grad[:, 0, 0], grad[:, 1, 1] = e[:, 0], e[:, 1]
-    grad[:, 0, 1] = grad[:, 1, 0] = e[:, 2]
     _, _, area = shape_gradients(xy, sub)
-    rates = ElementStrainRates(grad, area, xy[sub].mean(axis=1),
+    rates = ElementStrainRates(symmetric_gradient(eps_mean[inside]), area, xy[sub].mean(axis=1),
                                np.array([xy[:, 0].min(), xy[:, 1].min(), xy[:, 0].max(), xy[:, 1].max()]))
     st, _ = rate_statistics(rates)
     return {k: float(st[k]) for k in STAT_KEYS}
@@ -260,13 +256,19 @@ def _medians(rows: list[dict], field: str) -> dict:
 
 
 def paired_differences(rows: list[dict], n_boot: int = 2000, a: str = "rheology", b: str = "mesh") -> dict:
-    """Per statistic: the median over the blocks of field ``a`` − field ``b``, a 90 % bootstrap
-    interval of that median (blocks resampled, seed 0), and the share of blocks where it is > 0."""
+    """Per statistic: the median over the blocks (or windows: ``window_split.py``) of field ``a`` −
+    field ``b``, a 90 % bootstrap interval of that median (rows resampled, seed 0), and the share
+    of rows where it is > 0. A statistic that is undefined (None or NaN) in a row leaves that row
+    out; one undefined in every row gets NaN."""
     rng = np.random.default_rng(0)
     out = {}
     for k in STAT_KEYS:
-        d = np.array([r[a][k] - r[b][k] for r in rows], dtype=float)
+        d = np.array([r[a][k] - r[b][k] for r in rows if r[a][k] is not None and r[b][k] is not None],
+                     dtype=float)
         d = d[np.isfinite(d)]
+        if d.size == 0:
+            out[k] = dict.fromkeys(("median", "low", "high", "share_positive"), float("nan"))
+            continue
         boot = np.median(rng.choice(d, (n_boot, d.size)), axis=1)
         out[k] = {"median": float(np.median(d)), "low": float(np.percentile(boot, 5)),
                   "high": float(np.percentile(boot, 95)), "share_positive": float(np.mean(d > 0))}

@@ -40,14 +40,17 @@ import json
 from pathlib import Path
 
 import numpy as np
+from validate import TARGETS
+
+from lagice.diagnostics.drift import THORNDIKE_COLONY_WINTER
 
 ROOT = Path(__file__).resolve().parents[1]
 RECORDS = ROOT / "docs" / "figures" / "physics_experiments.json"
 FITS = ROOT / "docs" / "figures" / "drift_response.json"
-#: observed bands (issue 12; sources in benchmarks/validate.py and lagice.diagnostics.drift)
-BETA_BAND = (0.17, 0.20)
-WIND_FACTOR_BAND = (0.006, 0.010)
-N_BANDS = 6
+#: observed bands, with their sources where they are declared (issue 12)
+BETA_BAND = tuple(TARGETS["beta_space"][:2])
+WIND_FACTOR_BAND = tuple(THORNDIKE_COLONY_WINTER["factor"])
+N_BANDS = len(TARGETS)
 
 #: (key, label, rule): a run belongs to the first family whose rule holds for its overrides
 #: (a dict key -> value string)

@@ -17,7 +17,7 @@ statistics use) and the rheology's mean rates (the difference of the accumulated
 window's ends). The same estimators (:func:`lagice.diagnostics.report.rate_statistics`) are applied
 to both, on the elements at least 100 km from the coast, and the medians over the windows are set
 side by side with the window-by-window differences (rheology minus nodes; 90 % bootstrap interval
-of their median).
+of their median and the share of windows where it is positive: ``cr_node_motion.paired_differences``).
 
     python benchmarks/window_split.py F10-hthick-m10-acc F10-hthick-P-vcrj1-m10-acc
     python benchmarks/window_split.py --from-json docs/figures/window_split.json   # the table again
@@ -26,19 +26,19 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from pathlib import Path
 
 import numpy as np
 
+# the one-hour blocks' statistics, coast buffer and paired differences, for the windows
+from cr_node_motion import BUFFER_M, paired_differences
+from cr_node_motion import STAT_KEYS as KEYS
+
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 RUNS = ROOT / "benchmarks" / "out" / "physics"
 DAY_S = 86400.0
-#: the published windows: 3 days from day 1, 100 km from the coast
-WINDOW_DAYS, START_DAY, BUFFER_M = 3.0, 1.0, 100e3
-KEYS = ("beta_space", "pdf_tail_exponent_shear", "pdf_tail_exponent_divergence",
-        "localisation_half_shear_area_fraction", "shear_divergence_r2", "mean_total_s")
+#: the published windows: 3 days from day 1 (100 km from the coast: BUFFER_M)
+WINDOW_DAYS, START_DAY = 3.0, 1.0
 SHORT = {"beta_space": "β", "pdf_tail_exponent_shear": "shear tail", "pdf_tail_exponent_divergence": "|div| tail",
          "localisation_half_shear_area_fraction": "half-shear area", "shear_divergence_r2": "R²",
          "mean_total_s": "⟨ε̇tot⟩ day⁻¹"}
@@ -73,24 +73,11 @@ def _median(rows: list[dict], part: str, key: str) -> float:
     return float(np.nanmedian(v)) if np.isfinite(v).any() else float("nan")
 
 
-def differences(rows: list[dict], key: str, n_boot: int = 2000, seed: int = 0) -> dict:
-    """Median over the windows of rheology − nodes for ``key``, with a 90 % bootstrap interval."""
-    d = np.array([r["rheology"][key] - r["nodes"][key] for r in rows
-                  if r["rheology"][key] is not None and r["nodes"][key] is not None], float)
-    d = d[np.isfinite(d)]
-    if d.size == 0:
-        return {"median": float("nan"), "ci90": [float("nan"), float("nan")], "n": 0}
-    rng = np.random.default_rng(seed)
-    boot = np.median(rng.choice(d, (n_boot, d.size)), axis=1)
-    return {"median": float(np.median(d)), "ci90": [float(np.percentile(boot, 5)), float(np.percentile(boot, 95))],
-            "n": int(d.size)}
-
-
 def summary(rows: list[dict]) -> dict:
     return {"windows": len(rows),
             "nodes": {k: _median(rows, "nodes", k) for k in KEYS},
             "rheology": {k: _median(rows, "rheology", k) for k in KEYS},
-            "difference": {k: differences(rows, k) for k in KEYS}}
+            "difference": paired_differences(rows, a="rheology", b="nodes")}
 
 
 def table(results: dict) -> str:
@@ -112,8 +99,8 @@ def table(results: dict) -> str:
         for k in KEYS:
             d = s["difference"][k]
             scale = DAY_S if k == "mean_total_s" else (100.0 if k == "localisation_half_shear_area_fraction" else 1.0)
-            cells.append("–" if d["n"] == 0 else
-                         f"{d['median'] * scale:+.3f} [{d['ci90'][0] * scale:+.3f}, {d['ci90'][1] * scale:+.3f}]")
+            cells.append("–" if d["median"] != d["median"] else
+                         f"{d['median'] * scale:+.3f} [{d['low'] * scale:+.3f}, {d['high'] * scale:+.3f}]")
         out.append(f"| {name} | rheology − nodes | | " + " | ".join(cells) + " |")
     return "\n".join(out)
 

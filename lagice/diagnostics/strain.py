@@ -103,6 +103,18 @@ def total_deformation_rate(gradient_s):
     return np.hypot(divergence_rate(gradient_s), shear_rate(gradient_s))
 
 
+def symmetric_gradient(strain_rate_s):
+    """The gradient ``[[ε̇xx, ε̇xy], [ε̇xy, ε̇yy]]`` (m, 2, 2) [s-1] of a strain rate (m, 3)
+    (ε̇xx, ε̇yy, ε̇xy, tensor shear component): it has the strain rate's divergence and maximum
+    shear (no vorticity), so the estimators of :class:`ElementStrainRates` apply to a strain rate
+    the model gives per element (the rheology's, ``output.accumulate_strain``)."""
+    e = np.asarray(strain_rate_s, np.float64)
+    grad = np.empty((e.shape[0], 2, 2))
+    grad[:, 0, 0], grad[:, 1, 1] = e[:, 0], e[:, 1]
+    grad[:, 0, 1] = grad[:, 1, 0] = e[:, 2]
+    return grad
+
+
 def triangle_geometry(nodes_xy, triangles):
     """Signed areas (m²) and centroids (m) of triangles; arrays may have leading batch dims.
 

@@ -171,7 +171,12 @@ def accumulated_strain_rates(run_dir, start_s: float, end_s: float, coast_buffer
     option on: the snapshot written then has no field) starts from zero. Raises
     :class:`~lagice.errors.ConfigError` when a snapshot lacks the field otherwise, or the two
     count it from different starts (a resume that switched it on inside the window)."""
-    from lagice.diagnostics.strain import ElementStrainRates, lagrangian_velocity_gradients, triangle_geometry
+    from lagice.diagnostics.strain import (
+        ElementStrainRates,
+        lagrangian_velocity_gradients,
+        symmetric_gradient,
+        triangle_geometry,
+    )
     from lagice.remesh.remap import intersect_triangles, remap_field, remap_weights
 
     xy0, xy1, tri, dt, info = window_arrays(run_dir, start_s, end_s, coast_buffer_m, keep_datasets=True)
@@ -203,10 +208,7 @@ def accumulated_strain_rates(run_dir, start_s: float, end_s: float, coast_buffer
     acc1 = remap_field(acc1_mesh, i_old, j_new, w, weights)
     eps = (acc1 - acc0) / dt
     nodes = lagrangian_velocity_gradients(xy0, xy1, tri, dt, geometry="mid")
-    grad = np.empty((tri.shape[0], 2, 2))
-    grad[:, 0, 0], grad[:, 1, 1] = eps[:, 0], eps[:, 1]
-    grad[:, 0, 1] = grad[:, 1, 0] = eps[:, 2]
-    rheo = ElementStrainRates(grad, nodes.area_m2, nodes.centroid_xy_m, nodes.bounds_m)
+    rheo = ElementStrainRates(symmetric_gradient(eps), nodes.area_m2, nodes.centroid_xy_m, nodes.bounds_m)
     return nodes, rheo, info
 
 
