@@ -2408,6 +2408,42 @@ for _name in ("F10-hthick-P-vcrj1-m10", "F10s-hthick-P-vcrj1-m10", "B20-hthick-P
                                    _rest[2] + "; with the rheology's accumulated strain in the snapshots")
 
 
+
+# --- 2026-11-30 (forty-first session): a frictional rubble with neXtSIM's ridging cap, and stronger floes --
+# Written 2026-11-30 01:49 UTC, before the runs. Over 300 runs (drift_beta_plane.py) beta comes into its band
+# only where broken ice holds nothing (the effective envelope: wind factor 0.013, near free drift 0.015) or
+# where the statistics are the mesh's; a residual strength given back as cohesion and stiffness (the damage
+# cap) binds the floes and spreads the shear. Two untried ways to resist the wind without cohesion in the
+# bands:
+#   effP-vcrj1-m20-acc: the effective envelope (no cohesion after failure, friction kept) with broken ice that
+#     keeps its pressure below neXtSIM's P_max (PMAX, sourced), on Crouzeix-Raviart velocities (kappa = 1), so
+#     the kept pressure is not locked by the mesh. A Mohr-Coulomb rubble with a ridging cap, as in plastic
+#     models. On linear velocities the same physics (B20-hthick-effP) drifted as freely as the effective
+#     envelope alone, and the mean stress kept without a cap (effK-vcrj) locked (wind factor 0.0018). Its
+#     statistics are judged on the rheology's own strain (window_split.py), since the node motion of this
+#     element is not the ice's (thirty-ninth and fortieth sessions).
+#   eff-C15-m20, eff-C2-m20: the effective envelope with the intact ice 1.5 and 2 times stronger
+#     (rheology.strength_lab_pa 4.2 and 5.6 MPa; calibrations, the first the +50 % of the sensitivity
+#     table). Fewer bands break, so the floes may interlock; linear velocities.
+# 20 km, closed basin, the validation month, own 20 km spin-ups, the current code; references eff-m20 (wind
+# factor 0.0132, beta 0.240, tails 4.35 / 4.44, half-shear area 13.4 %, 1 band) and effK-vcrj.
+# (M1) the cap unlocks the rubble: effP-vcrj1's wind factor at least 2x effK-vcrj's (above 0.0036).
+# (M2) the rubble resists: effP-vcrj1's wind factor below 0.010.
+# (M3) stronger floes interlock: the wind factor falls from eff-m20 to C15 to C2, and C2's is at most 0.0106
+#      (-20 %); the shear tail falls (heavier) by at least 0.5 at C2.
+# (L) a lead for the 10 km months: wind factor in 0.006-0.010, beta in 0.14-0.23 and at least 3 bands inside,
+#     by the rheology's own strain for effP-vcrj1 and by the node motion (the same, linear) for the others.
+# Predicted: (M1) holds, (M2) holds (wind factor 0.004-0.008), beta by the rheology's strain 0.08-0.14 (its
+#     nodes' 0.20-0.30), 1-2 bands; (M3) fails: the drift is set by the bands' residual strength, which stays
+#     0 (wind factor 0.012-0.013); the tails heavier by 0.3-0.8; beta 0.20-0.30; (L) fails for all three.
+add_screen_20km("effP-vcrj1-m20-acc", EFFECTIVE + PMAX + CR_KAPPA1 + ACCUMULATE,
+                "20 km: effective envelope, neXtSIM's compressive term, Crouzeix-Raviart velocities with the jump "
+                "penalty 1, own spin-up, the rheology's accumulated strain in the snapshots")
+for _tag, _c in (("eff-C15-m20", "4.2e6"), ("eff-C2-m20", "5.6e6")):
+    add_screen_20km(_tag, EFFECTIVE + [f"rheology.strength_lab_pa={_c}"],
+                    f"20 km: the envelope judges the effective stress sigma/(1 - d), C_lab {_c} Pa (intact ice "
+                    f"{float(_c) / 2.8e6:g} x stronger; a calibration), own spin-up")
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
