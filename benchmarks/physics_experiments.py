@@ -2443,6 +2443,32 @@ for _tag, _c in (("eff-C15-m20", "4.2e6"), ("eff-C2-m20", "5.6e6")):
     add_screen_20km(_tag, EFFECTIVE + [f"rheology.strength_lab_pa={_c}"],
                     f"20 km: the envelope judges the effective stress sigma/(1 - d), C_lab {_c} Pa (intact ice "
                     f"{float(_c) / 2.8e6:g} x stronger; a calibration), own spin-up")
+# Result (2026-11-30, 01:53 UTC): (M3) fails, as predicted. Wind factor eff-m20 / C15 / C2: 0.0132 / 0.0132 /
+# 0.0130; beta 0.240 / 0.211 / 0.242; tails 4.35, 4.44 / 4.16, 3.94 / 4.02, 4.03 (heavier by 0.33-0.41, not 0.5);
+# half-shear area 13.4 / 11.3 / 10.8 %; R2 0.563 / 0.587 / 0.635; rate 0.0269 / 0.0227 / 0.0239 per day; 309 /
+# 281 / 291 remeshes; 1 band inside in each (the rate). Stronger floes break less but the bands that break hold
+# nothing, so the drift does not change.
+# Written 2026-11-30 01:54 UTC, before the runs (the results above for C15 and C2 came first: 0.0132 and 0.0130).
+# The damage cap with the effective envelope (twenty-sixth and twenty-eighth sessions, 20 km, older code) gave,
+# for caps 0.9 / 0.95 / 0.97 / 0.99, wind factors 0.0072 / 0.0104 / 0.0117 / 0.0133 and beta 0.049 / 0.068 /
+# 0.154 / 0.178: beta jumps between 0.95 and 0.97. A cap sets two things at once: the residual strength of
+# broken ice, (1 - cap) C, and the contrast between intact and broken ice, 1 / (1 - cap). Hypothesis: the
+# drift follows the residual strength and beta the contrast. Then a cap of 0.97 (contrast 33, beta's side of
+# the jump) with intact ice 2 and 3 times stronger (residual 0.06 C and 0.09 C, near cap 0.9's 0.1 C, the
+# drift's side) would have both. 20 km, closed basin, the validation month, own spin-ups, the current code:
+#   eff-cap97-m20: the effective envelope, cap 0.97 (the reference, made again with the current code);
+#   eff-C2-cap97-m20, eff-C3-cap97-m20: the same with rheology.strength_lab_pa 5.6 and 8.4 MPa (2x and 3x
+#     neXtSIM's C_lab in lagice's form; calibrations of a mechanism diagnostic, not values to ship).
+# (H) the hypothesis holds if the wind factor falls from the reference to C2 to C3, C3's at most 0.0095, while
+#     beta stays within 0.04 of the reference's in both.
+# (L) a lead: wind factor in 0.006-0.010, beta in 0.14-0.23 and at least 3 bands inside.
+# Predicted: (H) fails: the drift falls (C3 about 0.008) but beta falls with it (0.05-0.10), since the residual
+#     strength, whatever the floes' strength, transmits the load that spreads the shear; (L) fails.
+for _tag, _c in (("eff-cap97-m20", None), ("eff-C2-cap97-m20", "5.6e6"), ("eff-C3-cap97-m20", "8.4e6")):
+    add_screen_20km(_tag, EFFECTIVE + ["rheology.max_damage=0.97"]
+                    + ([] if _c is None else [f"rheology.strength_lab_pa={_c}"]),
+                    "20 km: effective envelope, damage cap 0.97" + ("" if _c is None else f", C_lab {_c} Pa "
+                    f"(intact ice {float(_c) / 2.8e6:g} x stronger; a calibration)") + ", own spin-up")
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
