@@ -2448,7 +2448,7 @@ for _tag, _c in (("eff-C15-m20", "4.2e6"), ("eff-C2-m20", "5.6e6")):
 # half-shear area 13.4 / 11.3 / 10.8 %; R2 0.563 / 0.587 / 0.635; rate 0.0269 / 0.0227 / 0.0239 per day; 309 /
 # 281 / 291 remeshes; 1 band inside in each (the rate). Stronger floes break less but the bands that break hold
 # nothing, so the drift does not change.
-# Written 2026-11-30 01:54 UTC, before the runs (the results above for C15 and C2 came first: 0.0132 and 0.0130).
+# Written 2026-11-30 01:53 UTC, before the runs (the results above for C15 and C2 came first: 0.0132 and 0.0130).
 # The damage cap with the effective envelope (twenty-sixth and twenty-eighth sessions, 20 km, older code) gave,
 # for caps 0.9 / 0.95 / 0.97 / 0.99, wind factors 0.0072 / 0.0104 / 0.0117 / 0.0133 and beta 0.049 / 0.068 /
 # 0.154 / 0.178: beta jumps between 0.95 and 0.97. A cap sets two things at once: the residual strength of
