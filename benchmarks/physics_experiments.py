@@ -2464,7 +2464,7 @@ for _tag, _c in (("eff-C15-m20", "4.2e6"), ("eff-C2-m20", "5.6e6")):
 # (L) a lead: wind factor in 0.006-0.010, beta in 0.14-0.23 and at least 3 bands inside.
 # Predicted: (H) fails: the drift falls (C3 about 0.008) but beta falls with it (0.05-0.10), since the residual
 #     strength, whatever the floes' strength, transmits the load that spreads the shear; (L) fails.
-# Result (2026-11-30, 02:00 UTC): (H) fails, and the prediction failed the other way. Reference / C2 / C3: wind
+# Result (2026-11-30, 01:59 UTC): (H) fails, and the prediction failed the other way. Reference / C2 / C3: wind
 # factor 0.0119 / 0.0112 / 0.0108 (-9 % at C3, not to 0.0095), beta 0.142 / 0.175 / 0.190 (it rises: +0.048 at C3,
 # outside the 0.04 asked), tails 5.21, 5.28 / 5.09, 3.97 / 4.61, 3.82, half-shear area 19.4 / 13.7 / 10.7 %, R2
 # 0.479 / 0.577 / 0.631, rate 0.0233 / 0.0211 / 0.0186 per day, 191 / 169 / 187 remeshes: 1 / 2 / 2 bands inside
