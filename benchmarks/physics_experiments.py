@@ -2472,6 +2472,23 @@ for _tag, _c in (("eff-C15-m20", "4.2e6"), ("eff-C2-m20", "5.6e6")):
 # left in broken ice that bound the floes at cap 0.9, but the stiffness and viscosity the cap leaves them
 # ((1 - cap)^alpha: 1e-4 of intact ice's at 0.9, 8e-7 at 0.97). (L) fails: both tails stay far lighter than
 # observed and R2 below its band.
+# Written 2026-11-30 02:01 UTC, before the runs. If the cap bound the floes at 0.9 through the viscosity it leaves
+# broken ice (eta0 (1 - cap)^alpha), and beta follows the cohesion contrast 1 / (1 - cap), then the cap 0.97 with a
+# smaller alpha gives broken ice cap 0.9's viscosity and keeps cap 0.97's contrast: (0.03)^2.5 = 1.6e-4 and
+# (0.03)^3 = 2.7e-5 of intact ice's, against cap 0.9's 1e-4 at alpha = 4. Without a cap the same alphas did not
+# slow the drift (fortieth session), because the damage climbed to 0.998-1.000; the cap stops it at 0.97.
+# alpha = 2.5 and 3 are calibrations inside Dansereau et al.'s (2016) bound alpha > 2, as before. 20 km, closed
+# basin, the validation month, own spin-ups, base strength, the current code: eff-a25-cap97-m20 and
+# eff-a3-cap97-m20 against eff-cap97-m20 (wind factor 0.0119, beta 0.142) and the old cap 0.9 (0.0072, 0.049).
+# (V) the drift follows the viscosity at the cap: the wind factor falls from the reference to alpha = 3 to 2.5,
+#     and alpha = 2.5's is at most 0.0095.
+# (B) beta follows the cohesion contrast: beta stays within 0.04 of the reference's at alpha = 2.5.
+# (L) a lead: wind factor in 0.006-0.010, beta in 0.14-0.23 and at least 3 bands inside.
+# Predicted: (V) holds (alpha = 2.5: 0.007-0.009); (B) fails (beta 0.05-0.10, as at cap 0.9: the resistance that
+#     binds the floes spreads the shear, whatever carries it); (L) fails.
+for _tag, _alpha in (("eff-a3-cap97-m20", "3"), ("eff-a25-cap97-m20", "2.5")):
+    add_screen_20km(_tag, EFFECTIVE + ["rheology.max_damage=0.97", f"rheology.alpha={_alpha}"],
+                    f"20 km: effective envelope, damage cap 0.97, alpha = {_alpha} (a calibration), own spin-up")
 for _tag, _c in (("eff-cap97-m20", None), ("eff-C2-cap97-m20", "5.6e6"), ("eff-C3-cap97-m20", "8.4e6")):
     add_screen_20km(_tag, EFFECTIVE + ["rheology.max_damage=0.97"]
                     + ([] if _c is None else [f"rheology.strength_lab_pa={_c}"]),
