@@ -2472,7 +2472,7 @@ for _tag, _c in (("eff-C15-m20", "4.2e6"), ("eff-C2-m20", "5.6e6")):
 # left in broken ice that bound the floes at cap 0.9, but the stiffness and viscosity the cap leaves them
 # ((1 - cap)^alpha: 1e-4 of intact ice's at 0.9, 8e-7 at 0.97). (L) fails: both tails stay far lighter than
 # observed and R2 below its band.
-# Written 2026-11-30 02:01 UTC, before the runs. If the cap bound the floes at 0.9 through the viscosity it leaves
+# Written 2026-11-30 02:00 UTC, before the runs. If the cap bound the floes at 0.9 through the viscosity it leaves
 # broken ice (eta0 (1 - cap)^alpha), and beta follows the cohesion contrast 1 / (1 - cap), then the cap 0.97 with a
 # smaller alpha gives broken ice cap 0.9's viscosity and keeps cap 0.97's contrast: (0.03)^2.5 = 1.6e-4 and
 # (0.03)^3 = 2.7e-5 of intact ice's, against cap 0.9's 1e-4 at alpha = 4. Without a cap the same alphas did not
