@@ -2436,6 +2436,12 @@ for _name in ("F10-hthick-P-vcrj1-m10", "F10s-hthick-P-vcrj1-m10", "B20-hthick-P
 # Predicted: (M1) holds, (M2) holds (wind factor 0.004-0.008), beta by the rheology's strain 0.08-0.14 (its
 #     nodes' 0.20-0.30), 1-2 bands; (M3) fails: the drift is set by the bands' residual strength, which stays
 #     0 (wind factor 0.012-0.013); the tails heavier by 0.3-0.8; beta 0.20-0.30; (L) fails for all three.
+# Result for effP-vcrj1 (2026-11-30, 02:03 UTC): (M1) holds, (M2) fails, and so does the prediction: the rubble
+# with the cap drifts freely. Wind factor 0.0137 (effK-vcrj 0.0018; eff-m20 0.0132), 677 remeshes, 149 km of mean
+# drift. Node motion / the rheology's own strain (window_split.py): beta 0.314 / 0.282, tails 4.50, 4.40 / 4.87,
+# 4.05, half-shear area 18.8 / 11.7 %, R2 0.449 / 0.602, rate 0.0367 / 0.0328 per day: 1 band inside (the rate) by
+# either. Broken ice under the effective envelope keeps almost no pressure to cap: its damage reaches 1 and its
+# stiffness with it, so the cap has nothing to hold. (L) fails for all three.
 add_screen_20km("effP-vcrj1-m20-acc", EFFECTIVE + PMAX + CR_KAPPA1 + ACCUMULATE,
                 "20 km: effective envelope, neXtSIM's compressive term, Crouzeix-Raviart velocities with the jump "
                 "penalty 1, own spin-up, the rheology's accumulated strain in the snapshots")
@@ -2486,6 +2492,11 @@ for _tag, _c in (("eff-C15-m20", "4.2e6"), ("eff-C2-m20", "5.6e6")):
 # (L) a lead: wind factor in 0.006-0.010, beta in 0.14-0.23 and at least 3 bands inside.
 # Predicted: (V) holds (alpha = 2.5: 0.007-0.009); (B) fails (beta 0.05-0.10, as at cap 0.9: the resistance that
 #     binds the floes spreads the shear, whatever carries it); (L) fails.
+# Result (2026-11-30, 02:05 UTC): as predicted, (V) holds and (B) fails. Reference / alpha = 3 / alpha = 2.5: wind
+# factor 0.0119 / 0.0098 / 0.0088 (both in the band), beta 0.142 / 0.067 / 0.054, tails 5.21, 5.28 / 5.63, 7.72 /
+# 5.77, 6.06, half-shear area 19.4 / 26.4 / 26.9 %, R2 0.479 / 0.199 / 0.182, rate 0.0233 / 0.0209 / 0.0210 per day,
+# 191 / 146 / 150 remeshes: 1 band inside (the rate) in each. The viscosity at the cap binds the floes as cap 0.9
+# did, and beta falls with it as at cap 0.9 (0.049). (L) fails.
 for _tag, _alpha in (("eff-a3-cap97-m20", "3"), ("eff-a25-cap97-m20", "2.5")):
     add_screen_20km(_tag, EFFECTIVE + ["rheology.max_damage=0.97", f"rheology.alpha={_alpha}"],
                     f"20 km: effective envelope, damage cap 0.97, alpha = {_alpha} (a calibration), own spin-up")
