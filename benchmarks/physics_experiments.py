@@ -2440,8 +2440,11 @@ for _name in ("F10-hthick-P-vcrj1-m10", "F10s-hthick-P-vcrj1-m10", "B20-hthick-P
 # with the cap drifts freely. Wind factor 0.0137 (effK-vcrj 0.0018; eff-m20 0.0132), 677 remeshes, 149 km of mean
 # drift. Node motion / the rheology's own strain (window_split.py): beta 0.314 / 0.282, tails 4.50, 4.40 / 4.87,
 # 4.05, half-shear area 18.8 / 11.7 %, R2 0.449 / 0.602, rate 0.0367 / 0.0328 per day: 1 band inside (the rate) by
-# either. Broken ice under the effective envelope keeps almost no pressure to cap: its damage reaches 1 and its
-# stiffness with it, so the cap has nothing to hold. (L) fails for all three.
+# either. The interior builds no pressure for the cap to hold: its median mean stress is 0.0 kPa at days 10 and
+# 28 (beta_vs_damage.py --at 10 28; effK-vcrj 22.6 kPa at day 28), with 46 % and 55 % of it above damage 0.9.
+# Below P_max neXtSIM's term stops the relaxation of the whole stress, so under the effective envelope a loaded
+# broken element sheds its stress by more damage, and its stiffness E (1 - d) falls with it. (L) fails for all
+# three.
 add_screen_20km("effP-vcrj1-m20-acc", EFFECTIVE + PMAX + CR_KAPPA1 + ACCUMULATE,
                 "20 km: effective envelope, neXtSIM's compressive term, Crouzeix-Raviart velocities with the jump "
                 "penalty 1, own spin-up, the rheology's accumulated strain in the snapshots")
