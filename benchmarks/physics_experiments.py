@@ -2500,6 +2500,23 @@ for _tag, _c in (("eff-C15-m20", "4.2e6"), ("eff-C2-m20", "5.6e6")):
 # 5.77, 6.06, half-shear area 19.4 / 26.4 / 26.9 %, R2 0.479 / 0.199 / 0.182, rate 0.0233 / 0.0209 / 0.0210 per day,
 # 191 / 146 / 150 remeshes: 1 band inside (the rate) in each. The viscosity at the cap binds the floes as cap 0.9
 # did, and beta falls with it as at cap 0.9 (0.049). (L) fails.
+# Written 2026-11-30 02:05 UTC, before the runs. One more reading of the five cap-0.97 screens: the resistance
+# that binds the floes (here the viscosity left at the cap) passes the load on to the intact ice, and the shear
+# spreads where that load breaks it; stronger floes (C2, C3 at alpha = 4) broke less and raised beta (0.142 ->
+# 0.190). If localisation follows the ratio of the floes' strength to the bands' resistance, the bound pack of
+# alpha = 2.5 (wind factor 0.0088, beta 0.054) localises again with floes 3 and 5 times stronger (C_lab 8.4 and
+# 14 MPa in lagice's form: a mechanism diagnostic, not values to ship; 14 MPa is seven times neXtSIM's value):
+# eff-C3-a25-cap97-m20, eff-C5-a25-cap97-m20, 20 km, closed basin, the validation month, own spin-ups.
+# (R) the ratio: beta rises from alpha = 2.5's 0.054 to C3 to C5, with C5's at least 0.12, while the wind factor
+#     stays at most 0.0100.
+# (L) a lead: wind factor in 0.006-0.010, beta in 0.14-0.23 and at least 3 bands inside.
+# Predicted: (R) holds in part: beta 0.07 (C3) and 0.10 (C5), short of 0.12, the wind factor 0.007-0.009; the
+#     tails stay lighter than 4; (L) fails.
+for _tag, _c in (("eff-C3-a25-cap97-m20", "8.4e6"), ("eff-C5-a25-cap97-m20", "14e6")):
+    add_screen_20km(_tag, EFFECTIVE + ["rheology.max_damage=0.97", "rheology.alpha=2.5",
+                                       f"rheology.strength_lab_pa={_c}"],
+                    f"20 km: effective envelope, damage cap 0.97, alpha = 2.5, C_lab {_c} Pa (intact ice "
+                    f"{float(_c) / 2.8e6:g} x stronger; calibrations of a mechanism diagnostic), own spin-up")
 for _tag, _alpha in (("eff-a3-cap97-m20", "3"), ("eff-a25-cap97-m20", "2.5")):
     add_screen_20km(_tag, EFFECTIVE + ["rheology.max_damage=0.97", f"rheology.alpha={_alpha}"],
                     f"20 km: effective envelope, damage cap 0.97, alpha = {_alpha} (a calibration), own spin-up")
