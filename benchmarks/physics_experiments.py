@@ -2515,8 +2515,8 @@ for _tag, _c in (("eff-C15-m20", "4.2e6"), ("eff-C2-m20", "5.6e6")):
 # Result (2026-11-30, 02:08 UTC): as predicted, (R) holds in part and fails by its letter; (L) fails. alpha = 2.5 /
 # C3 / C5: beta 0.054 / 0.073 / 0.100 (C5 short of 0.12), wind factor 0.0088 / 0.0066 / 0.0053, tails 5.77, 6.06 /
 # 4.49, 4.67 / 3.99, 4.51, half-shear area 26.9 / 20.1 / 15.7 %, R2 0.182 / 0.476 / 0.645, rate 0.0210 / 0.0141 /
-# 0.0102 per day, 150 / 105 / 84 remeshes, mean drift 92 / 67 / 53 km: 1 band inside in each (the rate; C5 also
-# none else). Stronger floes localise the bound pack again, slowly (beta +0.046 for five times the strength), and
+# 0.0102 per day, 150 / 105 / 84 remeshes, mean drift 92 / 67 / 53 km: 1 band inside in each (the rate). Stronger
+# floes localise the bound pack again, slowly (beta +0.046 for five times the strength), and
 # bind it further: the drift leaves its band below before beta reaches 0.14.
 for _tag, _c in (("eff-C3-a25-cap97-m20", "8.4e6"), ("eff-C5-a25-cap97-m20", "14e6")):
     add_screen_20km(_tag, EFFECTIVE + ["rheology.max_damage=0.97", "rheology.alpha=2.5",
