@@ -2518,6 +2518,21 @@ for _tag, _c in (("eff-C15-m20", "4.2e6"), ("eff-C2-m20", "5.6e6")):
 # 0.0102 per day, 150 / 105 / 84 remeshes, mean drift 92 / 67 / 53 km: 1 band inside in each (the rate). Stronger
 # floes localise the bound pack again, slowly (beta +0.046 for five times the strength), and
 # bind it further: the drift leaves its band below before beta reaches 0.14.
+# Written 2026-11-30 02:09 UTC, before the runs. At alpha = 4 the cap-0.97 screens with stronger floes moved
+# towards both bands at once: C1 / C2 / C3 wind factor 0.0119 / 0.0112 / 0.0108, beta 0.142 / 0.175 / 0.190,
+# half-shear area 19.4 / 13.7 / 10.7 %, R2 0.479 / 0.577 / 0.631, the tails 5.2-3.8. Where does that line go?
+# eff-C5-cap97-m20 and eff-C8-cap97-m20 (C_lab 14 and 22.4 MPa in lagice's form: calibrations of a mechanism
+# diagnostic, 7 and 11 times neXtSIM's value, not values to ship), 20 km, closed basin, the validation month,
+# own spin-ups.
+# (T) the trend: the wind factor falls and beta stays in 0.14-0.23 from C3 to C5 to C8.
+# (L) a lead (for 10 km and more months, with the strength named a calibration): wind factor in 0.006-0.010,
+#     beta in 0.14-0.23 and at least 3 bands inside.
+# Predicted: (T) holds (C5 0.0100-0.0105, C8 0.0092-0.0100); the tails stay lighter than 3.5, the half-shear
+#     area 7-10 %, R2 0.65-0.72: C5 2 bands (beta, rate), C8 2-3; (L) fails for C5 and is a coin toss for C8.
+for _tag, _c in (("eff-C5-cap97-m20", "14e6"), ("eff-C8-cap97-m20", "22.4e6")):
+    add_screen_20km(_tag, EFFECTIVE + ["rheology.max_damage=0.97", f"rheology.strength_lab_pa={_c}"],
+                    f"20 km: effective envelope, damage cap 0.97, C_lab {_c} Pa (intact ice "
+                    f"{float(_c) / 2.8e6:g} x stronger; a calibration of a mechanism diagnostic), own spin-up")
 for _tag, _c in (("eff-C3-a25-cap97-m20", "8.4e6"), ("eff-C5-a25-cap97-m20", "14e6")):
     add_screen_20km(_tag, EFFECTIVE + ["rheology.max_damage=0.97", "rheology.alpha=2.5",
                                        f"rheology.strength_lab_pa={_c}"],
