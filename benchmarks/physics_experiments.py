@@ -2518,7 +2518,7 @@ for _tag, _c in (("eff-C15-m20", "4.2e6"), ("eff-C2-m20", "5.6e6")):
 # 0.0102 per day, 150 / 105 / 84 remeshes, mean drift 92 / 67 / 53 km: 1 band inside in each (the rate). Stronger
 # floes localise the bound pack again, slowly (beta +0.046 for five times the strength), and
 # bind it further: the drift leaves its band below before beta reaches 0.14.
-# Written 2026-11-30 02:09 UTC, before the runs. At alpha = 4 the cap-0.97 screens with stronger floes moved
+# Written 2026-11-30 02:08 UTC, before the runs. At alpha = 4 the cap-0.97 screens with stronger floes moved
 # towards both bands at once: C1 / C2 / C3 wind factor 0.0119 / 0.0112 / 0.0108, beta 0.142 / 0.175 / 0.190,
 # half-shear area 19.4 / 13.7 / 10.7 %, R2 0.479 / 0.577 / 0.631, the tails 5.2-3.8. Where does that line go?
 # eff-C5-cap97-m20 and eff-C8-cap97-m20 (C_lab 14 and 22.4 MPa in lagice's form: calibrations of a mechanism
