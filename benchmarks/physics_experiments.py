@@ -2563,6 +2563,22 @@ add_months_20km("eff-C8-cap97-m20", "20 km, effective envelope, cap 0.97, C_lab 
 EFF_C8_CAP97 = EFFECTIVE + ["rheology.max_damage=0.97", "rheology.strength_lab_pa=22.4e6"]
 add_month_own_spinup("eff-C8-cap97", EFF_C8_CAP97,
                      "effective envelope, damage cap 0.97, C_lab 22.4 MPa (calibrations), own spin-up")
+# Result (K), closed basin (2026-11-30, 02:24 UTC): not a lead by its letter, and the miss has changed sides: at
+# 10 km the same set over-localises. beta 0.157 (lead band yes, observed band 0.013 below), wind factor 0.0066
+# (in), tails 2.62 / 2.85 (0.12 and 0.05 lighter than observed), half-shear area 3.0 % (1 point below), R2 0.744
+# (in), rate 0.0079 per day (0.002 below): 1 band inside, five near misses. 391 remeshes, 477 s on one thread.
+# Written 2026-11-30 02:25 UTC, before its runs: the scaling law makes the 10 km elements' cohesion 1.35 times the
+# 20 km elements' (sqrt of the size ratio: C8 median 130 kPa at 10 km against 97 kPa at 20 km). Is the 10 km
+# over-localisation that strength? eff-C5-cap97 at 10 km (C_lab 14 MPa: median cohesion about 81 kPa, near C8's
+# at 20 km; a calibration chosen now on one 10 km month), both basins, own 10 km spin-up.
+# (K5) a lead at 10 km if in each basin beta lies in 0.14-0.23, the wind factor in 0.006-0.010 and at least 3
+#      bands are inside.
+# (F) a candidate for the flagship (eight 10 km months next) if, in addition, each basin puts at least as many
+#     bands inside as the shipped set in the same month (4 and 4).
+# Predicted: (K5) holds in the closed basin (the half-shear area 4-5 %, tails 2.7-3.1, rate 0.009-0.012, beta
+#     0.15-0.19, wind factor 0.0075-0.0090: 3 bands) and is a coin toss in the strait; (F) fails (tails lighter).
+add_month_own_spinup("eff-C5-cap97", EFFECTIVE + ["rheology.max_damage=0.97", "rheology.strength_lab_pa=14e6"],
+                     "effective envelope, damage cap 0.97, C_lab 14 MPa (calibrations), own spin-up")
 for _tag, _c in (("eff-C3-a25-cap97-m20", "8.4e6"), ("eff-C5-a25-cap97-m20", "14e6")):
     add_screen_20km(_tag, EFFECTIVE + ["rheology.max_damage=0.97", "rheology.alpha=2.5",
                                        f"rheology.strength_lab_pa={_c}"],
