@@ -2567,7 +2567,7 @@ add_month_own_spinup("eff-C8-cap97", EFF_C8_CAP97,
 # 10 km the same set over-localises. beta 0.157 (lead band yes, observed band 0.013 below), wind factor 0.0066
 # (in), tails 2.62 / 2.85 (0.12 and 0.05 lighter than observed), half-shear area 3.0 % (1 point below), R2 0.744
 # (in), rate 0.0079 per day (0.002 below): 1 band inside, five near misses. 391 remeshes, 477 s on one thread.
-# Written 2026-11-30 02:25 UTC, before its runs: the scaling law makes the 10 km elements' cohesion 1.35 times the
+# Written 2026-11-30 02:24 UTC, before its runs: the scaling law makes the 10 km elements' cohesion 1.35 times the
 # 20 km elements' (sqrt of the size ratio: C8 median 130 kPa at 10 km against 97 kPa at 20 km). Is the 10 km
 # over-localisation that strength? eff-C5-cap97 at 10 km (C_lab 14 MPa: median cohesion about 81 kPa, near C8's
 # at 20 km; a calibration chosen now on one 10 km month), both basins, own 10 km spin-up.
