@@ -2567,6 +2567,9 @@ add_month_own_spinup("eff-C8-cap97", EFF_C8_CAP97,
 # 10 km the same set over-localises. beta 0.157 (lead band yes, observed band 0.013 below), wind factor 0.0066
 # (in), tails 2.62 / 2.85 (0.12 and 0.05 lighter than observed), half-shear area 3.0 % (1 point below), R2 0.744
 # (in), rate 0.0079 per day (0.002 below): 1 band inside, five near misses. 391 remeshes, 477 s on one thread.
+# Strait (02:28 UTC): beta 0.136, wind factor 0.0073, tails 3.08 / 3.51, half-shear area 3.8 %, R2 0.711, rate
+# 0.0085 per day: 0 bands inside, 481 remeshes, 498 s. (K) fails in both basins; the prediction (one of two) was
+# too high.
 # Written 2026-11-30 02:24 UTC, before its runs: the scaling law makes the 10 km elements' cohesion 1.35 times the
 # 20 km elements' (sqrt of the size ratio: C8 median 130 kPa at 10 km against 97 kPa at 20 km). Is the 10 km
 # over-localisation that strength? eff-C5-cap97 at 10 km (C_lab 14 MPa: median cohesion about 81 kPa, near C8's
