@@ -20,6 +20,8 @@ overrides) and ``docs/figures/drift_response.json`` (its wind factor,
   (thirty-ninth session, "What the best-β set-up's statistics measure");
 * the nodal volumetric strain, whose spurious modes carry the deformation (thirtieth session);
 * damage averaged over a length R, whose β follows R over the element size (a mesh parameter);
+* the effective envelope with floes at least five times neXtSIM's strength (calibrated; forty-first
+  session, "Strong floes in a weak network");
 * the effective envelope (broken ice keeps no cohesion), with or without a damage cap or another α;
 * broken ice that keeps or caps its pressure on the linear element (the mean stress kept, a bulk
   viscosity ratio, neXtSIM's compressive term, closed cracks);
@@ -52,6 +54,9 @@ BETA_BAND = tuple(TARGETS["beta_space"][:2])
 WIND_FACTOR_BAND = tuple(THORNDIKE_COLONY_WINTER["factor"])
 N_BANDS = len(TARGETS)
 
+#: C_lab [Pa, lagice's form] from which an effective-envelope run counts as "strong floes in a weak
+#: network" (forty-first session): five times neXtSIM's 2 MPa converted (2.8 MPa)
+STRONG_FLOES_LAB_PA = 5.0 * 2.8e6
 #: (key, label, rule): a run belongs to the first family whose rule holds for its overrides
 #: (a dict key -> value string)
 FAMILIES = (
@@ -62,6 +67,9 @@ FAMILIES = (
      lambda o: o.get("solver.volumetric_strain") == "nodal"),
     ("nonlocal", "damage averaged over R (a mesh parameter)",
      lambda o: float(o.get("rheology.damage_nonlocal_radius_m", "0")) > 0.0),
+    ("strong_floes", "effective envelope, floes at least 5x neXtSIM's strength (calibrated)",
+     lambda o: (o.get("rheology.failure_stress") == "effective"
+                and float(o.get("rheology.strength_lab_pa", "0")) >= STRONG_FLOES_LAB_PA)),
     ("effective", "effective envelope (broken ice keeps no cohesion)",
      lambda o: o.get("rheology.failure_stress") == "effective"),
     ("pressure", "broken ice keeps or caps its pressure (linear element)",
@@ -70,7 +78,7 @@ FAMILIES = (
     ("nominal", "nominal envelope, linear element (the shipped set and its variations)", lambda o: True),
 )
 COLOURS = {"evp": "tab:gray", "crouzeix_raviart": "tab:purple", "nodal": "tab:brown", "nonlocal": "tab:olive",
-           "effective": "tab:red", "pressure": "tab:orange", "nominal": "tab:blue"}
+           "effective": "tab:red", "strong_floes": "tab:pink", "pressure": "tab:orange", "nominal": "tab:blue"}
 
 
 def overrides_dict(overrides: list) -> dict:
