@@ -2618,6 +2618,10 @@ add_months_20km("eff-C8-cap99-m20", "20 km, effective envelope, cap 0.99, C_lab 
                 ENSEMBLE_SEEDS + MORE_SEEDS)
 add_month_own_spinup("eff-C8", EFFECTIVE + ["rheology.strength_lab_pa=22.4e6"],
                      "effective envelope, C_lab 22.4 MPa (a calibration), own spin-up")
+# Result (K3), closed basin (2026-11-30, 02:56 UTC): fails, as predicted, but not as predicted: beta 0.151, wind
+# factor 0.0093 (in), tails 4.30 / 5.18 (far lighter than observed), half-shear area 2.8 % (below), R2 0.726
+# (0.004 below), rate 0.0116 per day (in): 1 band inside, 807 remeshes, 577 s. Half the shear in 2.8 % of the area
+# with tails that light: the few active bands all deform at about the same rate, and the floes not at all.
 for _tag, _c in (("eff-C3-a25-cap97-m20", "8.4e6"), ("eff-C5-a25-cap97-m20", "14e6")):
     add_screen_20km(_tag, EFFECTIVE + ["rheology.max_damage=0.97", "rheology.alpha=2.5",
                                        f"rheology.strength_lab_pa={_c}"],
