@@ -2613,7 +2613,7 @@ for _tag, _cap in (("eff-C8-m20", None), ("eff-C8-cap99-m20", "0.99")):
 # 10 km spin-up: a lead at 10 km as (K) (beta in 0.14-0.23, the wind factor in its band, 3 bands inside in each).
 # Predicted: (W3) holds for both (beta medians 0.17-0.21, wind factor 0.008-0.0095, 3 bands); (K3) fails: at 10 km
 #     the floes are 1.35 times stronger and the set over-localises as C8 with the cap did (half-shear area 3-4 %).
-# Result (W3) (2026-11-30, 03:03 UTC): holds without the cap, fails by one band with the cap 0.99; the prediction
+# Result (W3) (2026-11-30, 03:02 UTC): holds without the cap, fails by one band with the cap 0.99; the prediction
 # held on beta and the drift. Eight months at 20 km (validation month, then 2027-2033), no cap / cap 0.99:
 # beta 0.212, 0.145, 0.136, 0.108, 0.211, 0.139, 0.218, 0.173 (median 0.159, 5 of 8 in 0.14-0.23) / 0.182, 0.146,
 # 0.149, 0.155, 0.209, 0.198, 0.188, 0.126 (median 0.169, 7 of 8); wind factor median 0.0097 (5 of 8 in the band,
