@@ -36,6 +36,9 @@ STORE = OUT / "drift_response.json"
 PUBLISHED = ROOT / "docs" / "figures" / "drift_response.json"
 from lagice.diagnostics.drift import THORNDIKE_COLONY_WINTER as OBSERVED  # noqa: E402
 
+#: the store's entry for the observed band (always the module's, never a stored copy)
+OBSERVED_KEY = "observed_thorndike_colony_1982_winter"
+
 
 def analyse(name: str) -> dict:
     """:func:`lagice.diagnostics.drift.run_drift_response` of physics run ``name``, with its
@@ -49,18 +52,28 @@ def analyse(name: str) -> dict:
 
 
 def store(res: dict) -> None:
-    # a fresh checkout has no store yet: start from the published records (without their daily
-    # speed pairs), so that one new run does not drop every earlier one from docs/figures
-    src = STORE if STORE.exists() else PUBLISHED
-    data = json.loads(src.read_text()) if src.exists() else {}
-    data[res["name"]] = res
-    key = "observed_thorndike_colony_1982_winter"
-    full = {key: OBSERVED, **{k: v for k, v in sorted(data.items()) if k != key}}
-    STORE.write_text(json.dumps(full, indent=1))
-    # the published copy without the daily speed pairs (about 450 numbers per run)
-    slim = {k: ({a: b for a, b in v.items() if a != "daily_speeds_g_u_m_s"} if k != key else v)
-            for k, v in full.items()}
-    PUBLISHED.write_text(json.dumps(slim, indent=1))
+    """Add one run's fit to the store and the published copy. Read, update and write happen under
+    an exclusive lock, so that two analyses finishing together (two queues of runs) do not drop
+    each other's record, as they did once (forty-first session)."""
+    import fcntl
+
+    STORE.parent.mkdir(parents=True, exist_ok=True)
+    with open(STORE.with_suffix(".lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        # a fresh checkout has no store yet: start from the published records (without their daily
+        # speed pairs), so that one new run does not drop every earlier one from docs/figures
+        src = STORE if STORE.exists() else PUBLISHED
+        data = json.loads(src.read_text()) if src.exists() else {}
+        data[res["name"]] = res
+        key = OBSERVED_KEY
+        full = {key: OBSERVED, **{k: v for k, v in sorted(data.items()) if k != key}}
+        tmp = STORE.with_suffix(".tmp")
+        tmp.write_text(json.dumps(full, indent=1))
+        tmp.replace(STORE)
+        # the published copy without the daily speed pairs (about 450 numbers per run)
+        slim = {k: ({a: b for a, b in v.items() if a != "daily_speeds_g_u_m_s"} if k != key else v)
+                for k, v in full.items()}
+        PUBLISHED.write_text(json.dumps(slim, indent=1))
 
 
 def row(r: dict) -> str:

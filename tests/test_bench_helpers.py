@@ -132,6 +132,39 @@ def test_drift_response_store_keeps_the_published_records_in_a_fresh_checkout(tm
     assert full[key] == json.loads(json.dumps(dr.OBSERVED))  # the observed band is always the module's
 
 
+def _store_many(prefix: str, n: int) -> None:
+    import drift_response as dr
+
+    for i in range(n):
+        dr.store({"name": f"{prefix}{i}", "fit": {"factor": 0.007}})
+
+
+def test_drift_response_store_keeps_every_record_when_analyses_finish_together(tmp_path, monkeypatch):
+    """Two queues of runs analysed side by side write the store at the same time: every record
+    must survive (without the lock one process's read-modify-write dropped the other's record,
+    forty-first session). Four processes, 25 records each."""
+    import json
+    import multiprocessing as mp
+
+    import drift_response as dr
+
+    published = tmp_path / "published.json"
+    published.write_text(json.dumps({"OLD": {"name": "OLD", "fit": {"factor": 0.003}}}))
+    monkeypatch.setattr(dr, "STORE", tmp_path / "out" / "store.json")
+    monkeypatch.setattr(dr, "PUBLISHED", published)
+    ctx = mp.get_context("fork")  # the children inherit the patched paths
+    procs = [ctx.Process(target=_store_many, args=(f"P{k}-", 25)) for k in range(4)]
+    for p in procs:
+        p.start()
+    for p in procs:
+        p.join(60)
+        assert p.exitcode == 0
+    full = json.loads(dr.STORE.read_text())
+    slim = json.loads(published.read_text())
+    expected = {"OLD", dr.OBSERVED_KEY} | {f"P{k}-{i}" for k in range(4) for i in range(25)}
+    assert set(full) == set(slim) == expected
+
+
 def test_physics_run_queues_deal_the_runs_round_robin_and_check_names_first(monkeypatch):
     """``physics_experiments.py run ... --jobs N``: the closed/strait pairs of a set-up, listed
     in pairs, land one basin per queue in their order; an unknown name, or a run whose scene
