@@ -2630,6 +2630,8 @@ add_month_own_spinup("eff-C8", EFFECTIVE + ["rheology.strength_lab_pa=22.4e6"],
 # factor 0.0093 (in), tails 4.30 / 5.18 (far lighter than observed), half-shear area 2.8 % (below), R2 0.726
 # (0.004 below), rate 0.0116 per day (in): 1 band inside, 807 remeshes, 577 s. Half the shear in 2.8 % of the area
 # with tails that light: the few active bands all deform at about the same rate, and the floes not at all.
+# Strait (03:13 UTC): beta 0.104, wind factor 0.0101 (just above), tails 4.70 / 3.77, half-shear area 3.1 %, R2
+# 0.721, rate 0.0104 per day (in): 1 band inside, 859 remeshes, 680 s. (K3) fails in both basins.
 for _tag, _c in (("eff-C3-a25-cap97-m20", "8.4e6"), ("eff-C5-a25-cap97-m20", "14e6")):
     add_screen_20km(_tag, EFFECTIVE + ["rheology.max_damage=0.97", "rheology.alpha=2.5",
                                        f"rheology.strength_lab_pa={_c}"],
