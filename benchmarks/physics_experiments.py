@@ -2632,6 +2632,18 @@ add_month_own_spinup("eff-C8", EFFECTIVE + ["rheology.strength_lab_pa=22.4e6"],
 # with tails that light: the few active bands all deform at about the same rate, and the floes not at all.
 # Strait (03:13 UTC): beta 0.104, wind factor 0.0101 (just above), tails 4.70 / 3.77, half-shear area 3.1 %, R2
 # 0.721, rate 0.0104 per day (in): 1 band inside, 859 remeshes, 680 s. (K3) fails in both basins.
+# Written 2026-11-30 03:21 UTC, before the run: do the floes' strength also set the tails? At 20 km without the cap
+# the shear tail fell from 4.35 (eff-m20) to 4.02 (C2) to 2.86 (C8), and the eight-month medians put the tails
+# at 3.13 / 2.78. eff-C12-m20: no cap, C_lab 33.6 MPa (12 times neXtSIM's; cohesion about 146 kPa at 20 km, 3.6
+# times the in-situ estimate; a mechanism diagnostic, not a value to ship), 20 km, closed basin, the validation
+# month, own spin-up.
+# (T12) the strength sets the tails if both tails are heavier than C8's (below 2.86 and 2.95) and at least one is
+#       inside its band.
+# Predicted: (T12) holds (tails 2.5-2.8), the wind factor falls to 0.007-0.009, beta 0.18-0.24, the half-shear
+#       area 4-5 %, R2 0.72-0.75: 3-4 bands inside.
+add_screen_20km("eff-C12-m20", EFFECTIVE + ["rheology.strength_lab_pa=33.6e6"],
+                "20 km: effective envelope, C_lab 33.6 MPa (intact ice 12 x stronger; a mechanism diagnostic), "
+                "own spin-up")
 for _tag, _c in (("eff-C3-a25-cap97-m20", "8.4e6"), ("eff-C5-a25-cap97-m20", "14e6")):
     add_screen_20km(_tag, EFFECTIVE + ["rheology.max_damage=0.97", "rheology.alpha=2.5",
                                        f"rheology.strength_lab_pa={_c}"],
