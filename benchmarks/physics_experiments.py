@@ -2641,6 +2641,11 @@ add_month_own_spinup("eff-C8", EFFECTIVE + ["rheology.strength_lab_pa=22.4e6"],
 #       inside its band.
 # Predicted: (T12) holds (tails 2.5-2.8), the wind factor falls to 0.007-0.009, beta 0.18-0.24, the half-shear
 #       area 4-5 %, R2 0.72-0.75: 3-4 bands inside.
+# Result (2026-11-30, 03:23 UTC): (T12) fails; the prediction was wrong on the tails. beta 0.167, tails 3.15 / 2.85
+# (the shear tail lighter than C8's 2.86, the |div| tail 0.10 heavier), half-shear area 3.8 % (below its band),
+# R2 0.748 (in), rate 0.0106 per day (in), wind factor 0.0082 (in), 181 remeshes: 2 bands inside. Stronger floes
+# concentrate the shear (as at 10 km) without spreading the rates of the active bands: the floes' strength does
+# not set the tails.
 add_screen_20km("eff-C12-m20", EFFECTIVE + ["rheology.strength_lab_pa=33.6e6"],
                 "20 km: effective envelope, C_lab 33.6 MPa (intact ice 12 x stronger; a mechanism diagnostic), "
                 "own spin-up")
