@@ -34,6 +34,8 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 OUT = ROOT / "benchmarks" / "out" / "physics"
 STORE = OUT / "drift_response.json"
 PUBLISHED = ROOT / "docs" / "figures" / "drift_response.json"
+from validate import update_record_store  # noqa: E402
+
 from lagice.diagnostics.drift import THORNDIKE_COLONY_WINTER as OBSERVED  # noqa: E402
 
 #: the store's entry for the observed band (always the module's, never a stored copy)
@@ -52,28 +54,20 @@ def analyse(name: str) -> dict:
 
 
 def store(res: dict) -> None:
-    """Add one run's fit to the store and the published copy. Read, update and write happen under
-    an exclusive lock, so that two analyses finishing together (two queues of runs) do not drop
-    each other's record, as they did once (forty-first session)."""
-    import fcntl
-
-    STORE.parent.mkdir(parents=True, exist_ok=True)
-    with open(STORE.with_suffix(".lock"), "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        # a fresh checkout has no store yet: start from the published records (without their daily
-        # speed pairs), so that one new run does not drop every earlier one from docs/figures
-        src = STORE if STORE.exists() else PUBLISHED
-        data = json.loads(src.read_text()) if src.exists() else {}
+    """Add one run's fit to the store and the published copy (two analyses may finish together:
+    :func:`validate.update_record_store`; without its lock they once dropped a record, forty-first
+    session). The observed band is always the module's, first; the published copy leaves out the
+    daily speed pairs (about 450 numbers per run)."""
+    def update(data):
         data[res["name"]] = res
-        key = OBSERVED_KEY
-        full = {key: OBSERVED, **{k: v for k, v in sorted(data.items()) if k != key}}
-        tmp = STORE.with_suffix(".tmp")
-        tmp.write_text(json.dumps(full, indent=1))
-        tmp.replace(STORE)
-        # the published copy without the daily speed pairs (about 450 numbers per run)
-        slim = {k: ({a: b for a, b in v.items() if a != "daily_speeds_g_u_m_s"} if k != key else v)
+        return {OBSERVED_KEY: OBSERVED, **{k: v for k, v in sorted(data.items()) if k != OBSERVED_KEY}}
+
+    def publish(full):
+        slim = {k: ({a: b for a, b in v.items() if a != "daily_speeds_g_u_m_s"} if k != OBSERVED_KEY else v)
                 for k, v in full.items()}
         PUBLISHED.write_text(json.dumps(slim, indent=1))
+
+    update_record_store(STORE, PUBLISHED, update, publish)
 
 
 def row(r: dict) -> str:

@@ -41,7 +41,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from validate import repo_relative, run_finished  # noqa: E402  (a run that reached its stop time; paths in published records)
+from validate import repo_relative, run_finished, update_record_store  # noqa: E402  (a run that reached its stop time; paths in published records)
 
 OUT = ROOT / "benchmarks" / "out" / "physics"
 DAY = 86400.0
@@ -2724,26 +2724,15 @@ def analyse(name: str, run: Path, days: float, buffer_m: float = 100e3) -> dict:
 
 
 def _store(res: dict):
-    """Add one result to ``experiments.json`` (read-modify-write under a lock: two runs
-    at a time may finish together) and copy the file to docs/figures."""
-    import fcntl
+    """Add one result to ``experiments.json`` and its copy in docs/figures (two runs at a time
+    may finish together: :func:`validate.update_record_store`)."""
+    pub = ROOT / "docs" / "figures" / "physics_experiments.json"
 
-    OUT.mkdir(parents=True, exist_ok=True)
-    p = OUT / "experiments.json"
-    with open(OUT / "experiments.lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        # a fresh checkout has no experiments.json: start from the published records, so
-        # that one new run does not drop every earlier one from docs/figures
-        pub = ROOT / "docs" / "figures" / "physics_experiments.json"
-        src = p if p.exists() else pub
-        allr = json.loads(src.read_text()) if src.exists() else {}
-        allr[res["name"]] = res
-        tmp = p.with_suffix(".tmp")
-        tmp.write_text(json.dumps(allr, indent=1, default=float))
-        tmp.replace(p)
-    (ROOT / "docs" / "figures").mkdir(parents=True, exist_ok=True)
-    (ROOT / "docs" / "figures" / "physics_experiments.json").write_text(
-        json.dumps(repo_relative(allr), indent=1, default=float))
+    def publish(allr):
+        pub.parent.mkdir(parents=True, exist_ok=True)
+        pub.write_text(json.dumps(repo_relative(allr), indent=1, default=float))
+
+    update_record_store(OUT / "experiments.json", pub, lambda allr: {**allr, res["name"]: res}, publish)
 
 
 def git_commit() -> str:

@@ -1190,6 +1190,28 @@ def _drop(obj, keys):
     return obj
 
 
+def update_record_store(store: Path, seed: Path, update, publish=None) -> dict:
+    """Read-modify-write of a JSON record store shared by runs that may finish together (two
+    queues of physics runs): under an exclusive lock (``store`` with suffix ``.lock``), read
+    ``store`` (in a fresh checkout, which has none, the published ``seed``, so that one new
+    record does not drop every earlier one), apply ``update(records) -> records``, write it
+    atomically, then call ``publish(records)`` (the copy under docs/) before the lock is
+    released. Returns the records written."""
+    import fcntl
+
+    store.parent.mkdir(parents=True, exist_ok=True)
+    with open(store.with_suffix(".lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        src = store if store.exists() else seed
+        records = update(json.loads(src.read_text()) if src.exists() else {})
+        tmp = store.with_suffix(".tmp")
+        tmp.write_text(json.dumps(records, indent=1, default=float))
+        tmp.replace(store)
+        if publish is not None:
+            publish(records)
+    return records
+
+
 def repo_relative(obj):
     """``obj`` with this checkout's absolute path taken out of every string (paths relative
     to the repository root), for the copies published under docs/: a record names files
