@@ -19,7 +19,10 @@ OMEGA_EARTH = 7.2921e-5  # rad s-1
 #: stress-correction paths of :class:`MaxwellEBParams` (``rheology.stress_correction``)
 STRESS_CORRECTIONS = ("origin", "mean_stress", "associated")
 #: the stress the failure envelope judges (:attr:`MaxwellEBParams.failure_stress`)
-FAILURE_STRESSES = ("nominal", "effective")
+FAILURE_STRESSES = ("nominal", "effective", "energy")
+#: the power p of (1 − d) that multiplies an element's cohesion in the envelope, per
+#: ``failure_stress`` (None: the cohesion is not scaled)
+FAILURE_EXPONENT = {"nominal": None, "effective": 1.0, "energy": 0.5}
 
 
 @dataclass(frozen=True)
@@ -97,7 +100,12 @@ class MaxwellEBParams:
             damage mechanics (Kachanov 1958; Lemaitre 1985), so the cohesion and the tensile
             strength of an element are C (1 − d) and the friction μ is kept: broken ice holds by
             friction alone, as a fault does. Explicit CPU stepper and implicit solver, with the
-            local damage (no ``damage_nonlocal_radius_m``)
+            local damage (no ``damage_nonlocal_radius_m``). ``"energy"`` (a diagnostic of
+            lagice, 2026-11-30; docs/physics.md §4, "Broken ice that keeps part of its cohesion"):
+            the effective stress of the hypothesis of strain-energy equivalence (Cordebois and
+            Sidoroff 1982): with lagice's modulus E0 (1 − d) that effective stress is σ/√(1 − d),
+            so the cohesion and tensile strength are C √(1 − d), friction kept. Explicit CPU
+            stepper and implicit solver, local damage
         crack_closure: False (Dansereau et al. 2016, neXtSIM; the default): damage lowers the
             modulus for every strain. True (a diagnostic of lagice, 2026-11-28; docs/physics.md §4,
             "Broken ice whose cracks close"): quasi-unilateral damage (Ladevèze and Lemaitre 1984,

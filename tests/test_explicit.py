@@ -154,7 +154,7 @@ def test_effective_failure_stress(kernel):
                rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag, None)
         return sg, dm, flag
 
-    _, d_eff, f_eff = run(True, coh, sig0, d)
+    _, d_eff, f_eff = run(1.0, coh, sig0, d)
     assert np.array_equal(f_eff.astype(bool), np.arange(m) % 2 == 0)
     assert np.all(d_eff[::2] > d[::2]) and np.array_equal(d_eff[1::2], d[1::2])
     _, d_nom, f_nom = run(None, coh, sig0, d)
@@ -162,7 +162,7 @@ def test_effective_failure_stress(kernel):
     # (2) random stresses, some tensile, some confined: the same as the nominal kernel with C (1 − d)
     sig = rng.normal(0, 2e4, (m, 3))
     sig[:, :2] -= rng.uniform(0, 3e4, (m, 1))
-    a = run(True, coh, sig, d)
+    a = run(1.0, coh, sig, d)
     b = run(None, coh * (1.0 - d), sig, d)
     assert 50 < a[2].sum() < m - 50
     for x, y in zip(a, b):
@@ -183,6 +183,78 @@ def test_effective_failure_stress(kernel):
         MaxwellEB(failure_stress="effective", damage_nonlocal_radius_m=2e4)
     with pytest.raises(ConfigError, match="rheology.failure_stress = 'plastic': expected one of"):
         MaxwellEB(failure_stress="plastic")
+
+
+@pytest.mark.parametrize("kernel", [element_stress_damage_kernel_serial, element_stress_damage_kernel_a4])
+def test_energy_equivalent_failure_stress(kernel):
+    """``rheology.failure_stress = "energy"``: the envelope judges σ/√(1 − d), the effective stress
+    of strain-energy equivalence for the modulus E0 (1 − d). (1) On the uniaxial-compression ray
+    σ = −s σc ŷŷ an element of damage d damages when s > √(1 − d) and not when s < √(1 − d) (margin
+    1e-3). (2) An element it damages ends on its own shrunk envelope, |σ_yy| = σc √(1 − d_new)
+    (td = Δt: the whole correction in one sub-step, no healing), where the effective criterion,
+    whose correction does not move σ/(1 − d), sends the same element far further. (3) Everywhere it
+    is the nominal kernel run with the cohesion C √(1 − d), bit for bit, and the implicit solver's
+    update agrees. (4) The CUDA stepper refuses it, naming the key and value."""
+    from lagice.rheology.maxwell_eb import envelope
+
+    rheo = MaxwellEB(failure_stress="energy", friction=0.7)
+    p = rheo.params
+    kc, kt = envelope_factors(rheo)
+    rng = np.random.default_rng(12)
+    m = 400
+    d = rng.uniform(0.0, 0.95, m)
+    coh = rng.uniform(1e4, 3e4, m)
+    sigma_c = envelope(coh, p.friction)[1]
+    root = np.sqrt(1.0 - d)
+    s = root * np.where(np.arange(m) % 2 == 0, 1.001, 0.999)
+    sig0 = np.zeros((m, 3))
+    sig0[:, 1] = -s * sigma_c
+    tri, zeros3 = np.zeros((m, 3), np.int32), np.zeros((m, 3))
+
+    def run(eff, cohesion, sigma, damage, td=20.0):
+        sg, dm, flag = sigma.copy(), damage.copy(), np.zeros(m, np.int8)
+        kernel(tri, zeros3, zeros3, np.zeros((1, 2)), sg, dm, np.ones(m), cohesion, kc, kt, np.full(m, td),
+               np.zeros(m), np.zeros(m), np.ones(m), None, None, None, None, eff, None, 7.0, *rheo.K[0, :2],
+               rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag, None)
+        return sg, dm, flag
+
+    _, d_en, f_en = run(0.5, coh, sig0, d)
+    assert np.array_equal(f_en.astype(bool), np.arange(m) % 2 == 0)
+    assert np.all(d_en[::2] > d[::2]) and np.array_equal(d_en[1::2], d[1::2])
+    # (2) 50 % beyond each element's shrunk envelope, td = Δt (a sub-step applies the whole
+    # correction factor k = 1/ρ to σ and 1 − d), no strain, no relaxation, no healing: the ratio ρ of
+    # σ/√(1 − d) to the envelope goes to √ρ each sub-step, so 1 − d converges to (1 − d0)/1.5² and σ
+    # to the envelope. The effective criterion's ratio σ/(1 − d) does not move, so it damages by
+    # the same factor every sub-step, to the cap.
+    sig_big = np.zeros((m, 3))
+    sig_big[:, 1] = -1.5 * root * sigma_c
+    sg, dn, se, de = sig_big, d, sig_big, d
+    for _ in range(40):
+        sg, dn, _ = run(0.5, coh, sg, dn, td=7.0)
+        se, de, _ = run(1.0, coh, se, de, td=7.0)
+    assert np.allclose((1.0 - dn) / (1.0 - d), 1.0 / 1.5 ** 2, rtol=1e-9)
+    assert np.allclose(-sg[:, 1], sigma_c * np.sqrt(1.0 - dn), rtol=1e-9)
+    assert np.all(de >= min(p.max_damage, 1.0 - 1e-6))
+    # (3) random stresses: the same as the nominal kernel with C √(1 − d)
+    sig = rng.normal(0, 2e4, (m, 3))
+    sig[:, :2] -= rng.uniform(0, 3e4, (m, 1))
+    a = run(0.5, coh, sig, d)
+    b = run(None, coh * np.sqrt(1.0 - d), sig, d)
+    assert 50 < a[2].sum() < m - 50
+    for x, y in zip(a, b):
+        assert np.array_equal(x, y)
+    # … and not the effective criterion's result
+    assert not np.array_equal(run(1.0, coh, sig, d)[1], a[1])
+    si, di = sig.copy(), d.copy()
+    dc = rheo.damage_update(si, di, coh, 7.0, np.full(m, 20.0), np.zeros(m))
+    assert np.array_equal(dc < 1.0, a[2].astype(bool))
+    assert np.allclose(si, a[0], rtol=1e-13, atol=1e-13 * np.abs(si).max())
+    assert np.allclose(di, a[1], rtol=1e-13, atol=1e-15)
+    # (4) the CPU stepper and the implicit solver implement it; the CUDA stepper refuses it
+    rheo.require_stepper("explicit")
+    rheo.require_stepper("implicit")
+    with pytest.raises(ConfigError, match="failure_stress = 'energy': the CUDA explicit stepper .* does not implement"):
+        rheo.require_stepper("explicit_cuda")
 
 
 @pytest.mark.parametrize("kernel", [element_stress_damage_kernel_serial, element_stress_damage_kernel_a4])

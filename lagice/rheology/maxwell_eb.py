@@ -293,6 +293,10 @@ OPTIONAL_TERMS = {"implicit": ("failure_stress",),
                                "bulk_shear_viscosity_ratio"),
                   "explicit_cuda": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg", "failure_stress",
                                     "crack_closure"), "prescribed": ()}
+#: the values of ``rheology.failure_stress`` each stepper implements beyond the default (a
+#: stepper that lists the key in :data:`OPTIONAL_TERMS` but not a value refuses that value)
+FAILURE_STRESS_PATHS = {"implicit": ("effective", "energy"), "explicit": ("effective", "energy"),
+                        "explicit_cuda": ("effective",), "prescribed": ()}
 STEPPER_LABELS = {"implicit": "the implicit solver (solver.name = 'implicit')",
                   "prescribed": "the prescribed-velocity stepper (solver.name = 'prescribed', no damage update)",
                   "explicit": "the explicit CPU stepper (solver.name = 'explicit', solver.device = 'cpu')",
@@ -375,6 +379,11 @@ class MaxwellEB:
                 raise ConfigError(f"rheology.{key} = {shown}: {STEPPER_LABELS[stepper]} does not implement it "
                                   f"(implemented in {' and '.join(where)}); use one of those, or leave "
                                   f"{key} at its default")
+        fs = self.params.failure_stress
+        if fs != "nominal" and fs not in FAILURE_STRESS_PATHS[stepper]:
+            where = [STEPPER_LABELS[k] for k, values in FAILURE_STRESS_PATHS.items() if fs in values]
+            raise ConfigError(f"rheology.failure_stress = {fs!r}: {STEPPER_LABELS[stepper]} does not implement it "
+                              f"(implemented in {' and '.join(where)})")
 
     def max_pressure(self, thickness, concentration):
         """P_max = P* (h / 1 m)^k exp(−c*(1−A)) [Pa] per element (neXtSIM's compressive term;
@@ -389,10 +398,13 @@ class MaxwellEB:
 
     def damage_update(self, sigma, damage, cohesion, dt, td, heal_rate):
         """Apply the damage/healing update in place; returns d_crit per element. With
-        ``failure_stress = "effective"`` the envelope is that of the cohesion C (1 − d), d the
-        damage passed in (the step's starting damage), as the explicit kernel takes it."""
-        if self.params.failure_stress != "nominal":
+        ``failure_stress = "effective"`` the envelope is that of the cohesion C (1 − d), with
+        ``"energy"`` that of C √(1 − d), d the damage passed in (the step's starting damage), as
+        the explicit kernel takes it."""
+        if self.params.failure_stress == "effective":
             cohesion = np.asarray(cohesion, np.float64) * (1.0 - np.asarray(damage, np.float64))
+        elif self.params.failure_stress == "energy":
+            cohesion = np.asarray(cohesion, np.float64) * np.sqrt(1.0 - np.asarray(damage, np.float64))
         out = np.empty(len(damage))
         kernel = pick(DAMAGE_UPDATE, len(damage))
         n = kernel(sigma, damage, cohesion, float(dt), np.ascontiguousarray(td),

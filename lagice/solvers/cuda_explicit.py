@@ -771,7 +771,7 @@ class CudaExplicitSolver:
         # the CPU kernel's optional terms; its None is 0 here (a CUDA launch cannot pass None)
         # bit flags (cuda_kernels.element_update): 1 keep the mean stress, 2 the effective failure
         # stress, 4 closed cracks
-        keep_mean = ((0 if p.relax_mean_stress else 1) | (2 if p.failure_stress != "nominal" else 0)
+        keep_mean = ((0 if p.relax_mean_stress else 1) | (2 if p.failure_stress == "effective" else 0)
                      | (4 if p.crack_closure else 0))
         theta = float(p.mean_fraction) if p.stress_correction == "mean_stress" else 0.0
         dilat = float(p.dilatancy_factor or 0.0)

@@ -46,6 +46,7 @@ from .._numba import PARALLEL_MIN_SIZE, autotune, serial_copy, specialised_copy
 from ..errors import ConfigError
 from ..fem import STRAIN_RATE, NodeSystem, element_strain_rate
 from ..forces import explicit_terms
+from ..params import FAILURE_EXPONENT
 from ..rheology import MaxwellEB, _dcrit, damage_step
 from ..rheology.maxwell_eb import _dcrit_towards, closed_crack_mean
 from ..stability import effective_dx
@@ -322,9 +323,10 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     the isotropic term leaves r unchanged). Only with the whole stress relaxing and no
     compressive term (params refuse the rest).
     eff: None (rheology.failure_stress = "nominal", the default; pruned as pmax is): the envelope
-    judges σ with the element's cohesion C. True (``"effective"``): it judges the effective
+    judges σ with the element's cohesion C. 1.0 (``"effective"``): it judges the effective
     stress σ/(1 − d), i.e. σ against the envelope of cohesion C (1 − d) (the friction is
-    kept), d the damage at the start of the sub-step.
+    kept), d the damage at the start of the sub-step. 0.5 (``"energy"``): the effective stress
+    of strain-energy equivalence σ/√(1 − d), i.e. the envelope of cohesion C √(1 − d).
     closure: None (rheology.crack_closure false, the default; pruned as pmax is). True: only with
     keep_mean (params refuse the rest), quasi-unilateral damage: the mean normal stress m changes
     with the undamaged Δt_s E0 exp(−c*(1−A)) where m ≤ 0 (the cracks closed) and with the
@@ -400,7 +402,10 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
         r2 = 0.25 * (sxx - syy) ** 2 + sxy * sxy
         ce = cohesion[e]
         if eff is not None:
-            ce = ce * (1.0 - damage[e])
+            if eff == 1.0:  # "effective": C (1 − d)
+                ce = ce * (1.0 - damage[e])
+            else:  # "energy": C √(1 − d)
+                ce = ce * math.sqrt(1.0 - damage[e])
         at = ce * kt - mm
         ac = ce * kc - (q - 1.0) * mm
         if at > 0.0 and ac > 0.0 and r2 < at * at and (q + 1.0) * (q + 1.0) * r2 < ac * ac:
@@ -1112,7 +1117,7 @@ class ExplicitSolver:
                      else mean_relaxation_ratio(p))
         theta = None if p.stress_correction == "origin" else float(p.mean_fraction)
         dilat = p.dilatancy_factor  # None: off
-        eff = None if p.failure_stress == "nominal" else True
+        eff = FAILURE_EXPONENT[p.failure_stress]
         closure = True if p.crack_closure else None
         heal = (self.heal_rate(state, t_s) if self.heal_rate is not None
                 else self.rheology.constant_heal_rate(mesh.n_elements))
