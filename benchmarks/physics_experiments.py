@@ -2663,6 +2663,32 @@ for _tag, _c in (("eff-cap97-m20", None), ("eff-C2-cap97-m20", "5.6e6"), ("eff-C
                     "20 km: effective envelope, damage cap 0.97" + ("" if _c is None else f", C_lab {_c} Pa "
                     f"(intact ice {float(_c) / 2.8e6:g} x stronger; a calibration)") + ", own spin-up")
 
+# Written 2026-11-30 03:45 UTC (forty-second session), before its runs: broken ice that keeps part of its
+# cohesion. The nominal envelope keeps broken ice as strong as intact ice (the whole pack yields together: beta
+# 0.04-0.05, the drift half the observed); the effective one, sigma/(1 - d), leaves it none (the damage runs to
+# the cap within hours, the floes drift freely, tails light). Continuum damage mechanics has a second effective
+# stress: under strain-energy equivalence (Cordebois and Sidoroff 1982, "Endommagement anisotrope en elasticite
+# et plasticite", J. Mec. Theor. Appl., numero special) a damage D lowers the modulus as (1 - D)^2 and the
+# effective stress is sigma/(1 - D); with lagice's modulus E0 (1 - d), 1 - D = sqrt(1 - d), so the effective
+# stress is sigma/sqrt(1 - d). rheology.failure_stress = "energy" (commit f10e105): cohesion C sqrt(1 - d), no
+# parameter (0.2 C at d = 0.96, where the nominal keeps C and the effective 0.04 C). Its correction converges
+# (the ratio to the envelope goes to its square root each sub-step), so damage is graded, not two-valued.
+# 20 km, closed basin, the validation month, each from its own 20 km spin-up, the current code: eng-m20
+# (neXtSIM's strength), eng-C2-m20 (C_lab x2, a mechanism diagnostic) and the control nom-m20 (the nominal
+# envelope on the same code and mesh); the effective reference is eff-m20 (beta 0.240, wind factor 0.0132).
+# (E) a lead (the 10 km validation month in both basins next) if beta lies in 0.14-0.23, the wind factor in
+#     0.006-0.010 and at least 3 bands are inside.
+# Predicted: eng-m20 lies between its two neighbours on every statistic: beta 0.08-0.14, wind factor
+#     0.006-0.009, tails 2.5-3.5, half-shear area 8-12 %, 2-3 bands; (E) fails on beta. eng-C2-m20: beta up by
+#     0.02-0.05 and the wind factor down, against eng-m20.
+ENERGY = ["rheology.failure_stress=energy"]
+add_screen_20km("nom-m20", [], "20 km: the nominal envelope (control), own spin-up, meshed at domain.resolution_m")
+add_screen_20km("eng-m20", ENERGY, "20 km: the envelope judges sigma/sqrt(1 - d) (strain-energy equivalence), "
+                "own spin-up")
+add_screen_20km("eng-C2-m20", ENERGY + ["rheology.strength_lab_pa=5.6e6"],
+                "20 km: the envelope judges sigma/sqrt(1 - d), C_lab 5.6 MPa (intact ice 2 x stronger; a mechanism "
+                "diagnostic), own spin-up")
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
