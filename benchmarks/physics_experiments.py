@@ -2688,6 +2688,25 @@ add_screen_20km("eng-m20", ENERGY, "20 km: the envelope judges sigma/sqrt(1 - d)
 add_screen_20km("eng-C2-m20", ENERGY + ["rheology.strength_lab_pa=5.6e6"],
                 "20 km: the envelope judges sigma/sqrt(1 - d), C_lab 5.6 MPa (intact ice 2 x stronger; a mechanism "
                 "diagnostic), own spin-up")
+# Result (E) (2026-11-30, 03:49 UTC): fails, and the prediction failed on the tails, the half-shear area and the
+# drift. Control nom-m20 / eng-m20 / eng-C2-m20 (eff-m20): beta 0.064 / 0.121 / 0.123 (0.240), wind factor 0.0044
+# / 0.0110 / 0.0092 (0.0132), tails 2.42, 2.58 / 3.76, 3.92 / 3.81, 3.31 (4.35, 4.44), half-shear area 6.7 / 14.1
+# / 8.9 % (13.4), R2 0.747 / 0.541 / 0.663 (0.563), rate 0.0030 / 0.0160 / 0.0117 per day (0.0269), remeshes 52 /
+# 162 / 121 (309): 4 / 1 / 1 bands inside (1). beta and the drift lie between the two envelopes, as predicted;
+# the tails and the spread of the shear do not: they are nearly the effective envelope's. Twice the floes'
+# strength brings the drift into its band and halves the spread, and leaves beta where it was.
+# Written 2026-11-30 03:50 UTC, before its runs: do strong floes work with the energy envelope as with the
+# effective one? eng-C5-m20 and eng-C8-m20 (C_lab 14 and 22.4 MPa; calibrations of a mechanism diagnostic, as
+# eff-C5/C8), 20 km, closed basin, the validation month, own spin-ups.
+# (E8) a lead (the 10 km validation month in both basins next) as (E): beta in 0.14-0.23, the wind factor in
+#      0.006-0.010 and at least 3 bands inside.
+# Predicted: the trend of eng-C2: the shear concentrates (half-shear area 5-7 %, R2 0.68-0.74) and the drift
+#     slows (wind factor 0.005-0.008 at C5, 0.004-0.007 at C8); beta stays at 0.11-0.15; tails 3.0-3.5. (E8)
+#     fails on beta for both.
+for _tag, _c in (("eng-C5-m20", "14e6"), ("eng-C8-m20", "22.4e6")):
+    add_screen_20km(_tag, ENERGY + [f"rheology.strength_lab_pa={_c}"],
+                    f"20 km: the envelope judges sigma/sqrt(1 - d), C_lab {_c} Pa (intact ice {float(_c) / 2.8e6:g} "
+                    "x stronger; a mechanism diagnostic), own spin-up")
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
