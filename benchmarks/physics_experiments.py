@@ -2695,7 +2695,7 @@ add_screen_20km("eng-C2-m20", ENERGY + ["rheology.strength_lab_pa=5.6e6"],
 # 162 / 121 (309): 4 / 1 / 1 bands inside (1). beta and the drift lie between the two envelopes, as predicted;
 # the tails and the spread of the shear do not: they are nearly the effective envelope's. Twice the floes'
 # strength brings the drift into its band and halves the spread, and leaves beta where it was.
-# Written 2026-11-30 03:50 UTC, before its runs: do strong floes work with the energy envelope as with the
+# Written 2026-11-30 03:49 UTC, before its runs: do strong floes work with the energy envelope as with the
 # effective one? eng-C5-m20 and eng-C8-m20 (C_lab 14 and 22.4 MPa; calibrations of a mechanism diagnostic, as
 # eff-C5/C8), 20 km, closed basin, the validation month, own spin-ups.
 # (E8) a lead (the 10 km validation month in both basins next) as (E): beta in 0.14-0.23, the wind factor in
