@@ -2707,6 +2707,24 @@ for _tag, _c in (("eng-C5-m20", "14e6"), ("eng-C8-m20", "22.4e6")):
     add_screen_20km(_tag, ENERGY + [f"rheology.strength_lab_pa={_c}"],
                     f"20 km: the envelope judges sigma/sqrt(1 - d), C_lab {_c} Pa (intact ice {float(_c) / 2.8e6:g} "
                     "x stronger; a mechanism diagnostic), own spin-up")
+# Result (E8) (2026-11-30, 03:51 UTC): fails for both, on beta and on the drift; the prediction held on beta and
+# was wrong on the drift and the tails. eng-C5-m20 / eng-C8-m20: beta 0.134 / 0.104, wind factor 0.0037 / 0.0009
+# (the pack locks), tails 1.81, 1.77 (heavier than observed) / 2.34, 2.35 (both in), half-shear area 2.7 / 6.7 %,
+# R2 0.757 / 0.753 (in), rate 0.0018 / 0.0002 per day, 51 / 4 remeshes: 1 / 4 bands inside (C8: both tails, the
+# half-shear area and R2, with the pack all but still). Broken ice that keeps C sqrt(1 - d) of floes that strong
+# holds the pack; between C_lab x2 (wind factor 0.0092, tails 3.81, 3.31) and x5 the tails cross the observed band.
+# Written 2026-11-30 03:51 UTC, before its runs: where between x2 and x5 does the pack stop, and what are the
+# statistics on the way? eng-C3-m20 (C_lab 8.4 MPa: a median cohesion of about 36 kPa at 20 km, near the in-situ
+# estimate of about 40 kPa of Weiss et al. 2007 as cited by Girard et al. 2011) and eng-C4-m20 (11.2 MPa; a
+# calibration of a mechanism diagnostic), 20 km, closed basin, the validation month, own spin-ups.
+# (E3) a lead (the 10 km validation month in both basins next) as (E): beta in 0.14-0.23, the wind factor in
+#      0.006-0.010 and at least 3 bands inside.
+# Predicted: C3: wind factor 0.006-0.008, tails 2.4-3.0, half-shear area 5-8 %, R2 0.70-0.76, rate 0.005-0.009
+#     per day, beta 0.12-0.14: 2-3 bands; C4: wind factor 0.004-0.006, tails 2.0-2.5; (E3) fails on beta.
+for _tag, _c in (("eng-C3-m20", "8.4e6"), ("eng-C4-m20", "11.2e6")):
+    add_screen_20km(_tag, ENERGY + [f"rheology.strength_lab_pa={_c}"],
+                    f"20 km: the envelope judges sigma/sqrt(1 - d), C_lab {_c} Pa (intact ice {float(_c) / 2.8e6:g} "
+                    "x stronger), own spin-up")
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
