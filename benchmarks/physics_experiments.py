@@ -2725,12 +2725,12 @@ for _tag, _c in (("eng-C3-m20", "8.4e6"), ("eng-C4-m20", "11.2e6")):
     add_screen_20km(_tag, ENERGY + [f"rheology.strength_lab_pa={_c}"],
                     f"20 km: the envelope judges sigma/sqrt(1 - d), C_lab {_c} Pa (intact ice {float(_c) / 2.8e6:g} "
                     "x stronger), own spin-up")
-# Result (E3) (2026-11-30, 03:56 UTC): fails for both by its letter (2 bands each); C3 misses a third band by the
+# Result (E3) (2026-11-30, 03:54 UTC): fails for both by its letter (2 bands each); C3 misses a third band by the
 # rate (0.0004 below). eng-C3-m20 / eng-C4-m20: beta 0.151 / 0.118, wind factor 0.0074 / 0.0062 (both in), tails
 # 3.71, 3.27 / 2.92, 2.57 (the |div| tail in), half-shear area 7.2 / 5.2 % (in), R2 0.743 / 0.725 (C3 in), rate
 # 0.0096 / 0.0085 per day, 97 / 80 remeshes. The prediction held on the drift (C3), the half-shear area and R2,
 # and failed on C3's tails (lighter), beta (higher) and C4's drift (0.0062, not 0.004-0.006).
-# Written 2026-11-30 03:56 UTC, before its runs: one month decides little (beta moved 0.03-0.08 between months in
+# Written 2026-11-30 03:54 UTC, before its runs: one month decides little (beta moved 0.03-0.08 between months in
 # every set-up so far). Eight months at 20 km (the shipped set's wind seeds 2026-2033, each set from its own 20 km
 # spin-up) for eng-C2-m20 (median cohesion 24 kPa at 20 km, range about 16-32 kPa: inside the in-situ maximum of
 # about 40 kPa, Weiss et al. 2007 as cited by Girard et al. 2011) and eng-C3-m20 (36 kPa, range about 24-48 kPa).
