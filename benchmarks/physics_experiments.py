@@ -2740,6 +2740,25 @@ for _tag, _c in (("eng-C3-m20", "8.4e6"), ("eng-C4-m20", "11.2e6")):
 #     0.10-0.13, wind factor 0.008-0.010, 1-2 bands; (WE) fails for both on beta.
 add_months_20km("eng-C2-m20", "20 km, energy envelope, C_lab x2, closed, eight months", ENSEMBLE_SEEDS + MORE_SEEDS)
 add_months_20km("eng-C3-m20", "20 km, energy envelope, C_lab x3, closed, eight months", ENSEMBLE_SEEDS + MORE_SEEDS)
+# Result (WE) (2026-11-30, 04:04 UTC): fails for both on beta, as predicted. Eight-month medians C2 / C3: beta
+# 0.109 / 0.105 (0 of 8 months in 0.14-0.23 / 1 of 8), wind factor 0.0092 / 0.0073 (6 of 8 in the band for each),
+# tails 3.29, 3.35 / 2.79, 2.96, half-shear area 8.6 / 6.0 % (C3 in, 8 of 8), R2 0.661 / 0.716, rate 0.0133 /
+# 0.0094 per day (C2 in, 8 of 8): 1 band inside each. The prediction held for C2 and was too high on C3's beta
+# (0.105, not 0.12-0.15) and its bands (1, not 2). The validation month's beta (0.151) was C3's highest of eight.
+# Written 2026-11-30 04:04 UTC, before its runs: does the energy envelope's month carry over from 20 to 10 km, and
+# with which strength? The scaling law makes the 10 km elements about 1.4 times stronger than the 20 km ones.
+# The 10 km validation month, closed basin, own 10 km spin-ups: eng-C3 (C_lab 8.4 MPa, the 20 km screen's; median
+# cohesion about 51 kPa at 10 km) and eng-C2 (5.6 MPa: about 34 kPa at 10 km, near the 20 km C3's 36 kPa in
+# pascals).
+# (R) the month carries over for a strength if its 10 km run puts at least as many bands inside as eng-C3-m20 at
+#     20 km (2), with beta within 0.03 of its 0.151 and the wind factor in 0.006-0.010.
+# Predicted: eng-C3 at 10 km behaves as C4-C5 did at 20 km: the drift slows to 0.004-0.006, the tails get heavier
+#     (2.0-2.7), beta 0.10-0.14: (R) fails on the drift. eng-C2 at 10 km is nearer the 20 km C3: wind factor
+#     0.006-0.009, beta 0.11-0.15, tails 2.8-3.6, 1-2 bands: (R) is a coin toss.
+for _tag, _c in (("eng-C3", "8.4e6"), ("eng-C2", "5.6e6")):
+    add_month_own_spinup(_tag, ENERGY + [f"rheology.strength_lab_pa={_c}"],
+                         f"the envelope judges sigma/sqrt(1 - d), C_lab {_c} Pa (intact ice {float(_c) / 2.8e6:g} x "
+                         "stronger), own spin-up")
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
