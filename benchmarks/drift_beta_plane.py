@@ -23,6 +23,8 @@ overrides) and ``docs/figures/drift_response.json`` (its wind factor,
 * the effective envelope with floes at least five times neXtSIM's strength (calibrated; forty-first
   session, "Strong floes in a weak network");
 * the effective envelope (broken ice keeps no cohesion), with or without a damage cap or another α;
+* the energy envelope (broken ice keeps C √(1 − d); forty-second session, "Broken ice that keeps part
+  of its cohesion"), at any strength;
 * broken ice that keeps or caps its pressure on the linear element (the mean stress kept, a bulk
   viscosity ratio, neXtSIM's compressive term, closed cracks);
 * the nominal envelope on the linear element: the shipped set and every change of forcing,
@@ -72,13 +74,16 @@ FAMILIES = (
                 and float(o.get("rheology.strength_lab_pa", "0")) >= STRONG_FLOES_LAB_PA)),
     ("effective", "effective envelope (broken ice keeps no cohesion)",
      lambda o: o.get("rheology.failure_stress") == "effective"),
+    ("energy", "energy envelope (broken ice keeps C sqrt(1 - d))",
+     lambda o: o.get("rheology.failure_stress") == "energy"),
     ("pressure", "broken ice keeps or caps its pressure (linear element)",
      lambda o: (o.get("rheology.relax_mean_stress") == "false" or "rheology.bulk_shear_viscosity_ratio" in o
                 or "rheology.max_pressure_pa" in o or o.get("rheology.crack_closure") == "true")),
     ("nominal", "nominal envelope, linear element (the shipped set and its variations)", lambda o: True),
 )
 COLOURS = {"evp": "tab:gray", "crouzeix_raviart": "tab:purple", "nodal": "tab:brown", "nonlocal": "tab:olive",
-           "effective": "tab:red", "strong_floes": "tab:pink", "pressure": "tab:orange", "nominal": "tab:blue"}
+           "effective": "tab:red", "strong_floes": "tab:pink", "energy": "tab:cyan", "pressure": "tab:orange",
+           "nominal": "tab:blue"}
 
 
 def overrides_dict(overrides: list) -> dict:

@@ -913,6 +913,8 @@ def test_drift_beta_plane_families_points_and_counts():
     assert family_of(["rheology.failure_stress=effective", "rheology.strength_lab_pa=8.4e6"]) == "effective"
     assert family_of(["rheology.failure_stress=effective", "rheology.strength_lab_pa=14e6"]) == "strong_floes"
     assert family_of(["rheology.strength_lab_pa=14e6"]) == "nominal"
+    assert family_of(["rheology.failure_stress=energy", "rheology.strength_lab_pa=14e6"]) == "energy"
+    assert family_of(["rheology.failure_stress=energy", "rheology.max_pressure_pa=1e4"]) == "energy"
     assert family_of(["rheology.failure_stress=effective", "solver.velocity_element=crouzeix_raviart"]) == \
         "crouzeix_raviart"
     assert family_of(["rheology.max_pressure_pa=10e3"]) == "pressure"
