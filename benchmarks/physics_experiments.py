@@ -2759,6 +2759,21 @@ for _tag, _c in (("eng-C3", "8.4e6"), ("eng-C2", "5.6e6")):
     add_month_own_spinup(_tag, ENERGY + [f"rheology.strength_lab_pa={_c}"],
                          f"the envelope judges sigma/sqrt(1 - d), C_lab {_c} Pa (intact ice {float(_c) / 2.8e6:g} x "
                          "stronger), own spin-up")
+# Result (R) (2026-11-30, 04:19 UTC): fails for both on beta; the prediction was wrong on C3's drift and C2's
+# tails. 10 km, closed, validation month, eng-C3 / eng-C2 (median cohesion 51 / 34 kPa at 10 km, 5-95 %: 36-68 /
+# 24-45 kPa): beta 0.111 / 0.104 (0.04 / 0.05 below the 20 km C3's 0.151), wind factor 0.0072 / 0.0084 (both
+# in), tails 2.59, 2.63 / 4.02, 3.50, half-shear area 4.4 / 6.6 % (both in), R2 0.744 / 0.689, rate 0.0083 /
+# 0.0115 per day, 389 / 495 remeshes: 3 / 2 bands inside (C3: the |div| tail, the half-shear area and R2; its
+# shear tail 0.09 and its rate 0.0017 outside). The shipped set in the same month: beta 0.082, 4 bands, rate
+# 0.0032, wind factor 0.0036 (8 km mesh).
+# Written 2026-11-30 04:19 UTC, before its runs: does eng-C3's 10 km month (3 bands with the drift in its band)
+# hold in the strait and in the calm month (wind seed 2028, where the shipped set locks: rate 0.0004 per day)?
+# F10s-hthick-eng-C3 and F10-hthick-eng-C3-w2028, from the same 10 km spin-up.
+# (S) it holds if each puts at least 3 bands inside with the wind factor in 0.006-0.010.
+# Predicted: the strait: beta 0.09-0.13, 2-3 bands, wind factor 0.006-0.009; the calm month: wind factor
+#     0.004-0.006, rate 0.002-0.005 per day, 1-2 bands; (S) fails on the calm month.
+EXPERIMENTS["F10-hthick-eng-C3-w2028"] = ("closed", EXPERIMENTS["F10-hthick-eng-C3"][1] + ["forcing.wind.seed=2028"],
+                                          10e3, 28, "F10-hthick-eng-C3, the weather of wind seed 2028 (the calm month)")
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
