@@ -182,7 +182,7 @@ VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.me
             # The envelope on sigma/sqrt(1 - d), the effective stress of strain-energy equivalence
             # (rheology.failure_stress = "energy", forty-second session; cohesion C sqrt(1 - d)).
             # "delaunay+eng" at N = 20 and 40, seed 0, implicit. Stated before the runs (2026-11-30,
-            # 04:35 UTC): item 7 is met only if the plate ruptures (a drop of at least 0.1 % of the
+            # 04:30 UTC): item 7 is met only if the plate ruptures (a drop of at least 0.1 % of the
             # peak) with both rate faults of the rupture block within 10 deg of 27.5 deg. Predicted:
             # it is not: the faults lie at 40-47 deg (the change acts on ice already damaged, not on
             # the growth of the first band in intact ice); the peak lies between the effective
