@@ -404,8 +404,10 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
         if eff is not None:
             if eff == 1.0:  # "effective": C (1 − d)
                 ce = ce * (1.0 - damage[e])
-            else:  # "energy": C √(1 − d)
+            elif eff == 0.5:  # "energy": C √(1 − d)
                 ce = ce * math.sqrt(1.0 - damage[e])
+            else:  # any other power of params.FAILURE_EXPONENT
+                ce = ce * (1.0 - damage[e]) ** eff
         at = ce * kt - mm
         ac = ce * kc - (q - 1.0) * mm
         if at > 0.0 and ac > 0.0 and r2 < at * at and (q + 1.0) * (q + 1.0) * r2 < ac * ac:
