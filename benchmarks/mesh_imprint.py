@@ -191,8 +191,8 @@ VARIANTS = {"base": [], "jitter": ["domain.jitter=0.3"], "delaunay": ["domain.me
             # Result (2026-11-30, 04:49 UTC): item 7 not met, as predicted. Rate faults of the rupture
             # block 44.8, 44.4 deg at N = 20 and 35.4, 44.4 deg at N = 40 (one within 10 deg of 27.5);
             # final damage 9.8, 30.4 / 14.2, 27.4 deg. Peak 102 / 99 kPa (in the predicted range);
-            # largest block drop 69.9 / 97.9 kPa, larger than the effective envelope's (84 / 62 kPa):
-            # the prediction failed there. Wall 72 / 572 s (implicit solver).
+            # largest block drop 69.9 / 97.9 kPa against the effective envelope's 84 / 62 kPa: at
+            # N = 40 beyond the predicted range. Wall 72 / 572 s (implicit solver).
             "eng": ["rheology.failure_stress=energy"],
             # The 8 km disk with the strength of the 5.2 km disk's elements (thirty-sixth session):
             # C_lab x sqrt(8.00 / 5.24) (the two meshes' median edges), so each element is as strong
