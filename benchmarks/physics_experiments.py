@@ -2792,7 +2792,7 @@ for _seed in (2027, 2029, 2030, 2031, 2032, 2033):
                                                   f"F10-hthick-eng-C3, the weather of wind seed {_seed}")
 ENSEMBLES["10 km, energy envelope, C_lab x3, closed, eight months"] = (
     ["F10-hthick-eng-C3"] + [f"F10-hthick-eng-C3-w{_s}" for _s in (2027, 2028, 2029, 2030, 2031, 2032, 2033)])
-# Result (W10) (2026-11-30, 04:59 UTC): fails, as predicted. Eight-month medians (10 km, closed): beta 0.089 (0 of 8
+# Result (W10) (2026-11-30, 04:58 UTC): fails, as predicted. Eight-month medians (10 km, closed): beta 0.089 (0 of 8
 # in 0.14-0.23; range 0.063-0.111), wind factor 0.0069 (6 of 8 in the band; the calm months 2028 and 2029 at
 # 0.0041), tails 2.57 / 2.37 (the |div| tail in, 6 of 8), half-shear area 3.5 % (3 of 8 in), R2 0.711 (3 of 8),
 # rate 0.0086 per day (3 of 8): 1 band inside. The shipped set's eight 10 km months: beta 0.056, 4 bands, rate
