@@ -2795,8 +2795,9 @@ ENSEMBLES["10 km, energy envelope, C_lab x3, closed, eight months"] = (
 # Result (W10) (2026-11-30, 04:58 UTC): fails, as predicted. Eight-month medians (10 km, closed): beta 0.089 (0 of 8
 # in 0.14-0.23; range 0.063-0.111), wind factor 0.0069 (6 of 8 in the band; the calm months 2028 and 2029 at
 # 0.0041), tails 2.57 / 2.37 (the |div| tail in, 6 of 8), half-shear area 3.5 % (3 of 8 in), R2 0.711 (3 of 8),
-# rate 0.0086 per day (3 of 8): 1 band inside. The shipped set's eight 10 km months: beta 0.056, 4 bands, rate
-# 0.0023 per day. The prediction held on every statistic but beta (0.001 below its range).
+# rate 0.0086 per day (3 of 8): 1 band inside. The shipped set's eight 10 km months (group "meshed at
+# domain.resolution_m, closed"): beta 0.044, 4 bands, rate 0.0027 per day. The prediction held on every statistic
+# but beta (0.001 below its range).
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
