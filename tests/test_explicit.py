@@ -123,6 +123,37 @@ def test_element_kernel_stress_update_uses_rheology_moduli(kernel):
         assert not np.allclose(sigma, sigma0, rtol=1e-3)  # the strain rate acted
 
 
+def _failure_ray(rheo, seed, shrink, m=400):
+    """400 elements with random damage d and cohesion C on the uniaxial-compression ray
+    σ = −s σc ŷŷ (σc the intact uniaxial strength of C), s = shrink(d) × 1.001 for even elements
+    (just outside the shrunk envelope) and × 0.999 for odd ones (just inside).
+    Returns (rng, m, d, C, σ)."""
+    from lagice.rheology.maxwell_eb import envelope
+
+    rng = np.random.default_rng(seed)
+    d = rng.uniform(0.0, 0.95, m)
+    coh = rng.uniform(1e4, 3e4, m)
+    s = shrink(d) * np.where(np.arange(m) % 2 == 0, 1.001, 0.999)
+    sig = np.zeros((m, 3))
+    sig[:, 1] = -s * envelope(coh, rheo.params.friction)[1]
+    return rng, m, d, coh, sig
+
+
+def _run_failure_kernel(kernel, rheo, eff, cohesion, sigma, damage, td=20.0):
+    """One sub-step of the element kernel at zero strain rate (no relaxation, no healing,
+    Δt = 7 s, damage time ``td``) on copies of σ and d, with the failure-stress power ``eff``;
+    returns (σ, d, flags)."""
+    m = len(damage)
+    p = rheo.params
+    kc, kt = envelope_factors(rheo)
+    tri, zeros3 = np.zeros((m, 3), np.int32), np.zeros((m, 3))
+    sg, dm, flag = sigma.copy(), damage.copy(), np.zeros(m, np.int8)
+    kernel(tri, zeros3, zeros3, np.zeros((1, 2)), sg, dm, np.ones(m), cohesion, kc, kt, np.full(m, td),
+           np.zeros(m), np.zeros(m), np.ones(m), None, None, None, None, eff, None, 7.0, *rheo.K[0, :2],
+           rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag, None)
+    return sg, dm, flag
+
+
 @pytest.mark.parametrize("kernel", [element_stress_damage_kernel_serial, element_stress_damage_kernel_a4])
 def test_effective_failure_stress(kernel):
     """``rheology.failure_stress = "effective"``: the envelope judges σ/(1 − d). (1) On the
@@ -132,27 +163,11 @@ def test_effective_failure_stress(kernel):
     the nominal kernel run with the cohesion C (1 − d): stress, damage and flags bit for bit
     (the friction is kept, only the cohesion scales). (3) Other steppers and the nonlocal damage
     refuse it, naming the key; the implicit solver's damage update agrees with the kernel."""
-    from lagice.rheology.maxwell_eb import envelope
-
     rheo = MaxwellEB(failure_stress="effective", friction=0.7)
-    p = rheo.params
-    kc, kt = envelope_factors(rheo)
-    rng = np.random.default_rng(11)
-    m = 400
-    d = rng.uniform(0.0, 0.95, m)
-    coh = rng.uniform(1e4, 3e4, m)
-    sigma_c = envelope(coh, p.friction)[1]
-    s = (1.0 - d) * np.where(np.arange(m) % 2 == 0, 1.001, 0.999)  # just outside / inside the shrunk envelope
-    sig0 = np.zeros((m, 3))
-    sig0[:, 1] = -s * sigma_c
-    tri, zeros3 = np.zeros((m, 3), np.int32), np.zeros((m, 3))
+    rng, m, d, coh, sig0 = _failure_ray(rheo, 11, lambda d: 1.0 - d)
 
     def run(eff, cohesion, sigma, damage):
-        sg, dm, flag = sigma.copy(), damage.copy(), np.zeros(m, np.int8)
-        kernel(tri, zeros3, zeros3, np.zeros((1, 2)), sg, dm, np.ones(m), cohesion, kc, kt, np.full(m, 20.0),
-               np.zeros(m), np.zeros(m), np.ones(m), None, None, None, None, eff, None, 7.0, *rheo.K[0, :2],
-               rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag, None)
-        return sg, dm, flag
+        return _run_failure_kernel(kernel, rheo, eff, cohesion, sigma, damage)
 
     _, d_eff, f_eff = run(1.0, coh, sig0, d)
     assert np.array_equal(f_eff.astype(bool), np.arange(m) % 2 == 0)
@@ -190,33 +205,21 @@ def test_energy_equivalent_failure_stress(kernel):
     """``rheology.failure_stress = "energy"``: the envelope judges σ/√(1 − d), the effective stress
     of strain-energy equivalence for the modulus E0 (1 − d). (1) On the uniaxial-compression ray
     σ = −s σc ŷŷ an element of damage d damages when s > √(1 − d) and not when s < √(1 − d) (margin
-    1e-3). (2) An element it damages ends on its own shrunk envelope, |σ_yy| = σc √(1 − d_new)
-    (td = Δt: the whole correction in one sub-step, no healing), where the effective criterion,
-    whose correction does not move σ/(1 − d), sends the same element far further. (3) Everywhere it
+    1e-3). (2) Its correction converges: from 50 % beyond the shrunk envelope, 40 full corrections
+    (td = Δt, zero strain rate) bring σ back onto σc √(1 − d) with 1 − d lowered 1.5² times, where
+    the effective criterion, whose correction does not move σ/(1 − d), runs to the cap. (3) Everywhere it
     is the nominal kernel run with the cohesion C √(1 − d), bit for bit, and the implicit solver's
     update agrees. (4) The CUDA stepper refuses it, naming the key and value."""
     from lagice.rheology.maxwell_eb import envelope
 
     rheo = MaxwellEB(failure_stress="energy", friction=0.7)
     p = rheo.params
-    kc, kt = envelope_factors(rheo)
-    rng = np.random.default_rng(12)
-    m = 400
-    d = rng.uniform(0.0, 0.95, m)
-    coh = rng.uniform(1e4, 3e4, m)
+    rng, m, d, coh, sig0 = _failure_ray(rheo, 12, lambda d: np.sqrt(1.0 - d))
     sigma_c = envelope(coh, p.friction)[1]
     root = np.sqrt(1.0 - d)
-    s = root * np.where(np.arange(m) % 2 == 0, 1.001, 0.999)
-    sig0 = np.zeros((m, 3))
-    sig0[:, 1] = -s * sigma_c
-    tri, zeros3 = np.zeros((m, 3), np.int32), np.zeros((m, 3))
 
     def run(eff, cohesion, sigma, damage, td=20.0):
-        sg, dm, flag = sigma.copy(), damage.copy(), np.zeros(m, np.int8)
-        kernel(tri, zeros3, zeros3, np.zeros((1, 2)), sg, dm, np.ones(m), cohesion, kc, kt, np.full(m, td),
-               np.zeros(m), np.zeros(m), np.ones(m), None, None, None, None, eff, None, 7.0, *rheo.K[0, :2],
-               rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag, None)
-        return sg, dm, flag
+        return _run_failure_kernel(kernel, rheo, eff, cohesion, sigma, damage, td)
 
     _, d_en, f_en = run(0.5, coh, sig0, d)
     assert np.array_equal(f_en.astype(bool), np.arange(m) % 2 == 0)
