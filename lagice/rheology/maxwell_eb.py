@@ -20,7 +20,7 @@ from numba import njit, prange
 
 from .._numba import pick, serial_copy
 from ..errors import ConfigError
-from ..params import STRESS_CORRECTIONS, MaxwellEBParams
+from ..params import FAILURE_EXPONENT, STRESS_CORRECTIONS, MaxwellEBParams
 
 
 def plane_stress_matrix(poisson: float) -> np.ndarray:
@@ -401,10 +401,11 @@ class MaxwellEB:
         ``failure_stress = "effective"`` the envelope is that of the cohesion C (1 − d), with
         ``"energy"`` that of C √(1 − d), d the damage passed in (the step's starting damage), as
         the explicit kernel takes it."""
-        if self.params.failure_stress == "effective":
-            cohesion = np.asarray(cohesion, np.float64) * (1.0 - np.asarray(damage, np.float64))
-        elif self.params.failure_stress == "energy":
-            cohesion = np.asarray(cohesion, np.float64) * np.sqrt(1.0 - np.asarray(damage, np.float64))
+        power = FAILURE_EXPONENT[self.params.failure_stress]  # as the explicit kernel takes it
+        if power is not None:
+            x = 1.0 - np.asarray(damage, np.float64)
+            factor = x if power == 1.0 else np.sqrt(x) if power == 0.5 else x ** power
+            cohesion = np.asarray(cohesion, np.float64) * factor
         out = np.empty(len(damage))
         kernel = pick(DAMAGE_UPDATE, len(damage))
         n = kernel(sigma, damage, cohesion, float(dt), np.ascontiguousarray(td),
