@@ -2798,6 +2798,22 @@ ENSEMBLES["10 km, energy envelope, C_lab x3, closed, eight months"] = (
 # rate 0.0086 per day (3 of 8): 1 band inside. The shipped set's eight 10 km months (group "meshed at
 # domain.resolution_m, closed"): beta 0.044, 4 bands, rate 0.0027 per day. The prediction held on every statistic
 # but beta (0.001 below its range).
+# Written 2026-11-30 05:37 UTC, before its runs: the energy envelope together with neXtSIM's compressive term (P* =
+# 10 kPa, h^1.5, PMAX; both sourced, C_lab a calibration inside the in-situ range as in E3/E4). On the nominal
+# envelope the term raised beta by 0.01-0.04 and the rate x1.5 (fourth session); on the effective envelope it raised
+# beta from 0.192 to 0.285 (B20-hthick-effP). The energy envelope alone at 20 km: beta 0.151 / 0.118 / 0.134 for C_lab
+# x3 / x4 / x5, wind factor 0.0074 / 0.0062 / 0.0037, 2 / 2 / 1 bands. eng-P-C3-m20, eng-P-C4-m20, eng-P-C5-m20:
+# 20 km, closed basin, the validation month, own 20 km spin-ups.
+# (EP) a lead for the 10 km month if a screen has beta in 0.14-0.23, the wind factor in 0.006-0.010 and at least 3
+#      bands inside.
+# Predicted: the term lifts beta by 0.02-0.06 and the rate x1.3-1.6 over the energy screens, and frees the drift
+#     by 10-30 %; C_lab x4 is the likeliest lead (beta 0.15-0.18, wind factor 0.007-0.008), with 2-3 bands: the
+#     tails lighter than observed, as with the effective envelope.
+for _tag, _c in (("eng-P-C3-m20", "8.4e6"), ("eng-P-C4-m20", "11.2e6"), ("eng-P-C5-m20", "14e6")):
+    add_screen_20km(_tag, ENERGY + PMAX + [f"rheology.strength_lab_pa={_c}"],
+                    f"20 km: the envelope judges sigma/sqrt(1 - d) with neXtSIM's compressive term, C_lab {_c} Pa, "
+                    "own spin-up")
+
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
