@@ -2813,6 +2813,31 @@ for _tag, _c in (("eng-P-C3-m20", "8.4e6"), ("eng-P-C4-m20", "11.2e6"), ("eng-P-
     add_screen_20km(_tag, ENERGY + PMAX + [f"rheology.strength_lab_pa={_c}"],
                     f"20 km: the envelope judges sigma/sqrt(1 - d) with neXtSIM's compressive term, C_lab {_c} Pa, "
                     "own spin-up")
+# Result (EP) (2026-11-30, 05:42 UTC): fails by one band; the prediction held on beta, the rate and the drift, and
+# was wrong on the tails. eng-P-C3 / eng-P-C4 / eng-P-C5 (20 km, closed, validation month): beta 0.142 / 0.164 /
+# 0.148, wind factor 0.0093 / 0.0079 (both in) / 0.0053, tails 3.43, 3.93 / 1.54, 1.34 / 2.28, 1.36, half-shear
+# area 6.2 / 4.3 % (both in) / 3.7 %, R2 0.693 / 0.715 / 0.730 (0.0001 below), rate 0.0139 / 0.0102 (both in) /
+# 0.0055 per day, 191 / 154 / 112 remeshes: 2 / 2 / 1 bands inside. Against the energy envelope alone (C3 / C4 /
+# C5): beta +0.009 / +0.046 / +0.014, the wind factor x1.26 / x1.27 / x1.43, the rate x1.45 / x1.20 / x3.0. The
+# tails cross the observed band between C_lab x3 (too light) and x4 (far too heavy).
+# Written 2026-11-30 05:41 UTC, before its runs:
+# (EP35) a 20 km screen between the two, eng-P-C35-m20 (C_lab 9.8 MPa, x3.5; a calibration, the median cohesion
+#        about 42 kPa at 20 km, at the in-situ maximum): a lead if beta lies in 0.14-0.23, the wind factor in
+#        0.006-0.010 and at least 3 bands are inside. Predicted: beta 0.14-0.17, wind factor 0.008-0.009, and
+#        tails that jump to one side rather than land in the band (the crossing is steep): 2 bands.
+# (EP10) the 10 km validation month in both basins, eng-P-C3 and eng-P-C4 (own 10 km spin-ups; the scaling law
+#        makes the 10 km elements 1.4 times stronger, so eng-P-C3 at 10 km has about eng-P-C4's 20 km cohesion):
+#        a lead if, in each basin, beta lies in 0.14-0.23, the wind factor in 0.006-0.010 and at least 3 bands
+#        are inside; a flagship candidate (eight 10 km months next) only if each basin also puts at least 4 bands
+#        inside, as the shipped set does. Predicted: beta 0.11-0.15 (the energy envelope lost 0.04 from 20 to 10
+#        km), the wind factor in its band, 2-3 bands in the closed basin and fewer in the strait: not a lead.
+add_screen_20km("eng-P-C35-m20", ENERGY + PMAX + ["rheology.strength_lab_pa=9.8e6"],
+                "20 km: the envelope judges sigma/sqrt(1 - d) with neXtSIM's compressive term, C_lab 9.8e6 Pa, "
+                "own spin-up")
+for _tag, _c in (("eng-P-C3", "8.4e6"), ("eng-P-C4", "11.2e6")):
+    add_month_own_spinup(_tag, ENERGY + PMAX + [f"rheology.strength_lab_pa={_c}"],
+                         f"the envelope judges sigma/sqrt(1 - d) with neXtSIM's compressive term, C_lab {_c} Pa, "
+                         "own spin-up")
 
 
 def command(scene, overrides, res, days, out) -> list:
