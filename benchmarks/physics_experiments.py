@@ -2813,7 +2813,7 @@ for _tag, _c in (("eng-P-C3-m20", "8.4e6"), ("eng-P-C4-m20", "11.2e6"), ("eng-P-
     add_screen_20km(_tag, ENERGY + PMAX + [f"rheology.strength_lab_pa={_c}"],
                     f"20 km: the envelope judges sigma/sqrt(1 - d) with neXtSIM's compressive term, C_lab {_c} Pa, "
                     "own spin-up")
-# Result (EP) (2026-11-30, 05:42 UTC): fails by one band; the prediction held on beta, the rate and the drift, and
+# Result (EP) (2026-11-30, 05:41 UTC): fails by one band; the prediction held on beta, the rate and the drift, and
 # was wrong on the tails. eng-P-C3 / eng-P-C4 / eng-P-C5 (20 km, closed, validation month): beta 0.142 / 0.164 /
 # 0.148, wind factor 0.0093 / 0.0079 (both in) / 0.0053, tails 3.43, 3.93 / 1.54, 1.34 / 2.28, 1.36, half-shear
 # area 6.2 / 4.3 % (both in) / 3.7 %, R2 0.693 / 0.715 / 0.730 (0.0001 below), rate 0.0139 / 0.0102 (both in) /
