@@ -2834,6 +2834,11 @@ for _tag, _c in (("eng-P-C3-m20", "8.4e6"), ("eng-P-C4-m20", "11.2e6"), ("eng-P-
 add_screen_20km("eng-P-C35-m20", ENERGY + PMAX + ["rheology.strength_lab_pa=9.8e6"],
                 "20 km: the envelope judges sigma/sqrt(1 - d) with neXtSIM's compressive term, C_lab 9.8e6 Pa, "
                 "own spin-up")
+# Result (EP35) (2026-11-30, 05:45 UTC): fails, 2 bands, as predicted, but beta fell below the predicted range:
+# beta 0.120, wind factor 0.0084 (in), tails 3.80 / 3.27 (light), half-shear area 4.6 % (in), R2 0.689, rate
+# 0.0125 per day (in), 170 remeshes. Over C_lab x3 / x3.5 / x4 / x5 beta goes 0.142 / 0.120 / 0.164 / 0.148 and the
+# shear tail 3.43 / 3.80 / 1.54 / 2.28: no trend that one month can resolve; these differences are of the size of
+# one month's noise.
 for _tag, _c in (("eng-P-C3", "8.4e6"), ("eng-P-C4", "11.2e6")):
     add_month_own_spinup(_tag, ENERGY + PMAX + [f"rheology.strength_lab_pa={_c}"],
                          f"the envelope judges sigma/sqrt(1 - d) with neXtSIM's compressive term, C_lab {_c} Pa, "
