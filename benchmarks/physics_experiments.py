@@ -2843,6 +2843,14 @@ for _tag, _c in (("eng-P-C3", "8.4e6"), ("eng-P-C4", "11.2e6")):
     add_month_own_spinup(_tag, ENERGY + PMAX + [f"rheology.strength_lab_pa={_c}"],
                          f"the envelope judges sigma/sqrt(1 - d) with neXtSIM's compressive term, C_lab {_c} Pa, "
                          "own spin-up")
+# Result (EP10) (2026-11-30, 06:00 UTC): fails in both basins at both strengths; the prediction held on the drift and
+# was wrong on beta (0.01 below its range) and on the bands. 10 km, validation month, closed / strait:
+#   eng-P-C3: beta 0.102 / 0.112, wind factor 0.0090 / 0.0097 (in), tails 3.58, 3.40 / 3.58, 3.64, half-shear area
+#             3.0 / 2.7 %, R2 0.708 / 0.693, rate 0.0109 / 0.0110 per day (in): 1 / 1 band, 630 / 727 remeshes.
+#   eng-P-C4: beta 0.0995 / 0.103, wind factor 0.0062 / 0.0077 (in), tails 1.93 (in), 1.40 / 2.80, 1.40, half-shear
+#             area 2.2 / 2.9 %, R2 0.722 / 0.729 (0.001 below), rate 0.0068 / 0.0077 per day: 1 / 0 bands.
+# From 20 to 10 km beta falls by 0.04-0.06, as for the energy envelope alone (0.151 -> 0.111) and the strong floes
+# (0.171 -> 0.136-0.157), and the shear gathers into 2-3 % of the area. 411-431 s a month on one thread.
 
 
 def command(scene, overrides, res, days, out) -> list:
