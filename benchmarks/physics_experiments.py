@@ -2851,6 +2851,20 @@ for _tag, _c in (("eng-P-C3", "8.4e6"), ("eng-P-C4", "11.2e6")):
 #             area 2.2 / 2.9 %, R2 0.722 / 0.729 (0.001 below), rate 0.0068 / 0.0077 per day: 1 / 0 bands.
 # From 20 to 10 km beta falls by 0.04-0.06, as for the energy envelope alone (0.151 -> 0.111) and the strong floes
 # (0.171 -> 0.136-0.157), and the shear gathers into 2-3 % of the area. 411-431 s a month on one thread.
+# Written 2026-11-30 06:02 UTC, before its runs: does beta keep falling with the element size in this family? The
+# reading (docs/physics.md): a band one element wide damages faster per unit of slip on a finer mesh, so fewer bands
+# carry the motion and less of it cancels. eng-P-C3 at 5 km: its own 5 km spin-up (14 days) and the first 10 days of
+# the closed basin's validation month (three windows: days 1-4, 4-7, 7-10), 2 threads each, one after the other.
+# Compared window by window with the same windows of F10-hthick-eng-P-C3 and B20-hthick-eng-P-C3-m20.
+# (R5) the reading holds if the median beta of the three windows is at least 0.02 below the 10 km run's and the
+#      median half-shear area at most 0.75 times the 10 km run's; it fails if beta is within 0.02 of the 10 km
+#      run's or above it.
+# Predicted: holds: beta 0.03-0.06 below the 10 km windows', half-shear area 0.5-0.7 times.
+SPINUPS["H5-eng-P-C3"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + ENERGY + PMAX
+                          + ["rheology.strength_lab_pa=8.4e6"], OUT / "spinup-H5-eng-P-C3.npz", 5e3)
+EXPERIMENTS["F5-hthick-eng-P-C3-10d"] = ("closed", ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6"]
+                                         + from_spinup("H5-eng-P-C3"), 5e3, 10,
+                                         "eng-P-C3 at 5 km, own 5 km spin-up, first 10 days (resolution test)")
 
 
 def command(scene, overrides, res, days, out) -> list:
