@@ -2865,6 +2865,22 @@ SPINUPS["H5-eng-P-C3"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + ENERGY +
 EXPERIMENTS["F5-hthick-eng-P-C3-10d"] = ("closed", ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6"]
                                          + from_spinup("H5-eng-P-C3"), 5e3, 10,
                                          "eng-P-C3 at 5 km, own 5 km spin-up, first 10 days (resolution test)")
+# Written 2026-11-30 06:11 UTC, before its runs: a second test of the same reading. If beta falls from 20 to 10 km
+# because a band keeps softening with its slip, a floor on the bands' strength should remove most of the fall: a
+# damage cap of 0.9 leaves broken ice at least sqrt(0.1) = 0.32 of its cohesion under the energy envelope, whatever
+# the element size. (The effective envelope's strong floes lost less beta with the cap 0.97 than without it: 0.025
+# against 0.061 in the closed basin.) eng-P-C3-cap90: eng-P-C3 with rheology.max_damage = 0.9, 20 km and 10 km,
+# closed basin, the validation month, own spin-ups.
+# (RC) the reading holds if beta falls from 20 to 10 km by at most 0.02 (eng-P-C3: 0.040) and the 10 km half-shear
+#      area is at least 0.7 times the 20 km one (eng-P-C3: 0.48); it fails if beta falls by 0.03 or more.
+# Predicted: holds; with the floor the floes drift less freely (wind factor 0.005-0.008) and beta is lower at both
+#     sizes (0.08-0.13).
+_CAP90 = ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6", "rheology.max_damage=0.9"]
+add_screen_20km("eng-P-C3-cap90-m20", _CAP90, "20 km: eng-P-C3 with the damage cap 0.9, own spin-up")
+SPINUPS["H1125-eng-P-C3-cap90"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + _CAP90,
+                                   OUT / "spinup-H1125-eng-P-C3-cap90.npz", 10e3)
+EXPERIMENTS["F10-hthick-eng-P-C3-cap90"] = ("closed", _CAP90 + from_spinup("H1125-eng-P-C3-cap90"), 10e3, 28,
+                                            "eng-P-C3 with the damage cap 0.9, own spin-up")
 
 
 def command(scene, overrides, res, days, out) -> list:
