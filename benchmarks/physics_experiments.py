@@ -2881,6 +2881,11 @@ SPINUPS["H1125-eng-P-C3-cap90"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] +
                                    OUT / "spinup-H1125-eng-P-C3-cap90.npz", 10e3)
 EXPERIMENTS["F10-hthick-eng-P-C3-cap90"] = ("closed", _CAP90 + from_spinup("H1125-eng-P-C3-cap90"), 10e3, 28,
                                             "eng-P-C3 with the damage cap 0.9, own spin-up")
+# Result (RC) (2026-11-30, 06:26 UTC): holds by its letter, and tests nothing: the floor locks the pack at both
+# sizes, against the prediction. 20 km / 10 km: beta 0.064 / 0.062 (a fall of 0.002), half-shear area 12.3 / 11.1 %
+# (ratio 0.90), wind factor 0.0009 / 0.0008, rate 0.0009 / 0.00025 per day, 4 / 18 remeshes, mean drift 15 / 12 km,
+# 1 / 1 band. A pack that does not move has no sparse network of sliding bands, and its beta holds across the
+# sizes as the nominal envelope's does; so this is not evidence for the reading.
 
 
 def command(scene, overrides, res, days, out) -> list:
