@@ -2865,6 +2865,13 @@ SPINUPS["H5-eng-P-C3"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + ENERGY +
 EXPERIMENTS["F5-hthick-eng-P-C3-10d"] = ("closed", ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6"]
                                          + from_spinup("H5-eng-P-C3"), 5e3, 10,
                                          "eng-P-C3 at 5 km, own 5 km spin-up, first 10 days (resolution test)")
+# Result (R5) (2026-11-30, 06:28 UTC): fails by its letter; the prediction held on the half-shear area and failed on
+# beta. Windows days 1-4 / 4-7 / 7-10 (median), 20 km / 10 km / 5 km: beta 0.052, 0.101, 0.128 (0.101) / 0.029,
+# -0.008, 0.102 (0.029) / 0.006, 0.072, 0.086 (0.072): the 5 km median is 0.043 above the 10 km one. Half-shear area
+# 4.6 / 2.0 / 0.67 % (medians; ratio 5/10 km 0.33), rate 0.0134 / 0.0109 / 0.0041 per day (medians). The storm window
+# (days 7-10) alone falls by 0.02-0.03 per halving (0.128, 0.102, 0.086), and its rate too (0.045, 0.028, 0.016 per
+# day). Window-to-window beta spreads over 0.1 at each size, so three windows cannot decide the reading. 5 km: 83k
+# elements, 631 remeshes in 10 days, 763 s on two threads (with another run beside it), mean drift 48 km.
 # Written 2026-11-30 06:11 UTC, before its runs: a second test of the same reading. If beta falls from 20 to 10 km
 # because a band keeps softening with its slip, a floor on the bands' strength should remove most of the fall: a
 # damage cap of 0.9 leaves broken ice at least sqrt(0.1) = 0.32 of its cohesion under the energy envelope, whatever
