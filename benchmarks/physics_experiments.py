@@ -2851,6 +2851,14 @@ for _tag, _c in (("eng-P-C3", "8.4e6"), ("eng-P-C4", "11.2e6")):
 #             area 2.2 / 2.9 %, R2 0.722 / 0.729 (0.001 below), rate 0.0068 / 0.0077 per day: 1 / 0 bands.
 # From 20 to 10 km beta falls by 0.04-0.06, as for the energy envelope alone (0.151 -> 0.111) and the strong floes
 # (0.171 -> 0.136-0.157), and the shear gathers into 2-3 % of the area. 411-431 s a month on one thread.
+# Written 2026-11-30 06:36 UTC, before its runs: the 20 km screen eng-P-C4-m20 (beta 0.164, the drift in its band, 2
+# bands) over eight months of weather (the scene's seed and 2027-2033, the same 20 km spin-up), closed basin.
+# (WP) it survives the weather at 20 km if its eight-month median beta lies in 0.14-0.23, its median wind factor in
+#      0.006-0.010 and its group medians put at least 3 bands inside.
+# Predicted: beta median 0.12-0.15 (the validation month was the energy family's highest at 20 km), wind factor
+#     0.006-0.008, tails erratic around the band, 1-2 bands: fails.
+add_months_20km("eng-P-C4-m20", "20 km, energy envelope + P_max, C_lab x4, closed, eight months",
+                ENSEMBLE_SEEDS + MORE_SEEDS)
 # Written 2026-11-30 06:02 UTC, before its runs: does beta keep falling with the element size in this family? The
 # reading (docs/physics.md): a band one element wide damages faster per unit of slip on a finer mesh, so fewer bands
 # carry the motion and less of it cancels. eng-P-C3 at 5 km: its own 5 km spin-up (14 days) and the first 10 days of
