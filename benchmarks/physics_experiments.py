@@ -2859,6 +2859,11 @@ for _tag, _c in (("eng-P-C3", "8.4e6"), ("eng-P-C4", "11.2e6")):
 #     0.006-0.008, tails erratic around the band, 1-2 bands: fails.
 add_months_20km("eng-P-C4-m20", "20 km, energy envelope + P_max, C_lab x4, closed, eight months",
                 ENSEMBLE_SEEDS + MORE_SEEDS)
+# Result (WP) (2026-11-30, 06:40 UTC): fails, as predicted, with beta 0.004 below the predicted range. Eight months
+# (the validation month first, then seeds 2027-2033): beta 0.164, 0.112, 0.013, 0.085, 0.099, 0.145, 0.121, 0.169
+# (median 0.116, 3 of 8 in 0.14-0.23, 0 in the observed band), wind factor 0.0079, 0.0084, 0.0038, 0.0054, 0.0074,
+# 0.0086, 0.0089, 0.0080 (median 0.0080, 6 of 8 in), group medians: tails 3.07 / 1.35 (2/8 and 1/8 in), half-shear
+# area 4.3 % (6/8), R2 0.715 (0/8), rate 0.0107 per day (6/8): 2 bands inside. 31-162 remeshes.
 # Written 2026-11-30 06:02 UTC, before its runs: does beta keep falling with the element size in this family? The
 # reading (docs/physics.md): a band one element wide damages faster per unit of slip on a finer mesh, so fewer bands
 # carry the motion and less of it cancels. eng-P-C3 at 5 km: its own 5 km spin-up (14 days) and the first 10 days of
