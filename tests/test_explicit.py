@@ -153,6 +153,28 @@ def _run_failure_kernel(kernel, rheo, eff, cohesion, sigma, damage, td=20.0):
            rheo.K[2, 2], rheo.q, rheo._denom, p.max_damage, p.E0, p.relaxation_time_s, 4.0, flag, None)
     return sg, dm, flag
 
+def _check_scaled_cohesion(kernel, rheo, rng, eff, coh, d, shrink):
+    """Random stresses, some tensile, some confined: the kernel with the failure-stress power
+    ``eff`` equals the nominal kernel run with the cohesion C shrink(d), bit for bit (stress,
+    damage, flags), with some elements damaging and some not; the implicit solver's damage
+    update (the rheology's; zero strain rate, γ = 1) damages the same elements, to round-off.
+    Returns (σ, the kernel's result)."""
+    m = len(d)
+    sig = rng.normal(0, 2e4, (m, 3))
+    sig[:, :2] -= rng.uniform(0, 3e4, (m, 1))
+    a = _run_failure_kernel(kernel, rheo, eff, coh, sig, d)
+    b = _run_failure_kernel(kernel, rheo, None, coh * shrink(d), sig, d)
+    assert 50 < a[2].sum() < m - 50
+    for x, y in zip(a, b):
+        assert np.array_equal(x, y)
+    si, di = sig.copy(), d.copy()
+    dc = rheo.damage_update(si, di, coh, 7.0, np.full(m, 20.0), np.zeros(m))
+    assert np.array_equal(dc < 1.0, a[2].astype(bool))
+    assert np.allclose(si, a[0], rtol=1e-13, atol=1e-13 * np.abs(si).max())
+    assert np.allclose(di, a[1], rtol=1e-13, atol=1e-15)
+    return sig, a
+
+
 
 @pytest.mark.parametrize("kernel", [element_stress_damage_kernel_serial, element_stress_damage_kernel_a4])
 def test_effective_failure_stress(kernel):
@@ -174,21 +196,8 @@ def test_effective_failure_stress(kernel):
     assert np.all(d_eff[::2] > d[::2]) and np.array_equal(d_eff[1::2], d[1::2])
     _, d_nom, f_nom = run(None, coh, sig0, d)
     assert not f_nom.any() and np.array_equal(d_nom, d)
-    # (2) random stresses, some tensile, some confined: the same as the nominal kernel with C (1 − d)
-    sig = rng.normal(0, 2e4, (m, 3))
-    sig[:, :2] -= rng.uniform(0, 3e4, (m, 1))
-    a = run(1.0, coh, sig, d)
-    b = run(None, coh * (1.0 - d), sig, d)
-    assert 50 < a[2].sum() < m - 50
-    for x, y in zip(a, b):
-        assert np.array_equal(x, y)
-    # the implicit solver's damage update (the rheology's) takes the same envelope: the same
-    # elements damage, to round-off (zero strain rate, γ = 1)
-    si, di = sig.copy(), d.copy()
-    dc = rheo.damage_update(si, di, coh, 7.0, np.full(m, 20.0), np.zeros(m))
-    assert np.array_equal(dc < 1.0, a[2].astype(bool))
-    assert np.allclose(si, a[0], rtol=1e-13, atol=1e-13 * np.abs(si).max())
-    assert np.allclose(di, a[1], rtol=1e-13, atol=1e-15)
+    # (2) random stresses: the same as the nominal kernel with C (1 − d), and the implicit update agrees
+    _check_scaled_cohesion(kernel, rheo, rng, 1.0, coh, d, lambda d: 1.0 - d)
     # (3) implemented in the CPU and CUDA steppers and the implicit solver (the CUDA kernel against
     # this one: tests/test_cuda_explicit.py, simulator variants "effective*"), not with the nonlocal damage
     rheo.require_stepper("explicit_cuda")
@@ -238,21 +247,10 @@ def test_energy_equivalent_failure_stress(kernel):
     assert np.allclose((1.0 - dn) / (1.0 - d), 1.0 / 1.5 ** 2, rtol=1e-9)
     assert np.allclose(-sg[:, 1], sigma_c * np.sqrt(1.0 - dn), rtol=1e-9)
     assert np.all(de >= min(p.max_damage, 1.0 - 1e-6))
-    # (3) random stresses: the same as the nominal kernel with C √(1 − d)
-    sig = rng.normal(0, 2e4, (m, 3))
-    sig[:, :2] -= rng.uniform(0, 3e4, (m, 1))
-    a = run(0.5, coh, sig, d)
-    b = run(None, coh * np.sqrt(1.0 - d), sig, d)
-    assert 50 < a[2].sum() < m - 50
-    for x, y in zip(a, b):
-        assert np.array_equal(x, y)
-    # … and not the effective criterion's result
+    # (3) random stresses: the same as the nominal kernel with C √(1 − d), and the implicit update
+    # agrees; and not the effective criterion's result
+    sig, a = _check_scaled_cohesion(kernel, rheo, rng, 0.5, coh, d, lambda d: np.sqrt(1.0 - d))
     assert not np.array_equal(run(1.0, coh, sig, d)[1], a[1])
-    si, di = sig.copy(), d.copy()
-    dc = rheo.damage_update(si, di, coh, 7.0, np.full(m, 20.0), np.zeros(m))
-    assert np.array_equal(dc < 1.0, a[2].astype(bool))
-    assert np.allclose(si, a[0], rtol=1e-13, atol=1e-13 * np.abs(si).max())
-    assert np.allclose(di, a[1], rtol=1e-13, atol=1e-15)
     # (4) the CPU stepper and the implicit solver implement it; the CUDA stepper refuses it
     rheo.require_stepper("explicit")
     rheo.require_stepper("implicit")
