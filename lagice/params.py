@@ -93,6 +93,15 @@ class MaxwellEBParams:
             whatever the mesh (:mod:`lagice.solvers.nonlocal_damage`). Explicit CPU stepper only,
             with the default stress path (origin correction, whole stress relaxing, no
             compressive term, no dilatancy)
+        damage_length_m: ℓ [m] of the damage time td = ℓ/cs, the same for every element (None or 0:
+            off, the default: td = Δx/cs with Δx = √(2 A) the element's own size, Dansereau et al.
+            2016 §3.1.1, as neXtSIM does). A rate-dependent damage law has a length of its own, the
+            distance an elastic wave runs while an element damages (Needleman 1988, "Material rate
+            dependence and mesh sensitivity in localization problems", Comput. Methods Appl. Mech.
+            Eng. 67): td = Δx/cs makes that length the element's, so it halves with the mesh; a fixed
+            ℓ keeps it in kilometres. A diagnostic of lagice (2026-11-30, forty-fourth session;
+            docs/physics.md §4, "A damage time of fixed length"); ℓ has no sea-ice source. Explicit
+            CPU stepper and implicit solver
         failure_stress: the stress the Mohr-Coulomb envelope judges. ``"nominal"`` (Dansereau et
             al. 2016, neXtSIM; the default): σ itself, so damaged ice fails at the strength of
             intact ice. ``"effective"`` (a diagnostic of lagice, 2026-11-28; docs/physics.md §4,
@@ -137,6 +146,7 @@ class MaxwellEBParams:
     relax_mean_stress: bool = True
     dilatancy_angle_deg: float | None = None
     damage_nonlocal_radius_m: float | None = None
+    damage_length_m: float | None = None
     failure_stress: str = "nominal"
     crack_closure: bool = False
     bulk_shear_viscosity_ratio: float | None = None
@@ -180,6 +190,9 @@ class MaxwellEBParams:
                                   f"implemented with the default stress path only (stress_correction = 'origin', "
                                   f"relax_mean_stress = true, no max_pressure_pa, no dilatancy_angle_deg); it is "
                                   f"set with {others}")
+        if self.damage_length_m:
+            check_range("damage_length_m (ℓ of td = ℓ/cs)", self.damage_length_m, 0.0, 1.0e6, low_open=True,
+                        unit="m")
         if self.failure_stress not in FAILURE_STRESSES:
             raise ConfigError(f"rheology.failure_stress = {self.failure_stress!r}: expected one of "
                               f"{list(FAILURE_STRESSES)}")
@@ -234,6 +247,8 @@ class MaxwellEBParams:
             out["dilatancy_angle_deg"] = self.dilatancy_angle_deg
         if self.damage_nonlocal_radius_m:
             out["damage_nonlocal_radius_m"] = self.damage_nonlocal_radius_m
+        if self.damage_length_m:
+            out["damage_length_m"] = self.damage_length_m
         if self.failure_stress != "nominal":
             out["failure_stress"] = self.failure_stress
         if self.crack_closure:

@@ -287,10 +287,10 @@ CORRECTION_PATHS = {"implicit": STRESS_CORRECTIONS, "explicit": ("origin", "mean
 #: the optional terms of :class:`lagice.params.MaxwellEBParams` that each stepper implements.
 #: A term set away from its default (:meth:`MaxwellEBParams.optional_terms`) is refused by a
 #: stepper that does not list it, so no stepper silently runs without it
-OPTIONAL_TERMS = {"implicit": ("failure_stress",),
+OPTIONAL_TERMS = {"implicit": ("failure_stress", "damage_length_m"),
                   "explicit": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg",
                                "damage_nonlocal_radius_m", "failure_stress", "crack_closure",
-                               "bulk_shear_viscosity_ratio"),
+                               "bulk_shear_viscosity_ratio", "damage_length_m"),
                   "explicit_cuda": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg", "failure_stress",
                                     "crack_closure"), "prescribed": ()}
 #: the values of ``rheology.failure_stress`` each stepper implements beyond the default (a
@@ -354,8 +354,13 @@ class MaxwellEB:
         return E, lam
 
     def damage_time(self, element_size_m):
-        """td = Δx / cs [s] (Dansereau et al. 2016 §3.1.1)."""
-        return np.asarray(element_size_m, np.float64) / self.params.shear_wave_speed
+        """td [s] per element: Δx / cs (Dansereau et al. 2016 §3.1.1), or ℓ / cs for every element
+        when ``damage_length_m`` = ℓ is set (:class:`lagice.params.MaxwellEBParams`)."""
+        size = np.asarray(element_size_m, np.float64)
+        ell = self.params.damage_length_m
+        if ell:
+            return np.full(size.shape, float(ell) / self.params.shear_wave_speed)
+        return size / self.params.shear_wave_speed
 
     def constant_heal_rate(self, n: int) -> np.ndarray:
         th = self.params.healing_time_s

@@ -70,6 +70,9 @@ SCHEMA = {
         # nonlocal damage: the load ratio averaged over centroids within this radius [m]
         # (MaxwellEBParams.damage_nonlocal_radius_m; 0/None off)
         "damage_nonlocal_radius_m": (NUM, None),
+        # the damage time td = ℓ/cs with this ℓ [m] for every element (MaxwellEBParams.damage_length_m;
+        # 0/None: td = Δx/cs, the element's own size)
+        "damage_length_m": (NUM, None),
         # the stress the failure envelope judges: "nominal" (Dansereau et al. 2016) or "effective",
         # σ/(1 − d): cohesion C (1 − d), friction kept (MaxwellEBParams.failure_stress)
         "failure_stress": (str, "nominal"),
@@ -148,7 +151,7 @@ RHEOLOGY_KEYS = {
                    "max_damage", "stress_correction", "stress_correction_mean_fraction", "max_pressure_pa",
                    "max_pressure_thickness_exponent", "relax_mean_stress",
                    "dilatancy_angle_deg", "damage_nonlocal_radius_m", "failure_stress", "crack_closure",
-                   "bulk_shear_viscosity_ratio"),
+                   "bulk_shear_viscosity_ratio", "damage_length_m"),
     "viscous_plastic": ("p_star", "c_star", "ellipse", "delta_min", "replacement_pressure", "rho_ice"),
 }
 
@@ -184,6 +187,7 @@ LEGACY_VALUES = {
     "rheology.relax_mean_stress": (True,),            # 2026-11-27: the whole stress relaxes
     "rheology.dilatancy_angle_deg": (None, 0, 0.0),   # 2026-11-27: the viscous flow does not dilate
     "rheology.damage_nonlocal_radius_m": (None, 0, 0.0),  # 2026-11-28: local damage
+    "rheology.damage_length_m": (None, 0, 0.0),      # 2026-11-30: td = Δx/cs, the element's own size
     "rheology.failure_stress": ("nominal",),         # 2026-11-28: the envelope judges the nominal stress
     "rheology.crack_closure": (False,),              # 2026-11-28: damage lowers the modulus for every strain
     "rheology.bulk_shear_viscosity_ratio": (None,),  # 2026-11-28: one relaxation time for the whole stress
