@@ -2907,6 +2907,28 @@ EXPERIMENTS["F10-hthick-eng-P-C3-cap90"] = ("closed", _CAP90 + from_spinup("H112
 # 1 / 1 band. A pack that does not move has no sparse network of sliding bands, and its beta holds across the
 # sizes as the nominal envelope's does; so this is not evidence for the reading.
 
+# Written 2026-11-30 07:02 UTC, before its runs: a damage time of fixed length. td = dx/cs (Dansereau et al. 2016) makes
+# the length of the rate-dependent damage law, the distance an elastic wave runs while an element damages (Needleman
+# 1988), the element's own size, so it halves with the mesh. rheology.damage_length_m = l sets td = l/cs on every
+# element (new this session; l has no sea-ice source). On eng-P-C3 (energy envelope + P_max, C_lab x3), whose beta
+# falls from 0.142 (20 km) to 0.102 (10 km) with half the shear in 6.2 and 3.0 % of the area: l = 20 km (about the
+# 20 km mesh's own sqrt(2 A) = 18.6 km) at 20 km (eng-P-C3-L20-m20) and at 10 km in both basins (eng-P-C3-L20,
+# own spin-ups), and l = 40 km at 20 km (eng-P-C3-L40-m20, the length doubled on one mesh).
+# (TD)  the damage time's length sets the fall if, in the closed basin, the 10 km month with l = 20 km has beta within
+#       0.02 of the 20 km month with l = 20 km and its half-shear area at least 0.7 times the 20 km one; it fails if
+#       beta falls by 0.03 or more.
+# (TD2) at 20 km, l is a lever on the bands if l = 40 km moves the half-shear area by 30 % or more against l = 20 km.
+# (TDL) a lead for the flagship if, in each basin at 10 km, beta lies in 0.14-0.23, the wind factor in 0.006-0.010
+#       and at least 3 bands are inside.
+# Predicted: all three fail. The wind loads the pack over hours, far slower than td (40 s), so which elements break
+#     is set by their strength and the stress field, not by how far a wave runs while they damage: at 10 km beta
+#     within 0.015 of the 10 km run without l (0.102), the half-shear area 2.5-3.5 %; at 20 km l = 40 km moves the
+#     half-shear area by less than 15 %.
+_L20 = ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6", "rheology.damage_length_m=20e3"]
+add_screen_20km("eng-P-C3-L20-m20", _L20, "20 km: eng-P-C3 with the damage time td = 20 km / cs, own spin-up")
+add_screen_20km("eng-P-C3-L40-m20", ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6", "rheology.damage_length_m=40e3"],
+                "20 km: eng-P-C3 with the damage time td = 40 km / cs, own spin-up")
+add_month_own_spinup("eng-P-C3-L20", _L20, "eng-P-C3 with the damage time td = 20 km / cs, own spin-up")
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
