@@ -2929,6 +2929,15 @@ add_screen_20km("eng-P-C3-L20-m20", _L20, "20 km: eng-P-C3 with the damage time 
 add_screen_20km("eng-P-C3-L40-m20", ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6", "rheology.damage_length_m=40e3"],
                 "20 km: eng-P-C3 with the damage time td = 40 km / cs, own spin-up")
 add_month_own_spinup("eng-P-C3-L20", _L20, "eng-P-C3 with the damage time td = 20 km / cs, own spin-up")
+# Result (TD, TD2, TDL) (2026-11-30, 07:16 UTC): all three fail, as predicted. 20 km, l = 20 / 40 km: beta 0.161 /
+# 0.176, half-shear area 5.6 / 5.9 % (+5 %: TD2 fails), wind factor 0.0091 / 0.0091, tails 2.85, 2.49 / 3.44, 2.73,
+# R2 0.710 / 0.711, rate 0.0140 / 0.0130 per day, 2 / 3 bands, 180 / 160 remeshes. 10 km, l = 20 km, closed /
+# strait: beta 0.102 / 0.087 (without l: 0.102 / 0.112), half-shear area 3.2 / 2.9 %, wind factor 0.0080 / 0.0089,
+# tails 4.53, 1.32 / 4.29, 1.70, R2 0.709 / 0.731, rate 0.0113 / 0.0103 per day, 1 / 2 bands, 596 / 662 remeshes,
+# 473 / 467 s. The fall from 20 to 10 km with the same l: 0.059 (TD fails), the half-shear area ratio 0.57. Over the
+# same box widths (>= 10 km; benchmarks/beta_estimator.py) the 10 km runs still lose 0.02-0.06 (0.104-0.136 against
+# 0.142-0.176 at 20 km): about a third of the fall is the 10 km mesh's extra finest octave, the rest is on widths
+# both meshes resolve.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
@@ -3432,6 +3441,29 @@ LEADS = (
     ("damage averaged over R = 10 km (a diagnostic)", "F10-hthick-1125-nl10", None, "§3, The averaging length"),
     ("the envelope judges σ/(1 − d): broken ice keeps no cohesion (own spin-up; a diagnostic)", "F10-hthick-eff",
      "F10s-hthick-eff", "Broken ice that keeps no cohesion"),
+    # from here on the shipped set is the one whose kept elements keep their strength (2026-11-28)
+    ("bulk viscosity ζ/η = 0.93, half the Maxwell-EB's (own spin-up)", "F10-hthick-zeta093", "F10s-hthick-zeta093",
+     "A bulk viscosity four times the shear viscosity"),
+    ("bulk viscosity ζ/η = 0.25 (own spin-up)", "F10-hthick-zeta025", "F10s-hthick-zeta025",
+     "A bulk viscosity four times the shear viscosity"),
+    ("Crouzeix–Raviart velocities, jump penalty κ = 1 (own spin-up; the mesh's statistics, not the ice's)",
+     "F10-hthick-vcrj1", None, "A stable velocity element"),
+    ("the same + neXtSIM's compressive term (own spin-up; the mesh's statistics, not the ice's)",
+     "F10-hthick-P-vcrj1", "F10s-hthick-P-vcrj1", "neXtSIM's compressive term on the stable element"),
+    ("σ/(1 − d) with floes 8 times stronger, C_lab ×8 (a calibration; own spin-up)", "F10-hthick-eff-C8",
+     "F10s-hthick-eff-C8", "Strong floes in a weak network"),
+    ("… and the damage cap 0.97", "F10-hthick-eff-C8-cap97", "F10s-hthick-eff-C8-cap97",
+     "Strong floes in a weak network"),
+    ("σ/√(1 − d): broken ice keeps C √(1 − d) (strain-energy equivalence), C_lab ×3 (own spin-up)",
+     "F10-hthick-eng-C3", "F10s-hthick-eng-C3", "Broken ice that keeps part of its cohesion"),
+    ("σ/√(1 − d) + neXtSIM's compressive term, C_lab ×3 (own spin-up)", "F10-hthick-eng-P-C3", "F10s-hthick-eng-P-C3",
+     "… with neXtSIM's compressive term"),
+    ("σ/√(1 − d) + neXtSIM's compressive term, C_lab ×4 (own spin-up)", "F10-hthick-eng-P-C4", "F10s-hthick-eng-P-C4",
+     "… with neXtSIM's compressive term"),
+    ("σ/√(1 − d) + compressive term, C_lab ×3, damage cap 0.9 (own spin-up)", "F10-hthick-eng-P-C3-cap90", None,
+     "… with neXtSIM's compressive term"),
+    ("σ/√(1 − d) + compressive term, C_lab ×3, damage time td = 20 km / cs (own spin-up)", "F10-hthick-eng-P-C3-L20",
+     "F10s-hthick-eng-P-C3-L20", "A damage time of fixed length"),
 )
 
 
@@ -3441,9 +3473,10 @@ def bands_inside(median: dict) -> int:
 
 
 def leads_table(records: dict, fits: dict, leads=LEADS) -> str:
-    """One row per change of :data:`LEADS` (the first row is the reference): β, the rate against
-    the reference's, the wind factor (drift_response.py) and the bands inside, closed / strait,
-    from the published records; a run not in ``records`` shows as "–"."""
+    """One row per change of :data:`LEADS` (the first row is the reference): β, the mean total
+    deformation rate [day⁻¹] and its ratio to the reference's, the wind factor
+    (drift_response.py) and the bands inside, closed / strait, from the published records; a run
+    not in ``records`` shows as "–"."""
     refs = [records.get(n) for n in leads[0][1:3]]
     rate = "mean_total_deformation_rate_per_day"
 
@@ -3452,11 +3485,11 @@ def leads_table(records: dict, fits: dict, leads=LEADS) -> str:
         return " / ".join("–" if r is None or ref is None else f(r["median"], ref["median"])
                           for r, ref in zip((records.get(n) if n else None for n in names), refs))
 
-    lines = ["| change (validation month) | β closed / strait | rate × the shipped set's | wind factor "
+    lines = ["| change (validation month) | β closed / strait | rate day⁻¹ (× the reference's) | wind factor "
              "| bands inside (of 6) | §4 section |", "|---|---|---|---|---|---|"]
     for label, c, s_, section in leads:
         beta = both((c, s_), lambda m, _: f"{m['beta_space']:.3f}")
-        ratio = both((c, s_), lambda m, mr: f"{m[rate] / mr[rate]:.2f}")
+        ratio = both((c, s_), lambda m, mr: f"{m[rate]:.4f} (×{m[rate] / mr[rate]:.2f})")
         wind = " / ".join(f"{fits[n]['fit']['factor']:.4f}" if n in fits else "–" for n in (c, s_))
         bands = both((c, s_), lambda m, _: str(bands_inside(m)))
         lines.append(f"| {label} | {beta} | {ratio} | {wind} | {bands} | {section} |")

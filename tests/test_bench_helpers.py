@@ -498,8 +498,8 @@ def test_final_damage_faults_find_one_straight_band_and_the_analysis_reports_the
 
 
 def test_leads_table_counts_bands_and_scales_rates_by_the_reference():
-    """``physics_experiments.py leads``: each change's rate is divided by the reference row's of
-    the same basin, bands are counted against the observed ranges, a run not recorded shows
+    """``physics_experiments.py leads``: each change's rate is shown and divided by the reference
+    row's of the same basin, bands are counted against the observed ranges, a run not recorded shows
     "–", and every LEADS run is an experiment of the script (a typo would show "–" for ever)."""
     import physics_experiments as pe
 
@@ -512,7 +512,7 @@ def test_leads_table_counts_bands_and_scales_rates_by_the_reference():
     fits = {"new": {"fit": {"factor": 0.0071}}}
     leads = (("reference", "ref", "refs", "S"), ("a change", "new", "missing", "T"))
     row = pe.leads_table(records, fits, leads).splitlines()[3]
-    assert row == "| a change | 0.180 / – | 10.00 / – | 0.0071 / – | 6 / – | T |"
+    assert row == "| a change | 0.180 / – | 0.0200 (×10.00) / – | 0.0071 / – | 6 / – | T |"
     for _, c, s, _ in pe.LEADS:
         assert c in pe.EXPERIMENTS and (s is None or s in pe.EXPERIMENTS)
 
