@@ -12,6 +12,7 @@ over the windows of:
 * β with the widths holding at least 4 boxes, and at least 10 (the default now);
 * β with at least 10 boxes over the widths of 10 km and more only, so that runs on meshes of
   20, 10 and 5 km are compared over the same physical widths;
+* ⟨ε̇tot⟩ at each box width pooled over the windows (printed after the table);
 * the widest width used with 10 boxes, and the ratio of the element-scale ⟨ε̇tot⟩ to the
   ⟨ε̇tot⟩ at that width (observed: about 2 between 10 and 300 km, from β ≈ 0.2).
 
@@ -63,12 +64,28 @@ def run_estimates(run_dir: Path, window_days: float = 3.0, start_day: float = 1.
         row["beta_widths_from_10km"] = (fit_power_law(scale[kk], mean[kk]).exponent if kk.sum() >= 2
                                         else float("nan"))
         row["widest_scale_km_min_boxes_10"] = float(scale[k].max() / 1e3)
+        row["fit_widths_km"] = [float(x / 1e3) for x in scale[k]]
+        row["rate_per_day_by_width"] = [float(x * DAY_S) for x in mean[k]]
         row["element_to_widest_rate_ratio"] = float(mean[0] / mean[k][-1])
         row["scales_km"] = [float(x / 1e3) for x in scale]
         row["n_boxes"] = [int(n) for n in nbox]
         rows.append(row)
-    keys = [k for k in rows[0] if k not in ("start_day", "scales_km", "n_boxes")]
-    return {"windows": rows, "median": {k: float(np.median([r[k] for r in rows])) for k in keys}}
+    keys = [k for k in rows[0] if k not in ("start_day", "scales_km", "n_boxes", "fit_widths_km",
+                                            "rate_per_day_by_width")]
+    return {"windows": rows, "median": {k: float(np.median([r[k] for r in rows])) for k in keys},
+            "curve": pooled_curve(rows)}
+
+
+def pooled_curve(rows: list) -> dict:
+    """⟨ε̇tot⟩(L) pooled over the windows: per box width (counted from the widest with at least
+    10 boxes, so that every window has it), the mean width [km] and the geometric mean over the
+    windows of ⟨ε̇tot⟩ [day⁻¹]. The ratio of two widths' values is the window-mean of the ratio on
+    a log scale, so the slope between them is the windows' mean local β."""
+    n = min(len(r["rate_per_day_by_width"]) for r in rows)
+    widths = np.array([r["fit_widths_km"][-n:] for r in rows])
+    rates = np.array([r["rate_per_day_by_width"][-n:] for r in rows])
+    return {"width_km": [float(x) for x in widths.mean(axis=0)],
+            "rate_per_day": [float(x) for x in np.exp(np.log(rates).mean(axis=0))]}
 
 
 def main(argv=None):
@@ -93,6 +110,10 @@ def main(argv=None):
               f"{m['widest_scale_km_min_boxes_10']:.0f} | "
               f"{m['element_to_widest_rate_ratio']:.2f} |", flush=True)
         args.json.write_text(json.dumps(out, indent=1, allow_nan=True) + "\n")
+    print("\n⟨ε̇tot⟩ [day⁻¹] by box width, pooled over the windows (geometric mean; widths with ≥ 10 boxes):")
+    for name in args.runs:
+        c = out[name]["curve"]
+        print(f"  {name}: " + ", ".join(f"{w:.0f} km {r:.4f}" for w, r in zip(c["width_km"], c["rate_per_day"])))
     print(f"beta_estimator: wrote {args.json}", file=sys.stderr)
 
 

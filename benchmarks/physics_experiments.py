@@ -2931,7 +2931,7 @@ add_screen_20km("eng-P-C3-L40-m20", ENERGY + PMAX + ["rheology.strength_lab_pa=8
 add_month_own_spinup("eng-P-C3-L20", _L20, "eng-P-C3 with the damage time td = 20 km / cs, own spin-up")
 # Result (TD, TD2, TDL) (2026-11-30, 07:16 UTC): all three fail, as predicted. 20 km, l = 20 / 40 km: beta 0.161 /
 # 0.176, half-shear area 5.6 / 5.9 % (+5 %: TD2 fails), wind factor 0.0091 / 0.0091, tails 2.85, 2.49 / 3.44, 2.73,
-# R2 0.710 / 0.711, rate 0.0140 / 0.0130 per day, 2 / 3 bands, 180 / 160 remeshes. 10 km, l = 20 km, closed /
+# R2 0.710 / 0.711, rate 0.0140 / 0.0130 per day, 3 / 4 bands, 180 / 160 remeshes. 10 km, l = 20 km, closed /
 # strait: beta 0.102 / 0.087 (without l: 0.102 / 0.112), half-shear area 3.2 / 2.9 %, wind factor 0.0080 / 0.0089,
 # tails 4.53, 1.32 / 4.29, 1.70, R2 0.709 / 0.731, rate 0.0113 / 0.0103 per day, 1 / 2 bands, 596 / 662 remeshes,
 # 473 / 467 s. The fall from 20 to 10 km with the same l: 0.059 (TD fails), the half-shear area ratio 0.57. Over the
