@@ -2938,6 +2938,29 @@ add_month_own_spinup("eng-P-C3-L20", _L20, "eng-P-C3 with the damage time td = 2
 # same box widths (>= 10 km; benchmarks/beta_estimator.py) the 10 km runs still lose 0.02-0.06 (0.104-0.136 against
 # 0.142-0.176 at 20 km): about a third of the fall is the 10 km mesh's extra finest octave, the rest is on widths
 # both meshes resolve.
+# Written 2026-11-30 07:20 UTC, before its runs: the only heterogeneity at the element's scale is the white strength
+# disorder (f in [1, 2], one independent draw per element; the thickness varies over 100 km and more). A finer mesh
+# has four times as many independent weak spots per area, and in the 10 km maps the bands are about as many as at
+# 20 km but spread more evenly (§4, "A damage time of fixed length"). If the fall of beta from 20 to 10 km comes from
+# the disorder's element scale, a disorder with a length in kilometres should keep beta across the meshes. eng-P-C3
+# with the white disorder off (rheology.strength_disorder = 0) and the cohesion multiplied instead by the correlated
+# field g (rheology.strength_correlation_m = 40 km, Gaussian covariance; rheology.strength_correlated_amplitude =
+# 1/3, so g is uniform on [2/3, 4/3], the same relative spread as f / 1.5), C_lab x1.5 = 12.6 MPa so that the mean
+# cohesion is eng-P-C3's; 20 km (eng-P-C3-g40-m20) and 10 km in both basins (eng-P-C3-g40), own spin-ups. The
+# length and the amplitude are calibrations (no source for the correlation length of sea-ice strength).
+# (CD)  the disorder's element scale sets the fall if the closed basin's 10 km month has beta within 0.02 of the
+#       20 km month's; it fails if beta falls by 0.03 or more.
+# (CDL) a lead for the flagship if, in each basin at 10 km, beta lies in 0.14-0.23, the wind factor in 0.006-0.010
+#       and at least 3 bands are inside.
+# Predicted: CD fails, with a smaller fall than the white disorder's (0.02-0.04 against 0.040-0.059): the bands still
+#     soften at the element's scale; with no element-scale weak spots the pack at both sizes breaks along fewer,
+#     longer bands (beta 0.12-0.17 at 20 km); CDL fails.
+_G40 = ENERGY + PMAX + ["rheology.strength_lab_pa=12.6e6", "rheology.strength_disorder=0",
+                        "rheology.strength_correlation_m=40e3", "rheology.strength_correlated_amplitude=0.3333"]
+add_screen_20km("eng-P-C3-g40-m20", _G40, "20 km: eng-P-C3 with a disorder correlated over 40 km instead of the "
+                "white one, own spin-up")
+add_month_own_spinup("eng-P-C3-g40", _G40, "eng-P-C3 with a disorder correlated over 40 km instead of the white "
+                     "one, own spin-up")
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
