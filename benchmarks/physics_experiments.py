@@ -2984,6 +2984,14 @@ add_month_own_spinup("eng-P-C3-g40", _G40, "eng-P-C3 with a disorder correlated 
 #     0.012-0.014).
 add_month_own_spinup("eff-m10", EFFECTIVE, "the envelope judges the effective stress sigma/(1 - d), own spin-up, "
                      "meshed at domain.resolution_m")
+# Result (CE) (2026-11-30, 07:47 UTC): fails by its letter (beta falls by 0.036, against 0.03); the prediction held
+# on beta and the drift and was wrong on the contrast. B20-hthick-eff-m20 made again: the same medians (beta 0.240).
+# 10 km, closed / strait: beta 0.204 / 0.210 (x0.85 / x0.875 of the 20 km month's; widths >= 10 km 0.192 / 0.204),
+# the contrast 1.77 / 1.80 against 1.66 at 20 km (x1.07 / x1.08: it grows, where the eng-P, L20 and g40 months' went
+# x0.92-1.01), wind factor 0.0134 / 0.0137, tails 4.44, 4.21 / 5.09, 4.70, half-shear area 9.0 / 8.8 %, R2 0.639 /
+# 0.634, rate 0.0239 / 0.0232 per day, 1 / 1 band, 1154 / 1206 remeshes, 477 / 476 s. Its finest octave is steep
+# (<rate> x1.17 from 12 to 6 km, against x1.03-1.10 in the eng-P months): the finer mesh adds deformation below
+# the old element's width, and beta falls by half as much as the x0.75 of a fixed contrast.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
