@@ -3518,6 +3518,10 @@ LEADS = (
      "… with neXtSIM's compressive term"),
     ("σ/√(1 − d) + compressive term, C_lab ×3, damage time td = 20 km / cs (own spin-up)", "F10-hthick-eng-P-C3-L20",
      "F10s-hthick-eng-P-C3-L20", "A damage time of fixed length"),
+    ("σ/√(1 − d) + compressive term, C_lab ×4.5 with a disorder correlated over 40 km instead of the white one "
+     "(own spin-up)", "F10-hthick-eng-P-C3-g40", "F10s-hthick-eng-P-C3-g40", "A damage time of fixed length"),
+    ("σ/(1 − d) at neXtSIM's strength on the mesh at the size asked (own spin-up; a diagnostic)",
+     "F10-hthick-eff-m10", "F10s-hthick-eff-m10", "A damage time of fixed length"),
 )
 
 
