@@ -2992,6 +2992,27 @@ add_month_own_spinup("eff-m10", EFFECTIVE, "the envelope judges the effective st
 # 0.634, rate 0.0239 / 0.0232 per day, 1 / 1 band, 1154 / 1206 remeshes, 477 / 476 s. Its finest octave is steep
 # (<rate> x1.17 from 12 to 6 km, against x1.03-1.10 in the eng-P months): the finer mesh adds deformation below
 # the old element's width, and beta falls by half as much as the x0.75 of a fixed contrast.
+# Written 2026-11-30 08:01 UTC, before its runs: an out-of-sample test of the contrast reading (rule CE's comment). If
+# the contrast K between the element's rate and the 94 km rate does not depend on the mesh in this family, a coarser
+# mesh raises beta by the ratio of the log ranges: at 40 km (element width about 24 km) beta is about ln K / ln(94 /
+# 24), 1.5 times the 20 km beta (ln 7.8 / ln 3.9). eng-P-C4 (energy envelope + P_max, C_lab x4) at 40 km over the
+# eight months of rule WP (the scene's seed and 2027-2033), from its own 40 km spin-up, closed basin, against the
+# eight 20 km months (B20-hthick-eng-P-C4-m20 and its -w runs; K from benchmarks/beta_estimator.py).
+# (K40) the reading holds if the median over the months of K at 40 km is within 10 % of the 20 km months' median and
+#       the median of the month-by-month ratio beta(40 km) / beta(20 km) lies in 1.2-1.8; it fails if that ratio is
+#       below 1.2 or K moves by more than 10 %.
+# Predicted: holds, with K within 5 % and the beta ratio 1.3-1.6; but at 40 km the fit has three widths only, so
+#     the month-by-month ratios scatter widely, and months whose 20 km beta is near 0 (0.013) give no ratio that
+#     means anything (the median over the eight is kept).
+_K40 = ENERGY + PMAX + ["rheology.strength_lab_pa=11.2e6"]
+SPINUPS["H40-eng-P-C4-m40"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + _K40, OUT / "spinup-H40-eng-P-C4-m40.npz",
+                               40e3)
+EXPERIMENTS["B40-hthick-eng-P-C4-m40"] = ("closed", _K40 + from_spinup("H40-eng-P-C4-m40"), 40e3, 28,
+                                          "40 km: eng-P-C4, own 40 km spin-up (the contrast reading)")
+for _seed in ENSEMBLE_SEEDS + MORE_SEEDS:
+    EXPERIMENTS[f"B40-hthick-eng-P-C4-m40-w{_seed}"] = (
+        "closed", _K40 + from_spinup("H40-eng-P-C4-m40") + [f"forcing.wind.seed={_seed}"], 40e3, 28,
+        f"B40-hthick-eng-P-C4-m40, the weather of wind seed {_seed}")
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
