@@ -18,6 +18,7 @@ over the windows of:
 
     python benchmarks/beta_estimator.py F10 F10x2 ...   # runs in benchmarks/out/physics
     python benchmarks/beta_estimator.py                  # the default list below
+    python benchmarks/beta_estimator.py RUN ... --figure docs/figures/NAME.png  # and the pooled curves
 
 Results go to ``docs/figures/beta_estimator.json``.
 """
@@ -92,6 +93,9 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("runs", nargs="*", default=list(DEFAULT_RUNS), help="run names in benchmarks/out/physics")
     ap.add_argument("--json", type=Path, default=ROOT / "docs" / "figures" / "beta_estimator.json")
+    ap.add_argument("--figure", type=Path, default=None,
+                    help="also draw the pooled ⟨ε̇tot⟩(L), each run divided by its value at the widest width, "
+                         "to this PNG")
     args = ap.parse_args(argv)
     missing = [r for r in args.runs if not (RUNS / r / "snapshots").is_dir()]
     if missing:
@@ -115,6 +119,37 @@ def main(argv=None):
         c = out[name]["curve"]
         print(f"  {name}: " + ", ".join(f"{w:.0f} km {r:.4f}" for w, r in zip(c["width_km"], c["rate_per_day"])))
     print(f"beta_estimator: wrote {args.json}", file=sys.stderr)
+    if args.figure is not None:
+        figure_curves({name: out[name]["curve"] for name in args.runs}, args.figure)
+        print(f"beta_estimator: wrote {args.figure}", file=sys.stderr)
+
+
+def figure_curves(curves: dict, path: Path) -> None:
+    """⟨ε̇tot⟩(L) / ⟨ε̇tot⟩(widest) against L on log-log axes, one line per run, with the slopes of
+    β = 0.10 and 0.20 drawn from the widest width for reference."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.6))
+    for name, c in curves.items():
+        w = np.asarray(c["width_km"])
+        r = np.asarray(c["rate_per_day"])
+        ax.plot(w, r / r[-1], "o-", label=name)
+    w_all = np.concatenate([np.asarray(c["width_km"]) for c in curves.values()])
+    lw = np.geomspace(w_all.min(), w_all.max(), 20)
+    for beta, ls in ((0.1, ":"), (0.2, "--")):
+        ax.plot(lw, (lw / lw[-1]) ** -beta, "k" + ls, lw=0.8, label=f"β = {beta:g}")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("box width L (km)")
+    ax.set_ylabel("⟨ε̇tot⟩(L) / ⟨ε̇tot⟩(widest), pooled over the windows")
+    ax.legend(fontsize=7)
+    ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
 
 
 if __name__ == "__main__":
