@@ -3021,6 +3021,32 @@ for _seed in ENSEMBLE_SEEDS + MORE_SEEDS:
 # at 40 km, ln K 30 % lower). Wind factor at 40 km 0.0047-0.0100 (6 of 8 in its band); 8-58 remeshes; 10-11 s a
 # month. So K is not fixed by the family: from 40 to 20 km the finer mesh adds contrast and beta holds; from 20 to
 # 10 km it adds none (x0.92-1.01) and beta falls. The reading holds for the 20 -> 10 km step only.
+# Written 2026-11-30 08:04 UTC, before its runs: remeshing as the cause of the fall. At 10 km the pack remeshes 3.3
+# times as often as at 20 km (596-727 events a month against 154-191 in this family), and its bands are one element
+# wide. docs/remeshing.md §6 measured what a remesh does to a band with the default area-weighted damage remap: one
+# remesh across a band of damage 0.99 makes it 6.5 times stiffer (0.9: 1.4 times) and 1.5 times wider; the compliance
+# remap (remesh.params.damage_remap = "compliance", remapping 1/(1 - d)) keeps its series stiffness to 0-2 %. If
+# remeshing heals the 10 km bands and so spreads the deformation over 24-94 km, the compliance remap, or fewer
+# remeshes, should bring the 10 km beta back. Never tried in a flagship run. eng-P-C3 with the compliance remap: 20 km
+# (eng-P-C3-crm-m20) and 10 km in both basins (eng-P-C3-crm), own spin-ups; and eng-P-C3 with the remesh trigger's
+# angle at 5 degrees instead of 10 (fewer remeshes; remesh.min_angle_deg, neXtSIM's is 10), 20 km and 10 km closed,
+# from the spin-ups of eng-P-C3 (the trigger does not change the physics).
+# (RR)  remeshing's healing of bands sets the fall if, with the compliance remap, the closed basin's 10 km beta is
+#       within 0.02 of the 20 km beta with it; it fails if beta falls by 0.03 or more.
+# (RA)  the same for the 5-degree trigger, against eng-P-C3-a5-m20.
+# (RRL) a lead for the flagship if, in each basin at 10 km with the compliance remap, beta lies in 0.14-0.23, the wind
+#       factor in 0.006-0.010 and at least 3 bands are inside.
+# Predicted: RR and RA fail, but the 10 km beta rises by 0.01-0.03 with the compliance remap (the remesh events
+#     per month fall by 30-60 % with the 5-degree trigger, and beta rises by less than 0.02); RRL fails.
+_CRM = ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6", "remesh.params.damage_remap=compliance"]
+add_screen_20km("eng-P-C3-crm-m20", _CRM, "20 km: eng-P-C3 with the compliance damage remap, own spin-up")
+add_month_own_spinup("eng-P-C3-crm", _CRM, "eng-P-C3 with the compliance damage remap, own spin-up")
+EXPERIMENTS["B20-hthick-eng-P-C3-a5-m20"] = (
+    "closed", ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6", "remesh.min_angle_deg=5"]
+    + from_spinup("H20-eng-P-C3-m20"), 20e3, 28, "20 km: eng-P-C3 with the remesh trigger at 5 degrees")
+EXPERIMENTS["F10-hthick-eng-P-C3-a5"] = (
+    "closed", ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6", "remesh.min_angle_deg=5"]
+    + from_spinup("H1125-eng-P-C3"), 10e3, 28, "eng-P-C3 with the remesh trigger at 5 degrees")
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
