@@ -3047,6 +3047,14 @@ EXPERIMENTS["B20-hthick-eng-P-C3-a5-m20"] = (
 EXPERIMENTS["F10-hthick-eng-P-C3-a5"] = (
     "closed", ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6", "remesh.min_angle_deg=5"]
     + from_spinup("H1125-eng-P-C3"), 10e3, 28, "eng-P-C3 with the remesh trigger at 5 degrees")
+# Result (RR, RA, RRL) (2026-11-30, 08:26 UTC): all three fail; the prediction was wrong on the compliance remap
+# (beta did not rise at 10 km) and on the trigger (it did not remesh less). 20 km, compliance / 5 degrees: beta
+# 0.147 / 0.145, half-shear area 6.5 / 7.1 %, wind factor 0.0092 / 0.0095, tails 3.09, 3.29 / 4.08, 3.63, R2 0.686 /
+# 0.673, rate 0.0127 / 0.0140 per day, 2 / 2 bands, 181 / 203 remeshes (eng-P-C3: 191). 10 km, compliance, closed /
+# strait: beta 0.101 / 0.057 (falls by 0.046 in the closed basin), half-shear area 2.1 / 3.1 %, wind factor 0.0084 /
+# 0.0099, tails 2.87, 3.00 / 4.23, 3.59, R2 0.702 / 0.700, rate 0.0106 / 0.0109 per day, 1 / 1 band, 638 / 769
+# remeshes. 10 km, 5 degrees, closed: beta 0.103 (falls by 0.042), half-shear area 2.8 %, tails 3.40, 3.42, R2 0.717,
+# rate 0.0117 per day, 737 remeshes (eng-P-C3: 630), 1 band. Remeshing's healing of bands does not set the fall.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
