@@ -3583,6 +3583,10 @@ LEADS = (
      "F10s-hthick-eng-P-C3-L20", "A damage time of fixed length"),
     ("σ/√(1 − d) + compressive term, C_lab ×4.5 with a disorder correlated over 40 km instead of the white one "
      "(own spin-up)", "F10-hthick-eng-P-C3-g40", "F10s-hthick-eng-P-C3-g40", "A damage time of fixed length"),
+    ("σ/√(1 − d) + compressive term, C_lab ×3, the compliance damage remap (own spin-up)", "F10-hthick-eng-P-C3-crm",
+     "F10s-hthick-eng-P-C3-crm", "A damage time of fixed length"),
+    ("σ/√(1 − d) + compressive term, C_lab ×3, remesh trigger at 5°", "F10-hthick-eng-P-C3-a5", None,
+     "A damage time of fixed length"),
     ("σ/(1 − d) at neXtSIM's strength on the mesh at the size asked (own spin-up; a diagnostic)",
      "F10-hthick-eff-m10", "F10s-hthick-eff-m10", "A damage time of fixed length"),
 )
