@@ -3055,6 +3055,15 @@ EXPERIMENTS["F10-hthick-eng-P-C3-a5"] = (
 # 0.0099, tails 2.87, 3.00 / 4.23, 3.59, R2 0.702 / 0.700, rate 0.0106 / 0.0109 per day, 1 / 1 band, 638 / 769
 # remeshes. 10 km, 5 degrees, closed: beta 0.103 (falls by 0.042), half-shear area 2.8 %, tails 3.40, 3.42, R2 0.717,
 # rate 0.0117 per day, 737 remeshes (eng-P-C3: 630), 1 band. Remeshing's healing of bands does not set the fall.
+# Written 2026-11-30 08:26 UTC, before its run: eng-P-C3 (the set of rules TD, CD, RR) at 40 km, the validation month,
+# own 40 km spin-up, to complete its chain 40 / 20 / 10 / 5 km (0.142, 0.102, 0.072 over the first 10 days).
+# (C40) as for eng-P-C4 (rule K40), beta at 40 km is within 0.03 of the 20 km beta (0.142); it fails otherwise.
+# Predicted: holds (beta 0.12-0.17), K 5-10 % below the 20 km one (1.34).
+_C40 = ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6"]
+SPINUPS["H40-eng-P-C3-m40"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + _C40, OUT / "spinup-H40-eng-P-C3-m40.npz",
+                               40e3)
+EXPERIMENTS["B40-hthick-eng-P-C3-m40"] = ("closed", _C40 + from_spinup("H40-eng-P-C3-m40"), 40e3, 28,
+                                          "40 km: eng-P-C3, own 40 km spin-up")
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
