@@ -132,13 +132,15 @@ def from_spinup(name: str) -> list:
     return [f"initial.state_file={SPINUPS[name][1].relative_to(ROOT)}"]
 
 
-def add_screen_20km(tag: str, changes: list, what: str) -> None:
+def add_screen_20km(tag: str, changes: list, what: str, res_km: int = 20) -> None:
     """A 20 km screen in the closed basin's validation month from its own 20 km spin-up with
     the same ``changes``: spin-up ``H20-{tag}`` (the thick-and-thin pack, 14 days) and run
-    ``B20-hthick-{tag}`` (28 days)."""
-    SPINUPS[f"H20-{tag}"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + changes, OUT / f"spinup-H20-{tag}.npz",
-                             20e3)
-    EXPERIMENTS[f"B20-hthick-{tag}"] = ("closed", changes + from_spinup(f"H20-{tag}"), 20e3, 28, what)
+    ``B20-hthick-{tag}`` (28 days). ``res_km``: another element size, the names then carrying it
+    (``H40-{tag}``, ``B40-hthick-{tag}``)."""
+    SPINUPS[f"H{res_km}-{tag}"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + changes,
+                                   OUT / f"spinup-H{res_km}-{tag}.npz", res_km * 1e3)
+    EXPERIMENTS[f"B{res_km}-hthick-{tag}"] = ("closed", changes + from_spinup(f"H{res_km}-{tag}"), res_km * 1e3, 28,
+                                              what)
 
 
 def add_month_own_spinup(tag: str, changes: list, what: str) -> None:
@@ -152,14 +154,14 @@ def add_month_own_spinup(tag: str, changes: list, what: str) -> None:
     EXPERIMENTS[f"F10s-hthick-{tag}"] = ("strait", changes + from_spinup(f"H1125-{tag}"), 10e3, 28, f"strait: {what}")
 
 
-def add_months_20km(tag: str, group: str, seeds) -> None:
+def add_months_20km(tag: str, group: str, seeds, res_km: int = 20) -> None:
     """The 20 km screen ``B20-hthick-{tag}`` (:func:`add_screen_20km`) in the weather of each wind seed
     of ``seeds`` (``B20-hthick-{tag}-w{seed}``, the same spin-up), and the group ``group`` of
-    :data:`ENSEMBLES` holding the screen and those runs."""
-    base = f"B20-hthick-{tag}"
+    :data:`ENSEMBLES` holding the screen and those runs (``res_km``: as in :func:`add_screen_20km`)."""
+    base = f"B{res_km}-hthick-{tag}"
     for seed in seeds:
-        EXPERIMENTS[f"{base}-w{seed}"] = ("closed", EXPERIMENTS[base][1] + [f"forcing.wind.seed={seed}"], 20e3, 28,
-                                          f"{base}, the weather of wind seed {seed}")
+        EXPERIMENTS[f"{base}-w{seed}"] = ("closed", EXPERIMENTS[base][1] + [f"forcing.wind.seed={seed}"],
+                                          res_km * 1e3, 28, f"{base}, the weather of wind seed {seed}")
     ENSEMBLES[group] = [base] + [f"{base}-w{seed}" for seed in seeds]
 
 
@@ -3004,15 +3006,10 @@ add_month_own_spinup("eff-m10", EFFECTIVE, "the envelope judges the effective st
 # Predicted: holds, with K within 5 % and the beta ratio 1.3-1.6; but at 40 km the fit has three widths only, so
 #     the month-by-month ratios scatter widely, and months whose 20 km beta is near 0 (0.013) give no ratio that
 #     means anything (the median over the eight is kept).
-_K40 = ENERGY + PMAX + ["rheology.strength_lab_pa=11.2e6"]
-SPINUPS["H40-eng-P-C4-m40"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + _K40, OUT / "spinup-H40-eng-P-C4-m40.npz",
-                               40e3)
-EXPERIMENTS["B40-hthick-eng-P-C4-m40"] = ("closed", _K40 + from_spinup("H40-eng-P-C4-m40"), 40e3, 28,
-                                          "40 km: eng-P-C4, own 40 km spin-up (the contrast reading)")
-for _seed in ENSEMBLE_SEEDS + MORE_SEEDS:
-    EXPERIMENTS[f"B40-hthick-eng-P-C4-m40-w{_seed}"] = (
-        "closed", _K40 + from_spinup("H40-eng-P-C4-m40") + [f"forcing.wind.seed={_seed}"], 40e3, 28,
-        f"B40-hthick-eng-P-C4-m40, the weather of wind seed {_seed}")
+add_screen_20km("eng-P-C4-m40", ENERGY + PMAX + ["rheology.strength_lab_pa=11.2e6"],
+                "40 km: eng-P-C4, own 40 km spin-up (the contrast reading)", res_km=40)
+add_months_20km("eng-P-C4-m40", "40 km, energy envelope + P_max, C_lab x4, closed, eight months",
+                ENSEMBLE_SEEDS + MORE_SEEDS, res_km=40)
 # Result (K40) (2026-11-30, 08:03 UTC): fails; the prediction was wrong on both counts. Months (the scene's, then
 # 2027-2033)
 # at 40 km / 20 km: beta 0.155 / 0.164, 0.125 / 0.112, 0.088 / 0.013, 0.089 / 0.085, 0.151 / 0.099, 0.097 / 0.145,
@@ -3059,11 +3056,8 @@ EXPERIMENTS["F10-hthick-eng-P-C3-a5"] = (
 # own 40 km spin-up, to complete its chain 40 / 20 / 10 / 5 km (0.142, 0.102, 0.072 over the first 10 days).
 # (C40) as for eng-P-C4 (rule K40), beta at 40 km is within 0.03 of the 20 km beta (0.142); it fails otherwise.
 # Predicted: holds (beta 0.12-0.17), K 5-10 % below the 20 km one (1.34).
-_C40 = ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6"]
-SPINUPS["H40-eng-P-C3-m40"] = ([f"initial.thickness_m={HETERO_THICKNESS}"] + _C40, OUT / "spinup-H40-eng-P-C3-m40.npz",
-                               40e3)
-EXPERIMENTS["B40-hthick-eng-P-C3-m40"] = ("closed", _C40 + from_spinup("H40-eng-P-C3-m40"), 40e3, 28,
-                                          "40 km: eng-P-C3, own 40 km spin-up")
+add_screen_20km("eng-P-C3-m40", ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6"],
+                "40 km: eng-P-C3, own 40 km spin-up", res_km=40)
 # Result (C40) (2026-11-30, 08:27 UTC): holds, as predicted: beta 0.169 (+0.027 on 20 km), K 1.25 (7 % below), wind
 # factor 0.0093, tails 4.61, 3.80, half-shear area 13.8 %, R2 0.625, rate 0.0161 per day, 50 remeshes, 1 band, 10 s.
 # The chain 40 / 20 / 10 / 5 km: beta 0.169 / 0.142 / 0.102 / 0.072 (5 km: first 10 days); <rate> at 94 km 0.0146 /
