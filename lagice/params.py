@@ -102,6 +102,21 @@ class MaxwellEBParams:
             ℓ keeps it in kilometres. A diagnostic of lagice (2026-11-30, forty-fourth session;
             docs/physics.md §4, "A damage time of fixed length"); ℓ has no sea-ice source. Explicit
             CPU stepper and implicit solver
+        crack_band_length_m: ℓ [m] of a crack-band scaling of the Maxwell viscous flow (None or 0:
+            off, the default: λ = λ0 ((1 − d) g)^(α−1) on every element, Dansereau et al. 2016).
+            Set, each element's relaxation time is multiplied by Δx/ℓ, Δx = √(2 A) its size, so its
+            viscosity E λ is proportional to its size. A damage band is one element wide, and the
+            slip rate across it is its width times its viscous strain rate, Δx σ/(E λ): with the
+            scaling, a band of any width slips at a given stress and damage as a band ℓ wide does
+            without it, the idea of the crack band of Bažant and Oh (1983, "Crack band theory for
+            fracture of concrete", Matériaux et Constructions 16), where the softening of an
+            element is scaled with its size so that a crack dissipates the same energy per unit
+            length on any mesh. Only the viscous flow is scaled, not the damaged modulus, so the
+            elastic wave speed and the sub-step limit are unchanged. Intact ice (λ0 = 1e7 s)
+            creeps negligibly with or without it. A diagnostic of lagice (2026-11-30,
+            forty-fifth session; docs/physics.md §4, "A crack band for the viscous flow"); ℓ has
+            no sea-ice source. Explicit CPU stepper only, with the local damage (no
+            ``damage_nonlocal_radius_m``)
         failure_stress: the stress the Mohr-Coulomb envelope judges. ``"nominal"`` (Dansereau et
             al. 2016, neXtSIM; the default): σ itself, so damaged ice fails at the strength of
             intact ice. ``"effective"`` (a diagnostic of lagice, 2026-11-28; docs/physics.md §4,
@@ -147,6 +162,7 @@ class MaxwellEBParams:
     dilatancy_angle_deg: float | None = None
     damage_nonlocal_radius_m: float | None = None
     damage_length_m: float | None = None
+    crack_band_length_m: float | None = None
     failure_stress: str = "nominal"
     crack_closure: bool = False
     bulk_shear_viscosity_ratio: float | None = None
@@ -193,6 +209,13 @@ class MaxwellEBParams:
         if self.damage_length_m:
             check_range("damage_length_m (ℓ of td = ℓ/cs)", self.damage_length_m, 0.0, 1.0e6, low_open=True,
                         unit="m")
+        if self.crack_band_length_m:
+            check_range("crack_band_length_m (ℓ of λ Δx/ℓ)", self.crack_band_length_m, 0.0, 1.0e6, low_open=True,
+                        unit="m")
+            if self.damage_nonlocal_radius_m:
+                raise ConfigError(f"rheology.crack_band_length_m = {self.crack_band_length_m!r} is implemented "
+                                  f"with the local damage only; it is set with damage_nonlocal_radius_m = "
+                                  f"{self.damage_nonlocal_radius_m!r} m")
         if self.failure_stress not in FAILURE_STRESSES:
             raise ConfigError(f"rheology.failure_stress = {self.failure_stress!r}: expected one of "
                               f"{list(FAILURE_STRESSES)}")
@@ -249,6 +272,8 @@ class MaxwellEBParams:
             out["damage_nonlocal_radius_m"] = self.damage_nonlocal_radius_m
         if self.damage_length_m:
             out["damage_length_m"] = self.damage_length_m
+        if self.crack_band_length_m:
+            out["crack_band_length_m"] = self.crack_band_length_m
         if self.failure_stress != "nominal":
             out["failure_stress"] = self.failure_stress
         if self.crack_closure:

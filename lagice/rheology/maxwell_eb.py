@@ -290,7 +290,7 @@ CORRECTION_PATHS = {"implicit": STRESS_CORRECTIONS, "explicit": ("origin", "mean
 OPTIONAL_TERMS = {"implicit": ("failure_stress", "damage_length_m"),
                   "explicit": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg",
                                "damage_nonlocal_radius_m", "failure_stress", "crack_closure",
-                               "bulk_shear_viscosity_ratio", "damage_length_m"),
+                               "bulk_shear_viscosity_ratio", "damage_length_m", "crack_band_length_m"),
                   "explicit_cuda": ("max_pressure_pa", "relax_mean_stress", "dilatancy_angle_deg", "failure_stress",
                                     "crack_closure"), "prescribed": ()}
 #: the values of ``rheology.failure_stress`` each stepper implements beyond the default (a
@@ -361,6 +361,15 @@ class MaxwellEB:
         if ell:
             return np.full(size.shape, float(ell) / self.params.shear_wave_speed)
         return size / self.params.shear_wave_speed
+
+    def relaxation_scale(self, element_size_m):
+        """Δx/ℓ [-] per element, the factor of the relaxation time λ when ``crack_band_length_m``
+        = ℓ is set (:class:`lagice.params.MaxwellEBParams`), or None when it is not (off: the
+        kernels then take λ unchanged, bit for bit)."""
+        ell = self.params.crack_band_length_m
+        if not ell:
+            return None
+        return np.asarray(element_size_m, np.float64) / float(ell)
 
     def constant_heal_rate(self, n: int) -> np.ndarray:
         th = self.params.healing_time_s

@@ -73,6 +73,9 @@ SCHEMA = {
         # the damage time td = ℓ/cs with this ℓ [m] for every element (MaxwellEBParams.damage_length_m;
         # 0/None: td = Δx/cs, the element's own size)
         "damage_length_m": (NUM, None),
+        # a crack-band scaling of the viscous flow: λ times Δx/ℓ with this ℓ [m] on every element
+        # (MaxwellEBParams.crack_band_length_m; 0/None: off)
+        "crack_band_length_m": (NUM, None),
         # the stress the failure envelope judges: "nominal" (Dansereau et al. 2016) or "effective",
         # σ/(1 − d): cohesion C (1 − d), friction kept (MaxwellEBParams.failure_stress)
         "failure_stress": (str, "nominal"),
@@ -151,7 +154,7 @@ RHEOLOGY_KEYS = {
                    "max_damage", "stress_correction", "stress_correction_mean_fraction", "max_pressure_pa",
                    "max_pressure_thickness_exponent", "relax_mean_stress",
                    "dilatancy_angle_deg", "damage_nonlocal_radius_m", "failure_stress", "crack_closure",
-                   "bulk_shear_viscosity_ratio", "damage_length_m"),
+                   "bulk_shear_viscosity_ratio", "damage_length_m", "crack_band_length_m"),
     "viscous_plastic": ("p_star", "c_star", "ellipse", "delta_min", "replacement_pressure", "rho_ice"),
 }
 
@@ -188,6 +191,7 @@ LEGACY_VALUES = {
     "rheology.dilatancy_angle_deg": (None, 0, 0.0),   # 2026-11-27: the viscous flow does not dilate
     "rheology.damage_nonlocal_radius_m": (None, 0, 0.0),  # 2026-11-28: local damage
     "rheology.damage_length_m": (None, 0, 0.0),      # 2026-11-30: td = Δx/cs, the element's own size
+    "rheology.crack_band_length_m": (None, 0, 0.0),  # 2026-11-30: λ not scaled with the element's size
     "rheology.failure_stress": ("nominal",),         # 2026-11-28: the envelope judges the nominal stress
     "rheology.crack_closure": (False,),              # 2026-11-28: damage lowers the modulus for every strain
     "rheology.bulk_shear_viscosity_ratio": (None,),  # 2026-11-28: one relaxation time for the whole stress

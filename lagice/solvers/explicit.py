@@ -285,7 +285,7 @@ _ALPHA_IS_4 = False
 
 def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion, kc, kt,
                            td, heal_rate, e_dt, gamma, pmax, keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy,
-                           kss, q, denom, max_damage, E0, lambda0, alpha, damaged_flag, divn):
+                           kss, q, denom, max_damage, E0, lambda0, alpha, damaged_flag, divn, lam_scale=None):
     """Maxwell stress update and damage/healing of one sub-step, in place (module doc, step 2).
 
     e_dt = Δt_s E [Pa s], gamma = λ/(λ+Δt_s) per element, refreshed here where damage
@@ -339,6 +339,9 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
     by the mean of its three nodes' values, its deviatoric rate kept (the average nodal pressure
     of Bonet and Burton 1998: no volumetric locking of linear triangles where the mean stress
     is kept and the deviator relaxes).
+    lam_scale: None (rheology.crack_band_length_m unset, the default; pruned as pmax is). An (m,)
+    array Δx/ℓ (``MaxwellEB.relaxation_scale``): the refreshed λ is multiplied by it, as the set-up
+    multiplies the λ it fills γ from (the crack-band scaling of the viscous flow).
     Returns the number of elements whose damage hit the cap.
     """
     m = tri.shape[0]
@@ -447,6 +450,8 @@ def _element_stress_damage(tri, b, c, vel, sigma, damage, conc_factor, cohesion,
                 lam = lambda0 * (x * x) * (x * x)
             else:
                 lam = lambda0 * x ** (alpha - 1.0)
+            if lam_scale is not None:  # pruned when None, as pmax is
+                lam *= lam_scale[e]
             e_dt[e] = dt_s * (E0 * x)
             gamma[e] = lam / (lam + dt_s)
     return n_capped
@@ -601,7 +606,8 @@ PARALLEL_MIN_ELEMENTS = PARALLEL_MIN_SIZE
 @njit(cache=True, error_model="numpy")
 def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
                       c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat,
-                      eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn, area):
+                      eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn, area,
+                      lam_scale):
     """All ``n_sub`` sub-steps of one outer step in compiled code (one call per outer
     step, no Python per sub-step): the node kernel then the element kernel, serial
     builds; the same calls as a Python loop over the kernels, bit-identical results."""
@@ -613,14 +619,15 @@ def substeps_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t,
             node_divergence_kernel_serial(vel, ptr, elems, tri, b, c, area, divn)
         n_capped += element_stress_damage_kernel_serial(
             tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta,
-            dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn)
+            dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn, lam_scale)
     return n_capped
 
 
 @njit(cache=True, error_model="numpy")
 def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
                       c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat,
-                      eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn, area):
+                      eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn, area,
+                      lam_scale):
     """:func:`substeps_serial` with the parallel kernel builds (one fork/join per
     kernel and sub-step, launched from compiled code)."""
     n_capped = 0
@@ -631,7 +638,7 @@ def substeps_parallel(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_
             node_divergence_kernel(vel, ptr, elems, tri, b, c, area, divn)
         n_capped += element_stress_damage_kernel(
             tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta,
-            dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn)
+            dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn, lam_scale)
     return n_capped
 
 
@@ -678,7 +685,8 @@ SUBSTEPS_NONLOCAL = (substeps_nonlocal_serial, substeps_nonlocal_parallel)
 def substeps_jump_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b,
                          c, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat,
                          eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn,
-                         area, j_dofs, j_coef, j_left, j_right, h, j_kfac, j_T, j_ptr, j_idx, j_c, dt_over_m):
+                         area, lam_scale, j_dofs, j_coef, j_left, j_right, h, j_kfac, j_T, j_ptr, j_idx, j_c,
+                         dt_over_m):
     """:func:`substeps_serial` for Crouzeix–Raviart velocities with the jump penalty
     (:class:`lagice.solvers.crouzeix_raviart.JumpPenalty`): each sub-step adds the penalty's
     impulse from the last tractions, runs the node kernel over the edges, updates the tractions
@@ -691,7 +699,7 @@ def substeps_jump_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, s
         jump_update_kernel_serial(vel, j_dofs, j_coef, j_left, j_right, h, e_dt, gamma, j_kfac, j_T)
         n_capped += element_stress_damage_kernel_serial(
             tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta,
-            dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn)
+            dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom, max_damage, E0, lambda0, alpha, flag, divn, lam_scale)
     return n_capped
 
 
@@ -892,6 +900,8 @@ class ExplicitSolver:
         """td and the smallest element size after nodes moved."""
         area = ns.area
         self.td = self.rheology.damage_time(np.sqrt(2.0 * area))
+        #: Δx/ℓ per element (rheology.crack_band_length_m), or None (off)
+        self.lam_scale = self.rheology.relaxation_scale(np.sqrt(2.0 * area))
         self.dx_min = float(np.sqrt(2.0 * area.min()))
         #: the element size the sub-step limit is applied with: dx_min ("mesh"), or with
         #: substep_limit = "element" that of the element-wise bound (lagice.stability.effective_dx),
@@ -981,7 +991,7 @@ class ExplicitSolver:
         """The sub-step loop in Python with each kernel timed (``profile_kernels``)."""
         (vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri, b, c, damage, conc_factor,
          coh, kc, kt, td, heal, e_dt, gamma, pmax, keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom,
-         max_damage, E0, lambda0, alpha, flag, divn, area) = args
+         max_damage, E0, lambda0, alpha, flag, divn, area, lam_scale) = args
         node_k = node_velocity_kernel if par else node_velocity_kernel_serial
         elem_k = element_kernels(alpha)[int(par)]
         n_capped = 0
@@ -995,7 +1005,7 @@ class ExplicitSolver:
             tb = time.perf_counter()
             n_capped += elem_k(tri, b, c, vel, sigma, damage, conc_factor, coh, kc, kt, td, heal, e_dt, gamma,
                                pmax, keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, q, denom,
-                               max_damage, E0, lambda0, alpha, flag, divn)
+                               max_damage, E0, lambda0, alpha, flag, divn, lam_scale)
             tc = time.perf_counter()
             tn += tb - ta
             tm += tc - tb
@@ -1078,6 +1088,8 @@ class ExplicitSolver:
         # g = exp(−c*(1−A)) once: the moduli and the element kernel share it
         conc_factor = self.rheology.concentration_factor(state.concentration)
         E, lam = self.rheology.moduli(state.damage, state.concentration, conc_factor)
+        if self.lam_scale is not None:  # rheology.crack_band_length_m: λ Δx/ℓ
+            lam = lam * self.lam_scale
         E_stab = stability_modulus(p, E, state.concentration)
         E_max = float(E_stab.max()) if len(E) else p.E0
         self.dx_eff = (effective_dx(self.dx_min, E_max, float((E_stab / ns.area).max()))
@@ -1144,7 +1156,8 @@ class ExplicitSolver:
                 pres1, tri32, gb, gc, damage, conc_factor, coh, k_c, k_t, self.td, heal, e_dt, gamma, pmax,
                 keep_mean, theta, dilat, eff, closure, dt_s, kxx, kxy, kss, rh.q, rh._denom, p.max_damage, p.E0,
                 p.relaxation_time_s, float(p.alpha), flag,
-                np.empty(mesh.n_nodes, np.float64) if self.volumetric_strain == "nodal" else None, ns.area)
+                np.empty(mesh.n_nodes, np.float64) if self.volumetric_strain == "nodal" else None, ns.area,
+                self.lam_scale)
         if self.kernel_choice is None or (
                 self.parallel_setting is None
                 and time.perf_counter() - self._tuned_at > (
