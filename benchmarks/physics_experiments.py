@@ -3063,6 +3063,45 @@ add_screen_20km("eng-P-C3-m40", ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6
 # The chain 40 / 20 / 10 / 5 km: beta 0.169 / 0.142 / 0.102 / 0.072 (5 km: first 10 days); <rate> at 94 km 0.0146 /
 # 0.0103 / 0.0074 / 0.0053 per day: about 30 % less at each halving, with the same drift.
 
+# Written 2026-11-30 09:03 UTC, before its runs. A reading formed this session from runs already published (no new
+# run): across the energy + P_max family, the pooled <rate> at 94 km (benchmarks/beta_estimator.py) is close to one
+# function of the cohesion in pascals, whatever the mesh. Cohesion relative to eng-P-C3 at 20 km (the scaling law
+# C ~ C_lab / sqrt(dx)) -> rate at 94 km per day: C3 40 km 0.71 -> 0.0146; C4 40 km 0.94 -> 0.0087; C3 20 km 1.00 ->
+# 0.0103; C3.5 20 km 1.17 -> 0.0088; C4 20 km 1.33 -> 0.0067; C3 10 km 1.41 -> 0.0074; C5 20 km 1.67 -> 0.0036; C4
+# 10 km 1.89 -> 0.0036. So the rate's fall of about 30 % at each halving of the element (rule C40's chain) would be
+# the scaling law's stronger elements, not the mesh. Two runs out of sample, each at the cohesion in pascals of a
+# published 20 km month:
+# (MC40) eng-P at 40 km with C_lab 15.84 MPa (= 11.2 MPa x sqrt 2, eng-P-C4-m20's cohesion in pascals), own 40 km
+#        spin-up: the reading holds if its rate at 94 km is within 15 % of eng-P-C4-m20's (0.0057-0.0077 per day);
+#        it fails otherwise.
+# (MC10) eng-P at 10 km with C_lab 5.94 MPa (= 8.4 MPa / sqrt 2, eng-P-C3-m20's cohesion in pascals), closed basin,
+#        own 10 km spin-up: the reading holds if its rate at 94 km is within 15 % of eng-P-C3-m20's (0.0088-0.0118
+#        per day); it fails otherwise.
+# Predicted: both hold. beta (widths >= 10 km): at 40 km 0.14-0.19; at 10 km 0.02-0.04 below eng-P-C3-m20's 0.142
+#     (as in the two matched pairs above, C4 20 km / C3 10 km and C5 20 km / C4 10 km), with the half-shear area about
+#     half the 20 km one.
+# Written 2026-11-30 09:03 UTC, before its runs: a crack band for the viscous flow. A damage band is one element wide,
+# and the slip rate across it is its width times its viscous strain rate, dx sigma/(E lambda): on a finer mesh a band
+# at the same stress and damage slips more slowly. rheology.crack_band_length_m = l (new this session; the idea of
+# Bazant and Oh 1983, l has no sea-ice source) multiplies each element's relaxation time by dx/l, so a band of any
+# width slips as a band l wide. eng-P-C3 with l = 20 km (scale about 0.93 on the 20 km mesh, 0.47 on the 10 km mesh),
+# at 20 km (eng-P-C3-CB20-m20) and at 10 km in both basins (eng-P-C3-CB20), own spin-ups.
+# (CB)  the bands' viscous width sets the fall of beta if the closed 10 km month with l has beta (widths >= 10 km)
+#       within 0.02 of the 20 km month with l; it fails if beta falls by 0.03 or more.
+# (CBL) a lead for the flagship if, in each basin at 10 km, beta lies in 0.14-0.23, the wind factor in 0.006-0.010
+#       and at least 3 bands are inside.
+# Predicted: both fail. At 20 km the month is close to eng-P-C3's (beta 0.13-0.16). At 10 km the bands slip up to
+#     twice as fast: the rate at 94 km rises by 10-30 % over eng-P-C3's at 10 km (0.0074), but the bands stay one
+#     element wide and as few, so the half-shear area moves by less than 20 % and beta by less than 0.02.
+add_screen_20km("eng-P-C566-m40", ENERGY + PMAX + ["rheology.strength_lab_pa=15.84e6"],
+                "40 km: eng-P with C_lab 15.84 MPa, the cohesion in pascals of eng-P-C4 at 20 km, own 40 km spin-up",
+                res_km=40)
+add_month_own_spinup("eng-P-C212", ENERGY + PMAX + ["rheology.strength_lab_pa=5.94e6"],
+                     "eng-P with C_lab 5.94 MPa, the cohesion in pascals of eng-P-C3 at 20 km, own spin-up")
+_CB20 = ENERGY + PMAX + ["rheology.strength_lab_pa=8.4e6", "rheology.crack_band_length_m=20e3"]
+add_screen_20km("eng-P-C3-CB20-m20", _CB20, "20 km: eng-P-C3 with the relaxation time x dx / 20 km, own spin-up")
+add_month_own_spinup("eng-P-C3-CB20", _CB20, "eng-P-C3 with the relaxation time x dx / 20 km, own spin-up")
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
