@@ -38,6 +38,7 @@ from .activities import (
 )
 from .errors import ConfigError, RestartError
 from .io.checkpoint import FORMAT_VERSION, latest_valid_checkpoint, read_checkpoint, write_checkpoint
+from .remesh.component import TRIGGER_CRITERIA
 from .schedule import parse_duration
 
 
@@ -211,7 +212,8 @@ class Simulation:
 
     def summary(self) -> dict:
         """Simulated time and steps, wall time (all sessions of the run, resumed parts
-        included, like the component ``timings``), remesh count, the mesh's element and node
+        included, like the component ``timings``), remesh count and the events each trigger
+        criterion fired in (``remesh_triggers``), the mesh's element and node
         counts now (remeshing changes them: docs/remeshing.md §7.1), ice volume budget,
         why the run stopped early (None: it reached its end) and the last checkpoint."""
         m = self.model
@@ -220,6 +222,7 @@ class Simulation:
         return {"time_s": m.clock.time_s, "steps": m.clock.iteration, "stop_time_s": self.stop_time,
                 "finished": self.finished, "wall_s": self.wall_s,
                 "timings": dict(m.timings), "remesh_count": st.counters.get("remesh_count", 0),
+                "remesh_triggers": {k: st.counters.get(f"remesh_trigger_{k}", 0) for k in TRIGGER_CRITERIA},
                 "n_elements": int(st.mesh.n_elements), "n_nodes": int(st.mesh.n_nodes),
                 "ice_volume_m3": st.ice_volume_m3, "volume_budget": m.volume_budget(),
                 "stop_reason": self.stop_reason,

@@ -61,7 +61,10 @@ REMESHING = {"run.duration": 6000.0, "solver.dt": 100.0, "output.every": 3000.0,
 
 def test_resumed_run_carries_the_remesh_event_count(tmp_path):
     """components.remeshing.n_events of the final checkpoint counts the whole run: a run
-    resumed after some remesh events ends with the uninterrupted run's count."""
+    resumed after some remesh events ends with the uninterrupted run's count, and with its
+    count of the events each trigger criterion fired in (summary ``remesh_triggers``). Each
+    event was fired by at least one criterion and each criterion fired in no more events than
+    there were, and the counts are those of the events' own logs."""
     def n_events(run):
         path = list_checkpoints(tmp_path / run / "checkpoints")[-1]
         return read_checkpoint(path)[1]["components"]["remeshing"]["n_events"]
@@ -78,6 +81,13 @@ def test_resumed_run_carries_the_remesh_event_count(tmp_path):
     resumed.run()
     assert n_events("part") == n_events("full")
     assert resumed.model.state.counters["remesh_count"] == full.model.state.counters["remesh_count"]
+    trig, count = full.summary()["remesh_triggers"], full.summary()["remesh_count"]
+    assert resumed.summary()["remesh_triggers"] == trig
+    assert set(trig) == {"angle", "near_inversion", "edge_length"}
+    assert max(trig.values()) <= count <= sum(trig.values())
+    events = [ev for ev in full.model.component("remeshing").log.events if ev.kind != "failed"]
+    assert len(events) == count
+    assert trig == {k: sum(ev.trigger_counts[k] > 0 for ev in events) for k in trig}
 
 
 def _as_written_without(path, keys):

@@ -31,9 +31,16 @@ def remeshed_transport(old_mesh, transport, mesh, ev):
     return v, strain_rate(mesh.triangles, b, c, v)
 
 
+#: the trigger's criteria (:func:`lagice.remesh.trigger.check_trigger`), each counted in
+#: ``state.counters["remesh_trigger_<criterion>"]``: the remesh events in which it caught at
+#: least one element (an event may count under several)
+TRIGGER_CRITERIA = ("angle", "near_inversion", "edge_length")
+
+
 class Remesher:
     """Remesh check after each move; events are appended to :attr:`log` and counted in
-    ``state.counters`` (``remesh_count``, ``mesh_epoch``).
+    ``state.counters`` (``remesh_count``, ``mesh_epoch``, and ``remesh_trigger_<criterion>`` for
+    each of :data:`TRIGGER_CRITERIA`).
 
     Args:
         size_field: target element size [m] (number or vectorised ``f(x, y)``).
@@ -92,6 +99,9 @@ class Remesher:
         if ev is not None and ev.kind != "failed":
             st.counters["remesh_count"] = st.counters.get("remesh_count", 0) + 1
             st.counters["mesh_epoch"] = st.counters.get("mesh_epoch", 0) + 1
+            for k in TRIGGER_CRITERIA:  # events in which each criterion caught an element
+                if ev.trigger_counts.get(k, 0) > 0:
+                    st.counters[f"remesh_trigger_{k}"] = st.counters.get(f"remesh_trigger_{k}", 0) + 1
             for f in self.after_remesh:
                 f(st, ev)
             model.set_remeshed_transport(*remeshed_transport(old_mesh, transport, st.mesh, ev))
