@@ -96,6 +96,9 @@ def main(argv=None):
     ap.add_argument("--figure", type=Path, default=None,
                     help="also draw the pooled ⟨ε̇tot⟩(L), each run divided by its value at the widest width, "
                          "to this PNG")
+    ap.add_argument("--absolute", action="store_true",
+                    help="with --figure: draw ⟨ε̇tot⟩(L) itself [day⁻¹], not divided by its widest value, to "
+                         "compare the rates of runs at each width")
     args = ap.parse_args(argv)
     missing = [r for r in args.runs if not (RUNS / r / "snapshots").is_dir()]
     if missing:
@@ -120,13 +123,14 @@ def main(argv=None):
         print(f"  {name}: " + ", ".join(f"{w:.0f} km {r:.4f}" for w, r in zip(c["width_km"], c["rate_per_day"])))
     print(f"beta_estimator: wrote {args.json}", file=sys.stderr)
     if args.figure is not None:
-        figure_curves({name: out[name]["curve"] for name in args.runs}, args.figure)
+        figure_curves({name: out[name]["curve"] for name in args.runs}, args.figure, absolute=args.absolute)
         print(f"beta_estimator: wrote {args.figure}", file=sys.stderr)
 
 
-def figure_curves(curves: dict, path: Path) -> None:
+def figure_curves(curves: dict, path: Path, absolute: bool = False) -> None:
     """⟨ε̇tot⟩(L) / ⟨ε̇tot⟩(widest) against L on log-log axes, one line per run, with the slopes of
-    β = 0.10 and 0.20 drawn from the widest width for reference."""
+    β = 0.10 and 0.20 drawn from the widest width for reference. ``absolute``: ⟨ε̇tot⟩(L) itself
+    [day⁻¹], the β slopes drawn through the first run's widest value."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -136,15 +140,17 @@ def figure_curves(curves: dict, path: Path) -> None:
     for name, c in curves.items():
         w = np.asarray(c["width_km"])
         r = np.asarray(c["rate_per_day"])
-        ax.plot(w, r / r[-1], "o-", label=name)
+        ax.plot(w, r if absolute else r / r[-1], "o-", label=name)
     w_all = np.concatenate([np.asarray(c["width_km"]) for c in curves.values()])
     lw = np.geomspace(w_all.min(), w_all.max(), 20)
+    ref = float(np.asarray(next(iter(curves.values()))["rate_per_day"])[-1]) if absolute else 1.0
     for beta, ls in ((0.1, ":"), (0.2, "--")):
-        ax.plot(lw, (lw / lw[-1]) ** -beta, "k" + ls, lw=0.8, label=f"β = {beta:g}")
+        ax.plot(lw, ref * (lw / lw[-1]) ** -beta, "k" + ls, lw=0.8, label=f"β = {beta:g}")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("box width L (km)")
-    ax.set_ylabel("⟨ε̇tot⟩(L) / ⟨ε̇tot⟩(widest), pooled over the windows")
+    ax.set_ylabel("⟨ε̇tot⟩(L) (day⁻¹), pooled over the windows" if absolute
+                  else "⟨ε̇tot⟩(L) / ⟨ε̇tot⟩(widest), pooled over the windows")
     ax.legend(fontsize=7)
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()

@@ -3132,6 +3132,12 @@ add_month_own_spinup("eng-P-C283", _C283, "eng-P with C_lab 7.92 MPa, the cohesi
 add_weather_ensemble("eng-P-C283", _C283 + from_spinup("H1125-eng-P-C283"),
                      "eng-P with C_lab 7.92 MPa, the cohesion in pascals of eng-P-C4 at 20 km, own spin-up",
                      "10 km, eng-P at eng-P-C4-m20's cohesion in pascals", (2027, 2031))
+# Result (MW, MWB) (2026-11-30, 09:36 UTC): both fail; the prediction was wrong on MW. Seed 2027 / 2031, 10 km against
+# 20 km: rate at 94 km 0.0089 / 0.0100 against 0.0070 / 0.0104 per day (x1.27: the 10 km month deforms more, at every
+# common width; x0.96), beta over widths >= 10 km 0.090 / 0.095 against 0.112 / 0.145 (falls 0.022 / 0.050), tails
+# 4.31, 3.5 / 3.99, 3.19, half-shear area 3.4 / 2.7 %, R2 0.681 / 0.693, wind factor 0.0096 / 0.0088 (20 km: 0.0084 /
+# 0.0086), 654 / 663 remeshes (633 / 634 by edge length). Over the five pairs at the same or nearly the same cohesion
+# the 10 km rate at 94 km is x0.96-1.27 the 20 km one (the law's chain: x0.72), and beta falls by 0.013-0.050.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
@@ -3666,6 +3672,11 @@ LEADS = (
      "A damage time of fixed length"),
     ("σ/(1 − d) at neXtSIM's strength on the mesh at the size asked (own spin-up; a diagnostic)",
      "F10-hthick-eff-m10", "F10s-hthick-eff-m10", "A damage time of fixed length"),
+    ("σ/√(1 − d) + compressive term, C_lab 5.94 MPa: the 20 km ×3 month's cohesion in pascals (own spin-up)",
+     "F10-hthick-eng-P-C212", None, "The rate and the scaling law; a crack band for the viscous flow"),
+    ("σ/√(1 − d) + compressive term, C_lab ×3, relaxation time × Δx / 20 km (crack band; own spin-up)",
+     "F10-hthick-eng-P-C3-CB20", "F10s-hthick-eng-P-C3-CB20",
+     "The rate and the scaling law; a crack band for the viscous flow"),
 )
 
 
