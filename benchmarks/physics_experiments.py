@@ -3139,6 +3139,36 @@ add_weather_ensemble("eng-P-C283", _C283 + from_spinup("H1125-eng-P-C283"),
 # 0.0086), 654 / 663 remeshes (633 / 634 by edge length). Over the five pairs at the same or nearly the same cohesion
 # the 10 km rate at 94 km is x0.96-1.27 the 20 km one (the law's chain: x0.72), and beta falls by 0.013-0.050.
 
+# Written 2026-11-30 09:37 UTC, before its runs: what is left of the mesh dependence at the same cohesion is beta's
+# (rules MC10, MW). Does the moving mesh make it? The month where it is largest, wind seed 2031 (eng-P-C4-m20 at 20
+# km / eng-P at its cohesion at 10 km: beta 0.145 / 0.095 over widths >= 10 km), made again two ways at both sizes,
+# from the same spin-ups (H20-eng-P-C4-m20, H1125-eng-P-C283):
+# (FX)  a fixed mesh: no mesh motion and no remeshing (lagrangian.enabled = false, remesh.enabled = false; the fields
+#       stay in their elements while the ice velocity is solved: a numerical diagnostic, not a model of drifting ice).
+#       The moving mesh makes the fall if the fixed 10 km month's beta is within 0.02 of the fixed 20 km month's; it
+#       fails if beta falls by 0.03 or more.
+# (RL)  remeshing less often: the trigger's edge-length test, which fires 95-97 % of the events, at 6 times the target
+#       size instead of 3 (remesh.params.length_factor = 6). Remeshing's frequency makes the fall if the 10 km month
+#       remeshes at least 40 % less than with 3 (663 events) and its beta is within 0.02 of the 20 km month's with 6;
+#       it fails if beta falls by 0.03 or more.
+# Predicted: both fail. The bands are one element wide on a fixed mesh too, and the compliance remap did not move the
+#     fall (rule RR): on the fixed meshes beta falls by 0.03-0.06; with length_factor 6 the 10 km month remeshes 40-70
+#     % less and beta stays within 0.02 of 0.095.
+_W31 = ["forcing.wind.seed=2031"]
+_FIXED = ["lagrangian.enabled=false", "remesh.enabled=false"]
+EXPERIMENTS["B20-hthick-eng-P-C4-m20-w2031-fx"] = (
+    "closed", EXPERIMENTS["B20-hthick-eng-P-C4-m20-w2031"][1] + _FIXED, 20e3, 28,
+    "20 km: eng-P-C4 in the weather of wind seed 2031 on a fixed mesh (no motion, no remeshing; a diagnostic)")
+EXPERIMENTS["F10-hthick-eng-P-C283-w2031-fx"] = (
+    "closed", EXPERIMENTS["F10-hthick-eng-P-C283-w2031"][1] + _FIXED, 10e3, 28,
+    "eng-P at eng-P-C4-m20's cohesion in the weather of wind seed 2031 on a fixed mesh (a diagnostic)")
+EXPERIMENTS["B20-hthick-eng-P-C4-m20-w2031-lf6"] = (
+    "closed", EXPERIMENTS["B20-hthick-eng-P-C4-m20-w2031"][1] + ["remesh.params.length_factor=6"], 20e3, 28,
+    "20 km: eng-P-C4 in the weather of wind seed 2031, the remesh trigger's edge-length test at 6 times the target")
+EXPERIMENTS["F10-hthick-eng-P-C283-w2031-lf6"] = (
+    "closed", EXPERIMENTS["F10-hthick-eng-P-C283-w2031"][1] + ["remesh.params.length_factor=6"], 10e3, 28,
+    "eng-P at eng-P-C4-m20's cohesion in the weather of wind seed 2031, the edge-length test at 6 times the target")
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
