@@ -3168,6 +3168,16 @@ EXPERIMENTS["B20-hthick-eng-P-C4-m20-w2031-lf6"] = (
 EXPERIMENTS["F10-hthick-eng-P-C283-w2031-lf6"] = (
     "closed", EXPERIMENTS["F10-hthick-eng-P-C283-w2031"][1] + ["remesh.params.length_factor=6"], 10e3, 28,
     "eng-P at eng-P-C4-m20's cohesion in the weather of wind seed 2031, the edge-length test at 6 times the target")
+# Result (FX, RL) (2026-11-30, 09:51 UTC): both fail, as predicted. beta over widths >= 10 km (beta_estimator.py), 20
+# / 10 km: moving mesh (MW) 0.145 / 0.095; fixed mesh 0.149 / 0.095 (falls 0.054); edge-length test at 6 0.129 / 0.095
+# (falls 0.034). The fixed meshes' rate at 94 km: 0.0167 / 0.0177 per day (x1.06 at the same cohesion, as on the
+# moving meshes); their 10 km month: tails 2.27 / 2.21, half-shear area 1.9 %, R2 0.774, rate 0.0249 per day. The 20
+# km fixed month's window statistics (validate.py's Lagrangian cells, built from the nodes carried by the velocity)
+# could not be computed: 4 cells invert in one 3-day window, so it has no published record (beta_estimator reads the
+# snapshots' element strain rates and gives the beta above). With the edge test at 6 the 10 km month remeshes 206
+# times (663 with 3: -69 %), now fired by the angle test in 186 events and the edge test in 22 (20 km: 42 events, 40
+# by angle); beta and the rate stay where they were (0.095; 0.0106 per day at 94 km against 0.0100). Neither the
+# mesh's motion nor remeshing makes beta's fall.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
