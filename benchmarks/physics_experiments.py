@@ -3286,6 +3286,25 @@ def run_experiment(name: str, force: bool = False, run: bool = True) -> dict:
     return r
 
 
+def run_each(names: list, force: bool = False, run: bool = True) -> None:
+    """:func:`run_experiment` for each of ``names`` in turn. A run that fails, or whose analysis
+    fails (a LagiceError, e.g. a diagnostic that cannot be computed for it), is reported and the
+    queue goes on to the next; the command then fails naming every one that failed, after all
+    have ended (before 2026-11-30 the first failure stopped the queue, and the runs after it in
+    that queue were not made)."""
+    from lagice.errors import LagiceError
+
+    failed = []
+    for n in names:
+        try:
+            run_experiment(n, force=force, run=run)
+        except (SystemExit, LagiceError) as exc:
+            print(f"physics: {n} failed: {exc}", file=sys.stderr, flush=True)
+            failed.append(n)
+    if failed:
+        raise SystemExit(f"physics: {len(failed)} of {len(names)} failed: {', '.join(failed)} (logs in {OUT})")
+
+
 def check_names(names: list) -> None:
     """Stop with the first name that is not an experiment, or whose scene and ``--set``
     overrides do not resolve (a key the scene does not know, a key given twice with two
@@ -3783,8 +3802,7 @@ def main(argv=None):
         run_queues(args.names, args.jobs, force=args.force)
     elif args.what in ("run", "analyse"):
         check_names(args.names)
-        for n in args.names:
-            run_experiment(n, force=args.force, run=args.what == "run")
+        run_each(args.names, force=args.force, run=args.what == "run")
     elif args.what == "spinup":
         for n in args.names or ["shipped"]:
             spinup(n, SPINUP_DAYS.get(n, 14))

@@ -200,6 +200,33 @@ def test_physics_run_queues_deal_the_runs_round_robin_and_check_names_first(monk
     assert started == []
 
 
+def test_physics_queue_goes_on_after_a_failed_run_and_then_fails(monkeypatch):
+    """A run (or its analysis) that fails in a queue does not stop the runs after it: each is
+    attempted in order, and the command fails at the end naming the failed ones."""
+    import physics_experiments as pe
+
+    from lagice.errors import ConfigError
+
+    names = ["F10-hthick-hnullsp", "F10s-hthick-hnullsp", "F10-hthick-hnullsp-w2027"]
+    tried = []
+
+    def fake(name, force=False, run=True):
+        tried.append(name)
+        if name == names[0]:
+            raise ConfigError("4 triangle(s) have non-positive area")
+        if name == names[1]:
+            raise SystemExit(f"physics: {name} failed; log x")
+        return {}
+
+    monkeypatch.setattr(pe, "run_experiment", fake)
+    with pytest.raises(SystemExit, match=r"2 of 3 failed: F10-hthick-hnullsp, F10s-hthick-hnullsp"):
+        pe.run_each(names)
+    assert tried == names
+    tried.clear()
+    pe.run_each(names[2:])  # none failed: no exit
+    assert tried == names[2:]
+
+
 def test_every_physics_experiment_resolves_to_a_valid_scene():
     """Each run and spin-up of benchmarks/physics_experiments.py is a bundled scene with
     ``--set`` overrides; a key given twice with two values or a key the scene does not know
