@@ -95,3 +95,31 @@ def test_observe_is_rgps_cells_without_relaying_the_grid(mesh):
     assert truth["tracking_error_m"] == 0.0  # the error-free record is left as it was
     with pytest.raises(ConfigError, match="already carry a 100 m tracking error"):
         observe(sinfo, DT, 50.0)
+
+
+def test_cells_folded_over_the_window_are_dropped_and_counted(mesh):
+    """A band of convergence that closes by more than a cell's height folds the cells across it
+    in the mid-window geometry (a fixed mesh whose nodes are carried by a sheared velocity does
+    that): those cells are dropped and counted (``n_cells_folded``), never used with a negative
+    area; the cells away from the band, which only translate, keep a zero gradient; and a
+    displacement that folds every cell is an error."""
+    xy, tri = mesh
+    y0, amp, width = 205e3, 15e3, 1e3  # the band at y = 205 km, half its closing 15 km, 1 km wide
+    xy1 = xy.copy()
+    xy1[:, 1] -= amp * np.tanh((xy[:, 1] - y0) / width)
+    rates, info = rgps_cells(xy, xy1, tri, DT, tracking_error_m=0.0)
+    assert 0 < info["n_cells_folded"] < 40 * 40
+    assert info["n_cells"] + info["n_cells_folded"] == 40 * 40
+    assert len(rates.area_m2) == info["n_cells"] == len(info["cells"])
+    assert (rates.area_m2 > 0).all() and np.isfinite(rates.gradient_s).all()
+    corners_y = info["points_xy0"][info["cells"], 1]
+    away = (np.abs(corners_y - y0) > 25e3).all(axis=1)  # all four corners beyond the band's 8 km elements
+    assert away.sum() > 1000
+    assert np.abs(rates.gradient_s[away]).max() < 1e-12 * amp / DT
+    # seen with a tracking error: the folded cells stay out, the count carried
+    seen, info2 = observe(info, DT, RGPS_TRACKING_ERROR_M, seed=1)
+    assert info2["n_cells_folded"] >= info["n_cells_folded"] and len(seen.area_m2) == info2["n_cells"]
+    mirrored = xy.copy()
+    mirrored[:, 0] = 3.0 * 200e3 - 2.0 * xy[:, 0]  # the mid-window geometry is the plate mirrored: all inverted
+    with pytest.raises(ConfigError, match="every one of the 1600 cells is inverted"):
+        rgps_cells(xy, mirrored, tri, DT, tracking_error_m=0.0)

@@ -72,9 +72,10 @@ def rgps_cells(nodes_xy0, nodes_xy1, triangles, dt_s, *, cell_m=RGPS_CELL_M, tra
 
     Returns ``(rates, info)``: an :class:`ElementStrainRates` with one entry per cell
     (gradient [s-1], area [m²] and centroid [m] in the mid-window geometry, bounds of
-    the cell corners) and ``info`` = ``{"n_cells", "cell_m", "tracking_error_m", "seed",
-    "origin_xy_m", "points_xy0", "points_xy1", "cells"}`` (corner indices, (k, 4),
-    counter-clockwise). Raises :class:`~lagice.errors.ConfigError` naming the argument
+    the cell corners) and ``info`` = ``{"n_cells", "n_cells_folded", "cell_m", "tracking_error_m",
+    "seed", "origin_xy_m", "points_xy0", "points_xy1", "cells"}`` (corner indices, (k, 4),
+    counter-clockwise; cells folded over the window are dropped and counted, :func:`observe`).
+    Raises :class:`~lagice.errors.ConfigError` naming the argument
     for a bad value, or when no cell fits in the elements."""
     from lagice.drifters import locate
 
@@ -121,7 +122,10 @@ def observe(cells_info: dict, dt_s, tracking_error_m=RGPS_TRACKING_ERROR_M, seed
     """The cells of an error-free :func:`rgps_cells` result (``tracking_error_m = 0``) seen
     with another tracking error: ``(rates, info)`` as :func:`rgps_cells` with that error and
     seed returns them, without laying and locating the grid again (steps 3 and 4 of the
-    module doc)."""
+    module doc). A cell either of whose two triangles is inverted in the mid-window geometry
+    (the points' displacement folds it; a fixed mesh whose nodes are carried by a sheared
+    velocity can do that) has no strain rate: it is dropped, and counted in ``info``'s
+    ``n_cells_folded`` (``n_cells``: the cells kept); all folded is an error."""
     if cells_info["tracking_error_m"] != 0.0:
         raise ConfigError(f"observe: the cells already carry a {cells_info['tracking_error_m']:g} m tracking error; "
                           f"pass the result of rgps_cells(..., tracking_error_m=0)")
@@ -132,6 +136,13 @@ def observe(cells_info: dict, dt_s, tracking_error_m=RGPS_TRACKING_ERROR_M, seed
     p0, p1, cells = cells_info["points_xy0"], cells_info["points_xy1"], cells_info["cells"]
     if tracking_error_m > 0.0:
         p1 = p1 + np.random.default_rng(seed).normal(0.0, tracking_error_m, p1.shape)
+    folded = _folded_cells(p0, p1, cells)
+    n_folded = int(folded.sum())
+    if n_folded:  # a cell whose mid-window geometry is inverted has no strain rate: dropped, counted
+        if n_folded == cells.shape[0]:
+            raise ConfigError(f"every one of the {n_folded} cells is inverted in its mid-window geometry (the "
+                              f"points' displacement over the window folds them)")
+        cells = cells[~folded]
     halves = np.concatenate([cells[:, [0, 1, 2]], cells[:, [0, 2, 3]]])
     r = _lagrangian(p0, p1, halves, dt, "mid")
     k = cells.shape[0]
@@ -141,5 +152,19 @@ def observe(cells_info: dict, dt_s, tracking_error_m=RGPS_TRACKING_ERROR_M, seed
     cen = (r.centroid_xy_m.reshape(2, k, 2) * a[..., None]).sum(axis=0) / area[:, None]
     rates = ElementStrainRates(grad, area, cen, r.bounds_m)
     info = {**cells_info, "tracking_error_m": float(tracking_error_m),
-            "seed": seed if np.isscalar(seed) else [int(v) for v in seed], "points_xy1": p1}
+            "seed": seed if np.isscalar(seed) else [int(v) for v in seed], "points_xy1": p1,
+            "cells": cells, "n_cells": int(cells.shape[0]),
+            "n_cells_folded": int(cells_info.get("n_cells_folded", 0)) + n_folded}
     return rates, info
+
+
+def _folded_cells(p0, p1, cells):
+    """(k,) bool: cells either of whose two triangles (0, 1, 2) and (0, 2, 3) has a non-positive
+    area in the mid-window geometry (0.5 (p0 + p1)), where :func:`observe` takes its gradient."""
+    mid = 0.5 * (p0 + p1)
+    out = np.zeros(cells.shape[0], bool)
+    for a, b, c in ((0, 1, 2), (0, 2, 3)):  # the two halves (not a loop over cells)
+        pa, pb, pc = mid[cells[:, a]], mid[cells[:, b]], mid[cells[:, c]]
+        cross = (pb[:, 0] - pa[:, 0]) * (pc[:, 1] - pa[:, 1]) - (pb[:, 1] - pa[:, 1]) * (pc[:, 0] - pa[:, 0])
+        out |= ~(cross > 0.0)
+    return out

@@ -125,7 +125,9 @@ def window_summary(run_dir, start_s: float, window_s: float, coast_buffer_m: flo
     ``rgps_tracking_error_m``: also the statistics of the interior as RGPS would see
     it (:func:`lagice.diagnostics.rgps.rgps_cells`: 10 km cells, this tracking error
     [m], seeded by ``(rgps_seed, start_s)``) under ``rgps``, and of the same cells
-    without error under ``rgps_cells``; each with ``n_cells`` (and without the PDFs)."""
+    without error under ``rgps_cells``; each with ``n_cells`` and ``n_cells_folded`` (cells the
+    window's displacement inverts, dropped: :func:`lagice.diagnostics.rgps.observe`; and without
+    the PDFs)."""
     from lagice.diagnostics.report import rate_statistics, summarise
     from lagice.diagnostics.rgps import observe, rgps_cells
 
@@ -147,6 +149,7 @@ def window_summary(run_dir, start_s: float, window_s: float, coast_buffer_m: flo
         for name, (rates, ci) in (("rgps", seen), ("rgps_cells", truth)):
             st, _ = rate_statistics(rates)
             out[name] = {**{k: st[k] for k in RGPS_WINDOW_KEYS}, "n_cells": ci["n_cells"],
+                         "n_cells_folded": ci["n_cells_folded"],
                          "tracking_error_m": ci["tracking_error_m"], "seed": ci["seed"]}
     return out
 
