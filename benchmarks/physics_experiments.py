@@ -3182,6 +3182,21 @@ EXPERIMENTS["F10-hthick-eng-P-C283-w2031-lf6"] = (
 # folded cells (4 and 3 of about 3700, in the windows of days 10 and 13): beta 0.149, tails 1.4 / 1.45, half-shear area
 # 3.7 %, R2 0.696, rate 0.0192 per day, wind factor 0.0079.
 
+# Written 2026-11-30 10:02 UTC, before its runs: is beta's fall at the same cohesion more than one realisation's noise?
+# Each mesh has its own white strength disorder, and one month on each is one realisation. In wind seed 2031 (rule
+# MW: beta over widths >= 10 km 0.145 at 20 km, 0.095 at 10 km) the strength disorder is drawn again with run seeds
+# 1-3 at 20 km and run seed 1 at 10 km (the same spin-up states, whose damage was made with draw 0).
+# (DS)  the fall is systematic if all four 20 km draws (0-3) lie 0.03 or more above both 10 km draws (0, 1); it is
+#       within one realisation's noise if some 20 km draw lies within 0.02 of some 10 km draw.
+# Predicted: systematic: the 20 km draws at 0.12-0.16, the 10 km draws at 0.08-0.11.
+for _d in (1, 2, 3):
+    EXPERIMENTS[f"B20-hthick-eng-P-C4-m20-w2031-d{_d}"] = (
+        "closed", EXPERIMENTS["B20-hthick-eng-P-C4-m20-w2031"][1] + [f"run.seed={_d}"], 20e3, 28,
+        f"20 km: eng-P-C4 in the weather of wind seed 2031, strength disorder of run seed {_d}")
+EXPERIMENTS["F10-hthick-eng-P-C283-w2031-d1"] = (
+    "closed", EXPERIMENTS["F10-hthick-eng-P-C283-w2031"][1] + ["run.seed=1"], 10e3, 28,
+    "eng-P at eng-P-C4-m20's cohesion in the weather of wind seed 2031, strength disorder of run seed 1")
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
