@@ -3196,6 +3196,11 @@ for _d in (1, 2, 3):
 EXPERIMENTS["F10-hthick-eng-P-C283-w2031-d1"] = (
     "closed", EXPERIMENTS["F10-hthick-eng-P-C283-w2031"][1] + ["run.seed=1"], 10e3, 28,
     "eng-P at eng-P-C4-m20's cohesion in the weather of wind seed 2031, strength disorder of run seed 1")
+# Result (DS) (2026-11-30, 10:19 UTC): decides neither way by its letter; the prediction was near on both ranges. beta
+# over widths >= 10 km, draws 0-3 at 20 km: 0.145, 0.118, 0.155, 0.139; draws 0-1 at 10 km: 0.095, 0.068. The
+# nearest pair is 0.023 apart: more than 0.02, less than 0.03. The pooled curves separate cleanly: the ratio of the
+# rate at 12 km to the rate at 92-93 km is 1.30-1.34 in all four 20 km draws and 1.21-1.22 in both 10 km draws; the
+# rate at 94 km is 0.0104-0.0108 and 0.0094-0.0100 per day.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
