@@ -35,6 +35,24 @@ def series(sim, name):
     return np.array(sim.activities["timeseries"].writer.rows[name][1:])
 
 
+def shear_inner_nodes(mesh, amplitude_m=8e3, wavelength_m=80e3):
+    """Move the interior nodes of ``mesh`` in place by ``amplitude_m`` sin(y/``wavelength_m``) in x
+    (the boundary nodes stay), distorting the elements as a Lagrangian step would."""
+    inner = np.ones(mesh.n_nodes, bool)
+    inner[np.unique(mesh.boundary_edges)] = False
+    mesh.nodes[inner, 0] += amplitude_m * np.sin(mesh.nodes[inner, 1] / wavelength_m)
+
+
+def global_remesh(model, dt_s=3600.0):
+    """Force one global remesh through the model's ``remeshing`` component (which makes new
+    elements); asserts that it happened and returns its event."""
+    rem = model.component("remeshing")
+    rem.options["force_global"] = True
+    ev = rem.advance(model, dt_s)
+    assert ev is not None and ev.kind == "global"
+    return ev
+
+
 def compression_overrides(n_across=10, **kw):
     """Overrides of the uniaxial_compression scene for N elements across the short edge."""
     return {"domain.resolution_m": 100e3 / n_across, **kw}

@@ -16,7 +16,7 @@ from lagice.solvers.explicit import (
 )
 from lagice.state import IceState
 
-from helpers import step
+from helpers import global_remesh, shear_inner_nodes, step
 
 
 def test_relaxation_scale_against_the_element_size():
@@ -134,13 +134,8 @@ def test_crack_band_scale_holds_on_every_element_through_a_remesh():
                                                         if k != "rheology.crack_band_length_m"})).stepper.lam_scale \
         is None
     m = model.state.mesh
-    inner = np.ones(m.n_nodes, bool)
-    inner[np.unique(m.boundary_edges)] = False
-    m.nodes[inner, 0] += 8e3 * np.sin(m.nodes[inner, 1] / 80e3)
-    rem = model.component("remeshing")
-    rem.options["force_global"] = True
-    ev = rem.advance(model, 3600.0)
-    assert ev is not None and ev.kind == "global"
+    shear_inner_nodes(m)
+    global_remesh(model)
     assert model.state.mesh is not m
     assert len(model.stepper.lam_scale) == model.state.mesh.n_elements
     np.testing.assert_allclose(model.stepper.lam_scale, np.sqrt(2.0 * model.stepper.nodes.area) / 30e3, rtol=1e-14)

@@ -8,6 +8,8 @@ from lagice.errors import ConfigError
 from lagice.rheology import MaxwellEB
 from lagice.strength import element_size
 
+from helpers import global_remesh, shear_inner_nodes
+
 
 def test_damage_time_of_fixed_length_against_the_element_size():
     """Default: td = Δx/cs per element (Dansereau et al. 2016); with ℓ set: ℓ/cs for every size."""
@@ -54,12 +56,7 @@ def test_fixed_damage_time_holds_on_every_element_through_a_remesh(solver):
     model = build_model(load_scene("winter_basin_pack", {**ov, "rheology.damage_length_m": 25e3}))
     np.testing.assert_array_equal(model.stepper.td, np.full(model.state.mesh.n_elements, 50.0))
     m = model.state.mesh
-    inner = np.ones(m.n_nodes, bool)
-    inner[np.unique(m.boundary_edges)] = False
-    m.nodes[inner, 0] += 8e3 * np.sin(m.nodes[inner, 1] / 80e3)
-    rem = model.component("remeshing")
-    rem.options["force_global"] = True
-    ev = rem.advance(model, 3600.0)
-    assert ev is not None and ev.kind == "global"
+    shear_inner_nodes(m)
+    ev = global_remesh(model)
     assert model.state.mesh is not m and len(ev.kept_elements) < model.state.mesh.n_elements  # new elements
     np.testing.assert_array_equal(model.stepper.td, np.full(model.state.mesh.n_elements, 50.0))

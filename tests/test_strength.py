@@ -11,6 +11,8 @@ from lagice.mesh import generate_mesh, rectangle_domain
 from lagice.rheology import dcrit
 from lagice.strength import StrengthLaw, element_size, element_uniforms, from_config, from_nextsim
 
+from helpers import global_remesh, shear_inner_nodes
+
 
 def _mesh(size):
     poly, segs = rectangle_domain(200e3, 200e3)
@@ -94,14 +96,10 @@ def test_after_a_remesh_every_element_carries_the_strength_of_its_size():
     law = from_config(model.config["rheology"], model.config["run"]["seed"])
     m = st.mesh
     f_before = st.cohesion / (law.lab_cohesion_pa * law.scale_factor(element_size(m.nodes, m.triangles)))
-    inner = np.ones(m.n_nodes, bool)
-    inner[np.unique(m.boundary_edges)] = False
-    m.nodes[inner, 0] += 8e3 * np.sin(m.nodes[inner, 1] / 80e3)
+    shear_inner_nodes(m)
     rem = model.component("remeshing")
     assert any(getattr(f, "__self__", None) == law for f in rem.after_remesh)  # the scene's law is the hook
-    rem.options["force_global"] = True
-    ev = rem.advance(model, 3600.0)
-    assert ev is not None and ev.kind == "global"
+    ev = global_remesh(model)
     nm = st.mesh
     dx = element_size(nm.nodes, nm.triangles)
     f = law.disorder_factor(st.node_id, nm.triangles)
@@ -204,14 +202,9 @@ def test_correlated_factor_is_carried_remapped_and_checkpointed(tmp_path):
     np.testing.assert_allclose(st.cohesion, law.cohesion(m.nodes, m.triangles, st.node_id) * st.strength_factor,
                                rtol=1e-12)
     std_before = st.strength_factor.std()
-    inner = np.ones(m.n_nodes, bool)
-    inner[np.unique(m.boundary_edges)] = False
-    m.nodes[inner, 0] += 8e3 * np.sin(m.nodes[inner, 1] / 80e3)
+    shear_inner_nodes(m)
     total = np.sum(st.strength_factor * m.areas())  # ∫ g da over the moved (Lagrangian) elements
-    rem = model.component("remeshing")
-    rem.options["force_global"] = True
-    ev = rem.advance(model, 3600.0)
-    assert ev is not None and ev.kind == "global"
+    ev = global_remesh(model)
     nm = st.mesh
     assert np.sum(st.strength_factor * nm.areas()) == pytest.approx(total, rel=1e-12)
     dx = element_size(nm.nodes, nm.triangles)

@@ -899,9 +899,10 @@ class ExplicitSolver:
     def _geometry_extras(self, ns) -> None:
         """td and the smallest element size after nodes moved."""
         area = ns.area
-        self.td = self.rheology.damage_time(np.sqrt(2.0 * area))
+        dx = np.sqrt(2.0 * area)
+        self.td = self.rheology.damage_time(dx)
         #: Δx/ℓ per element (rheology.crack_band_length_m), or None (off)
-        self.lam_scale = self.rheology.relaxation_scale(np.sqrt(2.0 * area))
+        self.lam_scale = self.rheology.relaxation_scale(dx)
         self.dx_min = float(np.sqrt(2.0 * area.min()))
         #: the element size the sub-step limit is applied with: dx_min ("mesh"), or with
         #: substep_limit = "element" that of the element-wise bound (lagice.stability.effective_dx),
