@@ -3205,6 +3205,31 @@ add_variant("F10-hthick-eng-P-C283-w2031-d1", "F10-hthick-eng-P-C283-w2031", ["r
 # rate at 12 km to the rate at 92-93 km is 1.30-1.34 in all four 20 km draws and 1.21-1.22 in both 10 km draws; the
 # rate at 94 km is 0.0104-0.0108 and 0.0094-0.0100 per day.
 
+# Written 2026-11-30 10:52 UTC, before its runs: does the concentration's dilution in bands one element wide make beta's
+# fall at the same cohesion? A band one element wide that opens by a given width loses twice as much concentration on
+# a mesh twice as fine, and c* = 20 acts through exp(-c* (1 - A)) on the modulus, on the relaxation time (to the power
+# alpha - 1), on P_max and on the healing rate. So the same opening leaves a 10 km band softer, less viscous, weaker
+# in compression and slower to heal than a 20 km band. (Over the month the 1st percentile of A is 0.61-0.90 at 10 km
+# against 0.72-0.94 at 20 km: F10-hthick-eng-P-C212 against B20-hthick-eng-P-C3-m20.) The wind seed 2031 months of
+# rule DS (the same spin-up states, the same draws) made again with rheology.concentration_c = 0 (healing takes the
+# model's c*, so it loses its dependence on A too): 20 km draws 0-3, 10 km draws 0-1.
+# (CS)  the dilution makes the fall if, with c* = 0, the gap between the pooled ratios of the rate at 12 km to the
+#       rate at 92-93 km (beta_estimator.py; the lowest 20 km draw's minus the highest 10 km draw's; 0.08 with c* = 20)
+#       is below 0.03; it fails if the gap is 0.06 or more; between the two it decides neither way.
+# Predicted: fails. The 1st percentile of A is one element in a hundred, and the fall appeared on a fixed mesh and
+#     with a crack band; with c* = 0 the leads keep their stiffness, both meshes deform less (rate at 94 km -10 to
+#     -40 %), and the gap stays at 0.06-0.10.
+for _d in (0, 1, 2, 3):
+    _base = "B20-hthick-eng-P-C4-m20-w2031" + (f"-d{_d}" if _d else "")
+    add_variant(f"{_base}-cs0", _base, ["rheology.concentration_c=0"],
+                f"20 km: eng-P-C4 in the weather of wind seed 2031, strength disorder of run seed {_d}, c* = 0 "
+                "(a diagnostic)")
+for _d in (0, 1):
+    _base = "F10-hthick-eng-P-C283-w2031" + (f"-d{_d}" if _d else "")
+    add_variant(f"{_base}-cs0", _base, ["rheology.concentration_c=0"],
+                f"eng-P at eng-P-C4-m20's cohesion in the weather of wind seed 2031, strength disorder of run seed "
+                f"{_d}, c* = 0 (a diagnostic)")
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
