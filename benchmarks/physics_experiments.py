@@ -3229,6 +3229,16 @@ for _d in (0, 1):
     add_variant(f"{_base}-cs0", _base, ["rheology.concentration_c=0"],
                 f"eng-P at eng-P-C4-m20's cohesion in the weather of wind seed 2031, strength disorder of run seed "
                 f"{_d}, c* = 0 (a diagnostic)")
+# Result (CS) (2026-11-30, 11:20 UTC): fails, as predicted; the gap grew. With c* = 0 the pooled ratio of the rate at
+# 12 km to the rate at 92-93 km is 1.42-1.47 in the four 20 km draws and 1.26-1.27 in the two 10 km draws (gap 0.15;
+# 0.08 with c* = 20). beta over widths >= 10 km: 20 km 0.164 / 0.164 / 0.169 / 0.175 (c* = 20: 0.118-0.155), 10 km
+# 0.102 / 0.110 (0.068 / 0.095): c* = 0 raises beta on both meshes by about 0.02-0.04 and leaves the fall (0.054-0.073).
+# Rate at 92-93 km: 0.0090-0.0092 per day at 20 km (-13 to -15 %), 0.0088-0.0090 at 10 km (-6 to -10 %). The element
+# rate over the 92 km rate: 1.41-1.47 (20 km), 1.34-1.38 (10 km). 20 km months: rate (window median) 0.0121-0.0129
+# per day, wind factor 0.0072-0.0082, half-shear area 4.4-4.8 %, tails 2.78-4.18 / 1.33-3.18, R2 0.65-0.73, 73-81
+# remeshes. 10 km months: rate 0.0124-0.0127, wind factor 0.0083 / 0.0094, half-shear area 2.5 / 2.9 %, tails 3.36,
+# 3.74 / 1.87, 3.48, R2 0.67-0.70, 579-603 remeshes. The concentration's dilution in one-element bands is not what
+# makes beta fall.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
