@@ -3205,7 +3205,7 @@ add_variant("F10-hthick-eng-P-C283-w2031-d1", "F10-hthick-eng-P-C283-w2031", ["r
 # rate at 12 km to the rate at 92-93 km is 1.30-1.34 in all four 20 km draws and 1.21-1.22 in both 10 km draws; the
 # rate at 94 km is 0.0104-0.0108 and 0.0094-0.0100 per day.
 
-# Written 2026-11-30 10:52 UTC, before its runs: does the concentration's dilution in bands one element wide make beta's
+# Written 2026-11-30 10:48 UTC, before its runs: does the concentration's dilution in bands one element wide make beta's
 # fall at the same cohesion? A band one element wide that opens by a given width loses twice as much concentration on
 # a mesh twice as fine, and c* = 20 acts through exp(-c* (1 - A)) on the modulus, on the relaxation time (to the power
 # alpha - 1), on P_max and on the healing rate. So the same opening leaves a 10 km band softer, less viscous, weaker
@@ -3229,7 +3229,7 @@ for _d in (0, 1):
     add_variant(f"{_base}-cs0", _base, ["rheology.concentration_c=0"],
                 f"eng-P at eng-P-C4-m20's cohesion in the weather of wind seed 2031, strength disorder of run seed "
                 f"{_d}, c* = 0 (a diagnostic)")
-# Result (CS) (2026-11-30, 11:20 UTC): fails, as predicted; the gap grew. With c* = 0 the pooled ratio of the rate at
+# Result (CS) (2026-11-30, 11:02 UTC): fails, as predicted; the gap grew. With c* = 0 the pooled ratio of the rate at
 # 12 km to the rate at 92-93 km is 1.42-1.47 in the four 20 km draws and 1.26-1.27 in the two 10 km draws (gap 0.15;
 # 0.08 with c* = 20). beta over widths >= 10 km: 20 km 0.164 / 0.164 / 0.169 / 0.175 (c* = 20: 0.118-0.155), 10 km
 # 0.102 / 0.110 (0.068 / 0.095): c* = 0 raises beta on both meshes by about 0.02-0.04 and leaves the fall (0.054-0.073).
