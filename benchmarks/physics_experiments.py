@@ -3240,6 +3240,18 @@ for _d in (0, 1):
 # 3.74 / 1.87, 3.48, R2 0.67-0.70, 579-603 remeshes. The concentration's dilution in one-element bands is not what
 # makes beta fall.
 
+# Written 2026-11-30 11:03 UTC, before its analysis (no new runs): is beta's fall at the same cohesion the coarse mesh's
+# finest width standing in for widths it does not resolve? On a 20 km mesh the 12 km boxes lie inside elements, so the
+# rate there is the elements' own, with no cancellation; on a 10 km mesh the 12 km boxes already hold about 1.4
+# elements. Rule CS's months hint at it: the pooled rate over the finest width's, c(L), is 0.88 / 0.79 / 0.69 at 24 /
+# 47 / 92 km on the 20 km mesh and 0.84 / 0.78 / 0.72 on the 10 km mesh. Pairs (beta_estimator.py, pooled curves):
+# MC10 (B20-hthick-eng-P-C3-m20 / F10-hthick-eng-P-C212), MW (B20-hthick-eng-P-C4-m20-w2027 / F10-hthick-eng-P-C283-
+# w2027, and w2031), DS (w2031-d1, 20 km / 10 km), CB (B20-hthick-eng-P-C3-CB20-m20 / F10-hthick-eng-P-C3-CB20), FX
+# (w2031-fx), CS (w2031-cs0, w2031-d1-cs0): eight pairs.
+# (CO)  it is the finest width if in every pair c(L) agrees within 0.05 between the meshes at 24, 47 and 92 km; it
+#       fails if in two or more pairs c differs by more than 0.08 at some common width.
+# Predicted: holds, with the largest difference in the pair whose 10 km month deformed more (MW, 2027).
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
