@@ -3251,6 +3251,16 @@ for _d in (0, 1):
 # (CO)  it is the finest width if in every pair c(L) agrees within 0.05 between the meshes at 24, 47 and 92 km; it
 #       fails if in two or more pairs c differs by more than 0.08 at some common width.
 # Predicted: holds, with the largest difference in the pair whose 10 km month deformed more (MW, 2027).
+# Result (CO) (2026-11-30, 11:04 UTC): decides neither way by its letter; the reading it tested does not carry the fall.
+# Largest difference in c(L) between the meshes at 24 / 47 / 92 km, per pair: MC10 0.075, MW 2027 0.037, MW 2031
+# 0.052, DS d1 0.033, CB 0.022, FX 0.201, CS 0.050, CS d1 0.049 (within 0.05 in five pairs; above 0.08 in one, the
+# fixed mesh, whose 10 km month has a 6 km rate 1.7 times its 12 km rate). The prediction was wrong on where the
+# largest difference lies (MC10 and FX, not MW 2027). The differences change sign between 24 and 92 km (the 10 km
+# curve lies lower at 24 km and higher at 92 km in four pairs), so they still move beta: over the widths both meshes
+# resolve (>= 20 km: 24, 47, 92 km; pooled curves, a fit written after the rule's result) beta is 0.099-0.200 on the
+# 20 km meshes and 0.070-0.163 on the 10 km ones, and falls in seven pairs of eight (by 0.029-0.087; CB: rises 0.021).
+# So the fall is not only the coarse mesh's finest width, as the forty-fourth session found with the 10 km mesh's
+# extra octave (about a third of the fall).
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
