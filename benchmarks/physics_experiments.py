@@ -3231,8 +3231,9 @@ for _d in (0, 1):
                 f"{_d}, c* = 0 (a diagnostic)")
 # Result (CS) (2026-11-30, 11:02 UTC): fails, as predicted; the gap grew. With c* = 0 the pooled ratio of the rate at
 # 12 km to the rate at 92-93 km is 1.42-1.47 in the four 20 km draws and 1.26-1.27 in the two 10 km draws (gap 0.15;
-# 0.08 with c* = 20). beta over widths >= 10 km: 20 km 0.164 / 0.164 / 0.169 / 0.175 (c* = 20: 0.118-0.155), 10 km
-# 0.102 / 0.110 (0.068 / 0.095): c* = 0 raises beta on both meshes (by 0.007-0.046 per draw) and leaves the fall (0.054-0.073).
+# 0.08 with c* = 20). beta over widths >= 10 km: 20 km 0.169 / 0.164 / 0.169 / 0.175 (c* = 20: 0.118-0.155), 10 km
+# 0.102 / 0.110 (0.068 / 0.095): c* = 0 raises beta on both meshes (by 0.007-0.046 per draw) and leaves the fall
+# (0.054-0.073).
 # Rate at 92-93 km: 0.0090-0.0092 per day at 20 km (-13 to -15 %), 0.0088-0.0090 at 10 km (-6 to -10 %). The element
 # rate over the 92 km rate: 1.41-1.47 (20 km), 1.34-1.38 (10 km). 20 km months: rate (window median) 0.0121-0.0129
 # per day, wind factor 0.0072-0.0082, half-shear area 4.4-4.8 %, tails 2.78-4.18 / 1.33-3.18, R2 0.65-0.73, 73-81
