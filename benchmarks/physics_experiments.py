@@ -3263,6 +3263,19 @@ for _d in (0, 1):
 # So the fall is not only the coarse mesh's finest width, as the forty-fourth session found with the 10 km mesh's
 # extra octave (about a third of the fall).
 
+# Written 2026-11-30 11:06 UTC, before its analysis (no new runs; a new script, benchmarks/band_geometry.py): are the
+# 10 km months' bands longer? On a finer mesh an element at a band's tip sees more of the tip's stress concentration
+# (the elastic field near a crack tip goes as 1 / sqrt(r), and an element averages it over its own size), so at the
+# same cohesion a band propagates more easily and the shear gathers into fewer, longer bands, whose slips cancel less
+# between 24 and 92 km. The measure, per 3-day window of the interior (validate.py's windows): the elements holding
+# half of the shear (as the half-shear area), grouped into bands by shared nodes; each band's length is sqrt(12) times
+# the standard deviation of its elements' centroids along its main axis (area-weighted; a band's length is at least
+# its elements' mean size); the shear-weighted median band length, median over the windows. The eight pairs of rule
+# CO.
+# (BL)  the 10 km bands are longer if their length is at least 1.2 times the 20 km month's in six or more pairs; it
+#       fails if that holds in two pairs or fewer.
+# Predicted: holds.
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
