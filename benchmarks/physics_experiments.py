@@ -3275,6 +3275,13 @@ for _d in (0, 1):
 # (BL)  the 10 km bands are longer if their length is at least 1.2 times the 20 km month's in six or more pairs; it
 #       fails if that holds in two pairs or fewer.
 # Predicted: holds.
+# Result (BL) (2026-11-30, 11:07 UTC): fails; the prediction was wrong. The shear-weighted median band length (km),
+# 20 / 10 km: MC10 175 / 103, MW 2027 152 / 110, MW 2031 107 / 95, DS d1 155 / 85, CB 147 / 90, FX 229 / 117, CS 161 /
+# 84, CS d1 147 / 109: the 10 km bands are 0.51-0.89 times as long, in every pair, and two to three times as many per
+# window (25-51 against 9-21); their total length per 10^4 km2 is about the same (24-45 against 20-33 km). So by this
+# measure the finer mesh's shear lies in more, shorter bands, not fewer, longer ones. A caveat: the set holding half of
+# the shear is thinner at 10 km (2.5-4.7 % of the area against 4.3-6.8 %), so a band one element wide may break into
+# beads where its slip dips; the measure cannot tell a bead from a segment.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",

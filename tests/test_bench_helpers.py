@@ -968,3 +968,36 @@ def test_drift_beta_plane_families_points_and_counts():
     assert s["crouzeix_raviart"]["both_in_band_runs"] == ["b"]
     assert s["nominal"]["both_in_band"] == 0 and s["nominal"]["wind_factor_in_band"] == 1
     assert s["nominal"]["most_bands_inside"] == 4
+
+
+def test_band_geometry_groups_bands_by_shared_nodes_and_measures_their_length():
+    """benchmarks/band_geometry.py on a real gmsh mesh: the elements near two separate segments make
+    two bands, each about as long as its segment; a shear layer across the whole box makes one band
+    as long as the box; the shear-weighted median is the length holding half of the weight."""
+    from band_geometry import band_lengths, bands, weighted_median, window_bands
+
+    from lagice.diagnostics.strain import triangle_geometry
+    from lagice.mesh import generate_mesh, rectangle_domain
+
+    side = 400e3
+    poly, _ = rectangle_domain(side, side)
+    mesh = generate_mesh(poly, 10e3, exterior_tag="free")
+    xy, tri = mesh.nodes, mesh.triangles
+    area, cen = triangle_geometry(xy, tri)[:2]
+    x, y = cen[:, 0], cen[:, 1]
+    seg_a = (np.abs(y - 100e3) < 8e3) & (x > 50e3) & (x < 250e3)  # 200 km long
+    seg_b = (np.abs(x - 300e3) < 8e3) & (y > 200e3) & (y < 300e3)  # 100 km long, 100 km away
+    n, labels = bands(tri, seg_a | seg_b)
+    assert n == 2
+    lengths = np.sort(band_lengths(cen[seg_a | seg_b], area[seg_a | seg_b], labels, n))
+    assert abs(lengths[0] - 100e3) < 15e3 and abs(lengths[1] - 200e3) < 15e3
+    # the weighted median: half of the weight lies at or above it
+    assert weighted_median(np.array([10.0, 20.0, 30.0]), np.array([1.0, 1.0, 2.0])) == 30.0
+    assert weighted_median(np.array([10.0, 20.0, 30.0]), np.array([1.0, 2.0, 0.5])) == 20.0
+    # a shear layer across the box: one band, as long as the box
+    day = 86400.0
+    xy1 = xy + np.column_stack([5e3 * np.tanh((xy[:, 1] - 200e3) / 10e3), 0.0 * xy[:, 1]])
+    r = window_bands(xy, xy1, tri, 3 * day)
+    assert r["n_bands"] == 1
+    assert abs(r["weighted_median_length_km"] - 400.0) < 20.0
+    assert 0.01 < r["set_area_fraction"] < 0.1

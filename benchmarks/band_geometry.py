@@ -1,0 +1,138 @@
+"""How long are the shear bands? (docs/physics.md §4, "The concentration in bands one element wide, and
+the widths both meshes resolve", forty-sixth session, rule BL.)
+
+Over the widths both meshes resolve, the 10 km months' rate falls less with the box width than the
+20 km months' at the same cohesion: their deformation cancels less between 24 and 92 km. One reading is
+that a finer mesh lets bands propagate further (an element at a band's tip averages the tip's stress
+concentration over a smaller size), so the shear gathers into fewer, longer bands. This script
+measures the bands' lengths.
+
+For each 3-day Lagrangian window of a run (the published windows: from day 1, every 3 days, the
+elements at least 100 km from the coast, :func:`lagice.diagnostics.windows.window_arrays`), it takes
+the elements that hold half of the window's shear (Σ ε̇II·A, as the half-shear area;
+:func:`band_persistence.band_set`) and groups them into bands: two elements of the set belong to the
+same band when they share a node. A band's length is √12 times the standard deviation of its
+elements' centroids along its main axis (area-weighted: a straight, uniform band of length ℓ gives
+ℓ), and at least its elements' mean size √(2A). Per window it reports the number of bands, the
+shear-weighted median band length (half of the set's shear lies in bands at least that long), the
+set's area fraction, and the bands' total length per 10⁴ km² of interior. A run's row is the median
+over its windows.
+
+    python benchmarks/band_geometry.py RUN [RUN ...] [--json PATH]   # runs in benchmarks/out/physics
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+from band_persistence import band_set
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from lagice.diagnostics.strain import lagrangian_velocity_gradients, shear_rate
+from lagice.diagnostics.windows import window_arrays, window_starts_days
+
+ROOT = Path(__file__).resolve().parents[1]
+RUNS = ROOT / "benchmarks" / "out" / "physics"
+DAY_S = 86400.0
+#: the published windows: 3 days from day 1, interior 100 km from the coast
+WINDOW_DAYS, START_DAY, BUFFER_M = 3.0, 1.0, 100e3
+ROW_KEYS = ("n_bands", "weighted_median_length_km", "set_area_fraction", "length_per_1e4_km2")
+
+
+def bands(triangles: np.ndarray, in_set: np.ndarray) -> tuple[int, np.ndarray]:
+    """Group the elements of ``in_set`` (mask over ``triangles``) into bands: elements sharing a
+    node are in one band. Returns (number of bands, band label per element of the set, in the
+    order of ``np.flatnonzero(in_set)``)."""
+    idx = np.flatnonzero(in_set)
+    if idx.size == 0:
+        return 0, np.zeros(0, np.int64)
+    tri = triangles[idx]
+    nodes, local = np.unique(tri.ravel(), return_inverse=True)
+    n_el = idx.size
+    # the element-node incidence as a bipartite graph: elements 0..n_el-1, nodes after them
+    rows = np.repeat(np.arange(n_el), 3)
+    cols = n_el + local
+    g = coo_matrix((np.ones(rows.size), (rows, cols)), shape=(n_el + nodes.size,) * 2)
+    n, labels = connected_components(g, directed=False)
+    el_labels = labels[:n_el]
+    _, el_labels = np.unique(el_labels, return_inverse=True)  # 0..k-1 over the bands
+    return int(el_labels.max()) + 1, el_labels
+
+
+def band_lengths(centroids: np.ndarray, area: np.ndarray, labels: np.ndarray, n_bands: int) -> np.ndarray:
+    """Length [m] of each band: √12 × the area-weighted standard deviation of its centroids along its
+    main axis, and at least its elements' mean size √(2A)."""
+    out = np.empty(n_bands)
+    for k in range(n_bands):  # bands, not elements: a few hundred per window at most
+        m = labels == k
+        w = area[m] / area[m].sum()
+        c = centroids[m]
+        d = c - w @ c
+        cov = (d * w[:, None]).T @ d
+        out[k] = max(np.sqrt(12.0 * np.linalg.eigvalsh(cov)[-1]), float(np.mean(np.sqrt(2.0 * area[m]))))
+    return out
+
+
+def weighted_median(values: np.ndarray, weights: np.ndarray) -> float:
+    """The value at which the weights of the values at or above it first reach half the total."""
+    order = np.argsort(-values, kind="stable")
+    cum = np.cumsum(weights[order])
+    return float(values[order][int(np.searchsorted(cum, 0.5 * cum[-1]))])
+
+
+def window_bands(xy0, xy1, triangles, dt_s) -> dict:
+    """The band measures of one window's elements (node positions at both ends, connectivity)."""
+    used = np.unique(triangles)
+    renum = np.full(xy0.shape[0], -1, np.int64)
+    renum[used] = np.arange(used.size)
+    t = renum[triangles]
+    g = lagrangian_velocity_gradients(xy0[used], xy1[used], t, dt_s)
+    shear = shear_rate(g.gradient_s)
+    in_set = band_set(shear, g.area_m2)
+    n, labels = bands(t, in_set)
+    a, c = g.area_m2[in_set], g.centroid_xy_m[in_set]
+    lengths = band_lengths(c, a, labels, n)
+    weight = np.bincount(labels, weights=shear[in_set] * a, minlength=n)
+    return {"n_bands": n, "weighted_median_length_km": weighted_median(lengths, weight) / 1e3,
+            "set_area_fraction": float(a.sum() / g.area_m2.sum()),
+            "length_per_1e4_km2": float(lengths.sum() / 1e3 / (g.area_m2.sum() / 1e10))}
+
+
+def run_bands(run_dir: Path) -> dict:
+    """Per-window band measures of a run and their medians over the windows."""
+    rows = []
+    for s0 in window_starts_days(run_dir, WINDOW_DAYS, START_DAY):
+        xy0, xy1, tri, dt, info = window_arrays(run_dir, s0 * DAY_S, (s0 + WINDOW_DAYS) * DAY_S, BUFFER_M)
+        rows.append({"start_day": float(s0), **window_bands(xy0, xy1, tri[info["interior"]], dt)})
+    return {"windows": rows, "median": {k: float(np.median([r[k] for r in rows])) for k in ROW_KEYS}}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("runs", nargs="+", help="run names in benchmarks/out/physics")
+    ap.add_argument("--json", type=Path, default=None, help="write the per-window values here")
+    args = ap.parse_args(argv)
+    missing = [r for r in args.runs if not (RUNS / r / "snapshots").is_dir()]
+    if missing:
+        raise SystemExit(f"band_geometry: no snapshots for {missing} in {RUNS}")
+    out = {}
+    print("| run | bands per window | shear-weighted median band length (km) | half-shear set's area | "
+          "band length per 10⁴ km² (km) |")
+    print("|---|---|---|---|---|")
+    for r in args.runs:
+        res = run_bands(RUNS / r)
+        out[r] = res
+        m = res["median"]
+        print(f"| {r} | {m['n_bands']:.0f} | {m['weighted_median_length_km']:.0f} | "
+              f"{100 * m['set_area_fraction']:.1f} % | {m['length_per_1e4_km2']:.0f} |", flush=True)
+    if args.json:
+        args.json.write_text(json.dumps(out, indent=1))
+        print(f"band_geometry: wrote {args.json}")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
