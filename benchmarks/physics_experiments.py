@@ -3283,6 +3283,17 @@ for _d in (0, 1):
 # the shear is thinner at 10 km (2.5-4.7 % of the area against 4.3-6.8 %), so a band one element wide may break into
 # beads where its slip dips; the measure cannot tell a bead from a segment.
 
+# Written 2026-11-30 11:07 UTC, before its analysis (no new runs; benchmarks/band_geometry.py --split): which part of
+# the deformation cancels less at 10 km? Each window's element gradients are split into the band set's (the elements
+# holding half of the shear; the others' gradients set to zero) and the background's (the reverse), and each part is
+# coarse-grained alone (the validation's boxes and estimator). Per run the pooled curves (geometric mean over the
+# windows, as beta_estimator.py) are fitted over the widths both meshes resolve (>= 20 km: 24, 47, 92 km). The eight
+# pairs of rule CO.
+# (BB)  the bands carry the difference if the band set's beta falls from 20 to 10 km by 0.03 or more in six or more
+#       pairs while the background's changes by less than 0.02 in six or more; the background carries it in the
+#       reverse case; otherwise neither alone.
+# Predicted: neither alone (both parts' beta fall by 0.02-0.05).
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
