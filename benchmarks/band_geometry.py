@@ -18,7 +18,13 @@ shear-weighted median band length (half of the set's shear lies in bands at leas
 set's area fraction, and the bands' total length per 10⁴ km² of interior. A run's row is the median
 over its windows.
 
-    python benchmarks/band_geometry.py RUN [RUN ...] [--json PATH]   # runs in benchmarks/out/physics
+``--split`` also coarse-grains two parts of each window's deformation alone (rule BB): the band
+set's (the other elements' gradients set to zero) and the background's (the reverse), with the
+validation's boxes and estimator (:func:`lagice.diagnostics.spatial_scaling`). Per run and part it
+pools ⟨ε̇tot⟩(L) over the windows (the geometric mean per width, as ``beta_estimator.py``) and fits
+β over the widths of 20 km and more, which a 20 km and a 10 km mesh both resolve.
+
+    python benchmarks/band_geometry.py RUN [RUN ...] [--split] [--json PATH]   # runs in benchmarks/out/physics
 """
 from __future__ import annotations
 
@@ -32,7 +38,8 @@ from band_persistence import band_set
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from lagice.diagnostics.strain import lagrangian_velocity_gradients, shear_rate
+from lagice.diagnostics.scaling import MIN_FIT_BOXES, fit_power_law, spatial_scaling
+from lagice.diagnostics.strain import ElementStrainRates, lagrangian_velocity_gradients, shear_rate
 from lagice.diagnostics.windows import window_arrays, window_starts_days
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -41,6 +48,9 @@ DAY_S = 86400.0
 #: the published windows: 3 days from day 1, interior 100 km from the coast
 WINDOW_DAYS, START_DAY, BUFFER_M = 3.0, 1.0, 100e3
 ROW_KEYS = ("n_bands", "weighted_median_length_km", "set_area_fraction", "length_per_1e4_km2")
+#: the narrowest box width [m] of the split's fit: widths a 20 km mesh resolves
+SPLIT_MIN_WIDTH_M = 20e3
+PARTS = ("whole", "bands", "background")
 
 
 def bands(triangles: np.ndarray, in_set: np.ndarray) -> tuple[int, np.ndarray]:
@@ -84,8 +94,32 @@ def weighted_median(values: np.ndarray, weights: np.ndarray) -> float:
     return float(values[order][int(np.searchsorted(cum, 0.5 * cum[-1]))])
 
 
-def window_bands(xy0, xy1, triangles, dt_s) -> dict:
-    """The band measures of one window's elements (node positions at both ends, connectivity)."""
+def part_curves(g: ElementStrainRates, in_set: np.ndarray) -> dict:
+    """⟨ε̇tot⟩(L) [s-1] by box width L [m] (widths with at least :data:`MIN_FIT_BOXES` boxes) of the
+    whole gradient, of the band set's alone and of the background's alone."""
+    out = {}
+    for part, keep in (("whole", None), ("bands", in_set), ("background", ~in_set)):
+        grad = g.gradient_s if keep is None else np.where(keep[:, None, None], g.gradient_s, 0.0)
+        sc = spatial_scaling(ElementStrainRates(grad, g.area_m2, g.centroid_xy_m, g.bounds_m),
+                             include_element_scale=False)
+        ok = np.isfinite(sc.coarse.mean_total_s) & (sc.coarse.n_boxes >= MIN_FIT_BOXES)
+        out[part] = {"width_m": sc.coarse.scale_m[ok].tolist(), "rate_s": sc.coarse.mean_total_s[ok].tolist()}
+    return out
+
+
+def pooled_beta(curves: list[dict], min_width_m: float = SPLIT_MIN_WIDTH_M) -> float:
+    """β of the windows' curves pooled (the geometric mean of ⟨ε̇tot⟩ per width, widths counted
+    from the widest every window has), fitted over the widths of at least ``min_width_m``."""
+    n = min(len(c["width_m"]) for c in curves)
+    w = np.array([c["width_m"][-n:] for c in curves]).mean(axis=0)
+    r = np.exp(np.log(np.array([c["rate_s"][-n:] for c in curves])).mean(axis=0))
+    k = w >= min_width_m
+    return float(fit_power_law(w[k], r[k]).exponent)
+
+
+def window_bands(xy0, xy1, triangles, dt_s, split: bool = False) -> dict:
+    """The band measures of one window's elements (node positions at both ends, connectivity);
+    with ``split`` also :func:`part_curves` (under ``"curves"``)."""
     used = np.unique(triangles)
     renum = np.full(xy0.shape[0], -1, np.int64)
     renum[used] = np.arange(used.size)
@@ -97,38 +131,50 @@ def window_bands(xy0, xy1, triangles, dt_s) -> dict:
     a, c = g.area_m2[in_set], g.centroid_xy_m[in_set]
     lengths = band_lengths(c, a, labels, n)
     weight = np.bincount(labels, weights=shear[in_set] * a, minlength=n)
-    return {"n_bands": n, "weighted_median_length_km": weighted_median(lengths, weight) / 1e3,
-            "set_area_fraction": float(a.sum() / g.area_m2.sum()),
-            "length_per_1e4_km2": float(lengths.sum() / 1e3 / (g.area_m2.sum() / 1e10))}
+    out = {"n_bands": n, "weighted_median_length_km": weighted_median(lengths, weight) / 1e3,
+           "set_area_fraction": float(a.sum() / g.area_m2.sum()),
+           "length_per_1e4_km2": float(lengths.sum() / 1e3 / (g.area_m2.sum() / 1e10))}
+    if split:
+        out["curves"] = part_curves(g, in_set)
+    return out
 
 
-def run_bands(run_dir: Path) -> dict:
-    """Per-window band measures of a run and their medians over the windows."""
+def run_bands(run_dir: Path, split: bool = False) -> dict:
+    """Per-window band measures of a run and their medians over the windows; with ``split`` also
+    each part's pooled β over the widths of :data:`SPLIT_MIN_WIDTH_M` and more (``"split_beta"``)."""
     rows = []
     for s0 in window_starts_days(run_dir, WINDOW_DAYS, START_DAY):
         xy0, xy1, tri, dt, info = window_arrays(run_dir, s0 * DAY_S, (s0 + WINDOW_DAYS) * DAY_S, BUFFER_M)
-        rows.append({"start_day": float(s0), **window_bands(xy0, xy1, tri[info["interior"]], dt)})
-    return {"windows": rows, "median": {k: float(np.median([r[k] for r in rows])) for k in ROW_KEYS}}
+        rows.append({"start_day": float(s0), **window_bands(xy0, xy1, tri[info["interior"]], dt, split)})
+    res = {"windows": rows, "median": {k: float(np.median([r[k] for r in rows])) for k in ROW_KEYS}}
+    if split:
+        res["split_beta"] = {p: pooled_beta([r["curves"][p] for r in rows]) for p in PARTS}
+    return res
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("runs", nargs="+", help="run names in benchmarks/out/physics")
+    ap.add_argument("--split", action="store_true", help="also β of the band set's and the background's "
+                    "deformation alone, over the widths of 20 km and more (rule BB)")
     ap.add_argument("--json", type=Path, default=None, help="write the per-window values here")
     args = ap.parse_args(argv)
     missing = [r for r in args.runs if not (RUNS / r / "snapshots").is_dir()]
     if missing:
         raise SystemExit(f"band_geometry: no snapshots for {missing} in {RUNS}")
     out = {}
+    split = " β ≥ 20 km: whole / bands / background |" if args.split else ""
     print("| run | bands per window | shear-weighted median band length (km) | half-shear set's area | "
-          "band length per 10⁴ km² (km) |")
-    print("|---|---|---|---|---|")
+          f"band length per 10⁴ km² (km) |{split}")
+    print("|---|---|---|---|---|" + ("---|" if args.split else ""))
     for r in args.runs:
-        res = run_bands(RUNS / r)
+        res = run_bands(RUNS / r, args.split)
         out[r] = res
         m = res["median"]
+        betas = " / ".join(f"{res['split_beta'][p]:.3f}" for p in PARTS) if args.split else ""
+        cells = f" {betas} |" if args.split else ""
         print(f"| {r} | {m['n_bands']:.0f} | {m['weighted_median_length_km']:.0f} | "
-              f"{100 * m['set_area_fraction']:.1f} % | {m['length_per_1e4_km2']:.0f} |", flush=True)
+              f"{100 * m['set_area_fraction']:.1f} % | {m['length_per_1e4_km2']:.0f} |{cells}", flush=True)
     if args.json:
         args.json.write_text(json.dumps(out, indent=1))
         print(f"band_geometry: wrote {args.json}")

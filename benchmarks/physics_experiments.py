@@ -3293,6 +3293,15 @@ for _d in (0, 1):
 #       pairs while the background's changes by less than 0.02 in six or more; the background carries it in the
 #       reverse case; otherwise neither alone.
 # Predicted: neither alone (both parts' beta fall by 0.02-0.05).
+# Result (BB) (2026-11-30, 11:08 UTC): neither part alone, as predicted; the prediction was wrong on the sizes. Pooled
+# beta over widths >= 20 km (band_geometry.py --split), 20 -> 10 km, band set / background: MC10 0.151 -> 0.083 /
+# 0.155 -> 0.168, MW 2027 0.058 -> 0.038 / 0.178 -> 0.092, MW 2031 0.155 -> 0.048 / 0.133 -> 0.104, DS d1 0.137 ->
+# 0.051 / 0.144 -> 0.106, CB 0.108 -> 0.139 / 0.212 -> 0.137, FX 0.091 -> 0.034 / 0.138 -> 0.111, CS 0.263 -> 0.054 /
+# 0.182 -> 0.095, CS d1 0.192 -> 0.066 / 0.171 -> 0.155. The band set's beta falls by 0.03 or more in six pairs
+# (0.057-0.209), the background's changes by less than 0.02 in two (it falls by 0.027-0.087 in five, rises 0.013 in
+# one). At 10 km the band set's own deformation hardly cancels between 24 and 92 km (beta 0.034-0.066, CB 0.139): its
+# more numerous, shorter bands (rule BL) slip together. The crack band (CB) is the one pair whose 10 km bands cancel
+# more than its 20 km bands.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",

@@ -1001,3 +1001,10 @@ def test_band_geometry_groups_bands_by_shared_nodes_and_measures_their_length():
     assert r["n_bands"] == 1
     assert abs(r["weighted_median_length_km"] - 400.0) < 20.0
     assert 0.01 < r["set_area_fraction"] < 0.1
+    # the split (rule BB): a simple shear of one sense everywhere does not cancel, so at every box
+    # width the whole rate is the band set's plus the background's, and the band set's is the larger
+    r = window_bands(xy, xy1, tri, 3 * day, split=True)
+    c = r["curves"]
+    assert c["whole"]["width_m"] == c["bands"]["width_m"] == c["background"]["width_m"]
+    whole, bands_, back = (np.array(c[p]["rate_s"]) for p in ("whole", "bands", "background"))
+    assert np.allclose(whole, bands_ + back, rtol=1e-9) and np.all(bands_ > back)
