@@ -3302,7 +3302,7 @@ for _d in (0, 1):
 # one). At 10 km the band set's own deformation hardly cancels between 24 and 92 km (beta 0.034-0.066, CB 0.139): its
 # more numerous, shorter bands (rule BL) slip together. The crack band (CB) is the one pair whose 10 km bands cancel
 # more than its 20 km bands.
-# (2026-11-30, 11:11 UTC) The split's whole beta differs from beta_estimator.py's pooled fit over the same widths by
+# (2026-11-30, 11:09 UTC) The split's whole beta differs from beta_estimator.py's pooled fit over the same widths by
 # 0.001-0.035 (its boxes are laid from another origin): falls of 0.03 or less over three widths are within that.
 
 def command(scene, overrides, res, days, out) -> list:
