@@ -3305,6 +3305,32 @@ for _d in (0, 1):
 # (2026-11-30, 11:09 UTC) The split's whole beta differs from beta_estimator.py's pooled fit over the same widths by
 # 0.001-0.035 (its boxes are laid from another origin): falls of 0.03 or less over three widths are within that.
 
+# Written 2026-11-30 11:09 UTC, before its runs: does a band that slips as a band of fixed width keep beta from 20 to
+# 10 km at the same cohesion? Rule BB found the fall mostly in the band set, whose 10 km bands slip together; the
+# crack band (rule CB: each element's relaxation time x dx / l, so a band one element wide slips at a given stress as
+# a band l wide) was the one change whose 10 km bands cancelled as the 20 km ones did, but that pair was not at the
+# same cohesion in pascals (the 10 km month 1.41 times stronger). Rule DS's months (wind seed 2031, the same spin-up
+# states and draws) made again with rheology.crack_band_length_m = 20 km at both sizes (at 20 km the factor is each
+# element's size over 20 km, near 1): 20 km draws 0-3, 10 km draws 0-1.
+# (CW)  the crack band keeps beta if the gap between the pooled ratios of the rate at 12 km to the rate at 92-93 km
+#       (the lowest 20 km draw's minus the highest 10 km draw's; 0.08 without it) is below 0.03; it fails if the gap
+#       is 0.06 or more; between the two it decides neither way.
+# (CWL) the same at l = 40 km (bands slip twice as easily on both meshes), 20 km draws 0-1 and 10 km draw 0, reported
+#       beside CW: beta rises on both meshes over CW's if each l = 40 km month's beta over widths >= 10 km is at least
+#       0.02 above the same draw's with l = 20 km.
+# Predicted: CW decides neither way (gap 0.03-0.06); CWL: beta rises on both meshes.
+for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,))):
+    for _d in _draws20:
+        _base = "B20-hthick-eng-P-C4-m20-w2031" + (f"-d{_d}" if _d else "")
+        add_variant(f"{_base}-cb{_ell}", _base, [f"rheology.crack_band_length_m={_ell}e3"],
+                    f"20 km: eng-P-C4 in the weather of wind seed 2031, strength disorder of run seed {_d}, the "
+                    f"relaxation time x dx / {_ell} km (a diagnostic)")
+    for _d in _draws10:
+        _base = "F10-hthick-eng-P-C283-w2031" + (f"-d{_d}" if _d else "")
+        add_variant(f"{_base}-cb{_ell}", _base, [f"rheology.crack_band_length_m={_ell}e3"],
+                    f"eng-P at eng-P-C4-m20's cohesion in the weather of wind seed 2031, strength disorder of run "
+                    f"seed {_d}, the relaxation time x dx / {_ell} km (a diagnostic)")
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
