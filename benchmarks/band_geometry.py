@@ -120,11 +120,10 @@ def pooled_beta(curves: list[dict], min_width_m: float = SPLIT_MIN_WIDTH_M) -> f
 def window_bands(xy0, xy1, triangles, dt_s, split: bool = False) -> dict:
     """The band measures of one window's elements (node positions at both ends, connectivity);
     with ``split`` also :func:`part_curves` (under ``"curves"``)."""
-    used = np.unique(triangles)
-    renum = np.full(xy0.shape[0], -1, np.int64)
-    renum[used] = np.arange(used.size)
-    t = renum[triangles]
-    g = lagrangian_velocity_gradients(xy0[used], xy1[used], t, dt_s)
+    # every node, as the validation's summarise takes them: the boxes are laid from the corner of the
+    # whole mesh's mid-window bounds, so the split's "whole" is the published coarse-graining
+    t = triangles
+    g = lagrangian_velocity_gradients(xy0, xy1, t, dt_s)
     shear = shear_rate(g.gradient_s)
     in_set = band_set(shear, g.area_m2)
     n, labels = bands(t, in_set)
