@@ -3304,7 +3304,7 @@ for _d in (0, 1):
 # more than its 20 km bands.
 # (2026-11-30, 11:09 UTC) The split's whole beta differs from beta_estimator.py's pooled fit over the same widths by
 # 0.001-0.035 (its boxes are laid from another origin): falls of 0.03 or less over three widths are within that.
-# (2026-11-30, 11:12 UTC) Corrected: the analysis above laid the boxes from the corner of the interior's nodes, not the
+# (2026-11-30, 11:11 UTC) Corrected: the analysis above laid the boxes from the corner of the interior's nodes, not the
 # validation's (the whole mesh's), so it was not "the validation's boxes" the rule named. Made again with the
 # validation's origin (band_geometry.py now passes every node, as summarise does; its whole beta is then
 # beta_estimator.py's to the third decimal), band set / background, 20 -> 10 km: MC10 0.159 -> 0.038 / 0.161 -> 0.167,
