@@ -3339,6 +3339,14 @@ for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,)))
         add_variant(f"{_base}-cb{_ell}", _base, [f"rheology.crack_band_length_m={_ell}e3"],
                     f"eng-P at eng-P-C4-m20's cohesion in the weather of wind seed 2031, strength disorder of run "
                     f"seed {_d}, the relaxation time x dx / {_ell} km (a diagnostic)")
+# Result (CW, CWL) (2026-11-30, 11:32 UTC): both fail; the predictions were wrong on both. CW: the pooled ratio of the
+# rate at 12 km to the rate at 92-93 km is 1.33-1.41 in the four 20 km draws and 1.20-1.25 in the two 10 km draws (gap
+# 0.083; 0.08 without the crack band). beta over widths >= 10 km: 20 km 0.158 / 0.178 / 0.146 / 0.151 (draws 0-3;
+# without it 0.145 / 0.118 / 0.155 / 0.139), 10 km 0.101 / 0.109 (0.095 / 0.068). Rate at 92-93 km 0.0087-0.0108 /
+# 0.0096-0.0100 per day, wind factor 0.0078-0.0090 / 0.0089-0.0100. CWL (l = 40 km) against l = 20 km, the same draw:
+# 20 km 0.133 against 0.158 and 0.150 against 0.178 (beta falls), 10 km 0.119 against 0.101 (rises 0.018). 20 km months:
+# tails 2.5-4.7 / 1.3-3.2, half-shear area 3.7-5.2 %, R2 0.64-0.71; 10 km months: half-shear area 2.6-3.0 %, 631-700
+# remeshes, 529-555 s each. A band that slips as a band of fixed width leaves beta's fall where it was.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
