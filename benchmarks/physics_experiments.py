@@ -3348,6 +3348,17 @@ for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,)))
 # tails 2.5-4.7 / 1.3-3.2, half-shear area 3.7-5.2 %, R2 0.64-0.71; 10 km months: half-shear area 2.6-3.0 %, 631-700
 # remeshes, 529-555 s each. A band that slips as a band of fixed width leaves beta's fall where it was.
 
+# Written 2026-11-30 11:35 UTC, before its analysis (no new runs; beta_estimator.py --origins): how much does the
+# published beta move with where the boxes are laid? The validation lays its box grid from the lower-left corner of
+# the window's mesh; rule BB found that over three widths the fit moves by up to 0.035 with another corner. Here the
+# grid is shifted by eight seeded random offsets in [0, 92 km) in x and y (the widest fitted width), each window's beta
+# fitted as the validation does (widths with >= 10 boxes, the element scale included), and the median over the
+# windows taken per offset. Runs: the flagship's validation month (F10-hthick-m10, F10s-hthick-m10), and the energy
+# family's F10-hthick-eng-P-C3, B20-hthick-eng-P-C3-m20, F10-hthick-eng-P-C283-w2031, B20-hthick-eng-P-C4-m20-w2031.
+# (OR)  the published beta is robust to the box origin if, in every run, the eight offsets' medians span less than
+#       0.01; otherwise the span is the estimator's own uncertainty, to be reported beside every beta difference.
+# Predicted: not robust; spans of 0.01-0.03, larger at 20 km (fewer boxes per width).
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
