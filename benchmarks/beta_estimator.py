@@ -16,6 +16,12 @@ over the windows of:
 * the widest width used with 10 boxes, and the ratio of the element-scale ⟨ε̇tot⟩ to the
   ⟨ε̇tot⟩ at that width (observed: about 2 between 10 and 300 km, from β ≈ 0.2).
 
+``--origins N`` also fits each window's β as the validation does with the box grid laid from N
+seeded random offsets of its corner (uniform in [0, 92 km) in x and y, the widest width fitted in the
+basin) besides the validation's own corner, and prints per run the spread of the window medians over
+those grids: how much β moves with where the boxes fall, an uncertainty of the estimator itself
+(docs/physics.md §4, rule OR).
+
     python benchmarks/beta_estimator.py F10 F10x2 ...   # runs in benchmarks/out/physics
     python benchmarks/beta_estimator.py                  # the default list below
     python benchmarks/beta_estimator.py RUN ... --figure docs/figures/NAME.png  # and the pooled curves
@@ -31,8 +37,9 @@ from pathlib import Path
 
 import numpy as np
 
-from lagice.diagnostics.scaling import MIN_FIT_BOXES, fit_power_law
-from lagice.diagnostics.windows import window_starts_days, window_summary
+from lagice.diagnostics.scaling import MIN_FIT_BOXES, fit_power_law, spatial_scaling
+from lagice.diagnostics.strain import lagrangian_velocity_gradients
+from lagice.diagnostics.windows import window_arrays, window_starts_days, window_summary
 
 ROOT = Path(__file__).resolve().parents[1]
 RUNS = ROOT / "benchmarks" / "out" / "physics"
@@ -77,6 +84,30 @@ def run_estimates(run_dir: Path, window_days: float = 3.0, start_day: float = 1.
             "curve": pooled_curve(rows)}
 
 
+#: the range [m] of the --origins offsets of the box grid's corner: the widest width fitted in the basin
+ORIGIN_RANGE_M = 92e3
+
+
+def origin_spread(run_dir: Path, n_origins: int, seed: int = 0, window_days: float = 3.0, start_day: float = 1.0,
+                  coast_buffer_m: float = 100e3) -> dict:
+    """Window-median β (the validation's estimator: widths with at least :data:`MIN_FIT_BOXES` boxes,
+    the element scale included) with the box grid laid from the validation's corner (the mesh's
+    mid-window bounds) and from ``n_origins`` seeded offsets of it, uniform in [0,
+    :data:`ORIGIN_RANGE_M`) in x and y. Returns the offsets [m], the medians per grid (the validation's
+    first) and their span."""
+    rng = np.random.default_rng(seed)
+    offsets = np.vstack([[0.0, 0.0], rng.uniform(0.0, ORIGIN_RANGE_M, size=(n_origins, 2))])
+    per_window = []
+    for s0 in window_starts_days(run_dir, window_days, start_day):
+        xy0, xy1, tri, dt, info = window_arrays(run_dir, s0 * DAY_S, (s0 + window_days) * DAY_S, coast_buffer_m)
+        rates = lagrangian_velocity_gradients(xy0, xy1, tri[info["interior"]], dt)
+        corner = rates.bounds_m[:2]
+        per_window.append([spatial_scaling(rates, origin_xy_m=corner - off).fit.exponent for off in offsets])
+    medians = np.median(np.asarray(per_window), axis=0)
+    return {"offsets_m": offsets.tolist(), "median_beta": medians.tolist(),
+            "span": float(medians.max() - medians.min())}
+
+
 def pooled_curve(rows: list) -> dict:
     """⟨ε̇tot⟩(L) pooled over the windows: per box width (counted from the widest with at least
     10 boxes, so that every window has it), the mean width [km] and the geometric mean over the
@@ -99,7 +130,12 @@ def main(argv=None):
     ap.add_argument("--absolute", action="store_true",
                     help="with --figure: draw ⟨ε̇tot⟩(L) itself [day⁻¹], not divided by its widest value, to "
                          "compare the rates of runs at each width")
+    ap.add_argument("--origins", type=int, default=0, metavar="N",
+                    help="also the window-median β with the box grid laid from N seeded random offsets of its "
+                         "corner, and its spread (rule OR)")
     args = ap.parse_args(argv)
+    if args.origins < 0:
+        raise SystemExit(f"beta_estimator: --origins {args.origins}: expected a number of offsets >= 0")
     missing = [r for r in args.runs if not (RUNS / r / "snapshots").is_dir()]
     if missing:
         raise SystemExit(f"beta_estimator: no finished run for {', '.join(missing)} in {RUNS} "
@@ -121,6 +157,17 @@ def main(argv=None):
     for name in args.runs:
         c = out[name]["curve"]
         print(f"  {name}: " + ", ".join(f"{w:.0f} km {r:.4f}" for w, r in zip(c["width_km"], c["rate_per_day"])))
+    if args.origins:
+        print(f"\nβ (window median, ≥ {MIN_FIT_BOXES} boxes) with the box grid laid from the validation's corner "
+              f"and from {args.origins} offsets of it:")
+        print("| run | validation's corner | offsets: min – max | span |")
+        print("|---|---|---|---|")
+        for name in args.runs:
+            o = origin_spread(RUNS / name, args.origins)
+            out[name]["origin_spread"] = o
+            b = o["median_beta"]
+            print(f"| {name} | {b[0]:.3f} | {min(b[1:]):.3f} – {max(b[1:]):.3f} | {o['span']:.3f} |", flush=True)
+        args.json.write_text(json.dumps(out, indent=1, allow_nan=True) + "\n")
     print(f"beta_estimator: wrote {args.json}", file=sys.stderr)
     if args.figure is not None:
         figure_curves({name: out[name]["curve"] for name in args.runs}, args.figure, absolute=args.absolute)

@@ -1008,3 +1008,41 @@ def test_band_geometry_groups_bands_by_shared_nodes_and_measures_their_length():
     assert c["whole"]["width_m"] == c["bands"]["width_m"] == c["background"]["width_m"]
     whole, bands_, back = (np.array(c[p]["rate_s"]) for p in ("whole", "bands", "background"))
     assert np.allclose(whole, bands_ + back, rtol=1e-9) and np.all(bands_ > back)
+
+
+def test_beta_origin_spread_starts_from_the_validations_grid_and_moves_it(tmp_path):
+    """beta_estimator.origin_spread on a real run (a prescribed shear layer, daily snapshots): the
+    first grid is the validation's own (its window median is window_summary's β to round-off), the
+    offsets move the grid within [0, 92 km), and the fit moves with where the boxes fall."""
+    from beta_estimator import ORIGIN_RANGE_M, origin_spread
+
+    from lagice.diagnostics.windows import window_starts_days, window_summary
+    from lagice.lagrangian import MeshMotion
+    from lagice.mesh import generate_mesh, rectangle_domain
+    from lagice.model import Model
+    from lagice.simulation import Simulation
+    from lagice.solvers import PrescribedStepper
+    from lagice.state import IceState
+
+    poly, _ = rectangle_domain(600e3, 600e3)
+    mesh = generate_mesh(poly, 20e3, exterior_tag="free")
+
+    def velocity(t, x, y):
+        return 0.02 * np.tanh((y - 310e3) / 15e3), 0.0 * x
+
+    st = IceState.uniform(mesh, thickness_m=1.0, concentration=1.0, cohesion_pa=1e9)
+    sim = Simulation(Model(st, solver=PrescribedStepper(mesh=mesh, velocity=velocity), mover=MeshMotion()), dt="3h",
+                     stop="4d", progress=False)
+    sim.output(every="1d", path=tmp_path / "run" / "snapshots", crs=None)
+    sim.run()
+    o = origin_spread(tmp_path / "run", 3, window_days=3.0, start_day=1.0, coast_buffer_m=100e3)
+    off = np.asarray(o["offsets_m"])
+    assert off.shape == (4, 2) and np.all(off[0] == 0) and np.all((off[1:] >= 0) & (off[1:] < ORIGIN_RANGE_M))
+    (s0,) = window_starts_days(tmp_path / "run", 3.0, 1.0)
+    published = window_summary(tmp_path / "run", s0 * 86400.0, 3 * 86400.0, 100e3)["interior"]["beta_space"]
+    assert o["median_beta"][0] == pytest.approx(published, abs=1e-12)
+    # one straight band of one sense: a box's rate is the band's slip over the box's width, and the
+    # share of boxes that hold it grows with the width, so the mean does not cancel (β near 0)
+    assert abs(o["median_beta"][0]) < 0.1
+    assert o["span"] == pytest.approx(max(o["median_beta"]) - min(o["median_beta"]))
+    assert o["span"] > 1e-3  # where the boxes fall against the band moves the fit
