@@ -3358,6 +3358,15 @@ for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,)))
 # (OR)  the published beta is robust to the box origin if, in every run, the eight offsets' medians span less than
 #       0.01; otherwise the span is the estimator's own uncertainty, to be reported beside every beta difference.
 # Predicted: not robust; spans of 0.01-0.03, larger at 20 km (fewer boxes per width).
+# Result (OR) (2026-11-30, 11:48 UTC): not robust, as predicted; the prediction was wrong on the sizes and on where the
+# span is largest. Window-median beta, the validation's grid / the eight offsets' range / span: F10-hthick-m10 0.082 /
+# 0.032-0.067 / 0.050, F10s-hthick-m10 0.035 / 0.024-0.069 / 0.045, F10-hthick-eng-P-C3 0.102 / 0.082-0.105 / 0.023,
+# B20-hthick-eng-P-C3-m20 0.142 / 0.138-0.162 / 0.025, F10-hthick-eng-P-C283-w2031 0.090 / 0.068-0.109 / 0.040,
+# B20-hthick-eng-P-C4-m20-w2031 0.145 / 0.099-0.147 / 0.048. The mean over the nine grids (standard deviation):
+# 0.059 (0.014), 0.040 (0.015), 0.093 (0.009), 0.147 (0.008), 0.088 (0.013), 0.124 (0.018). The flagship's two
+# validation months were made again for this (benchmarks/out/physics was missing them): every published window
+# statistic came out the same (the records differ only in wall time and in the commit now named); the published
+# records were kept as they were.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
