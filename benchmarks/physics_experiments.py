@@ -3368,6 +3368,14 @@ for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,)))
 # statistic came out the same (the records differ only in wall time and in the commit now named); the published
 # records were kept as they were.
 
+# Written 2026-11-30 11:59 UTC, before its analysis (no new runs): does beta's fall at the same cohesion survive the box
+# grid's spread (rule OR)? Each month of rules DS (c* = 20, no crack band), CS (c* = 0) and CW (crack band l = 20 km),
+# wind seed 2031, 20 km draws 0-3 and 10 km draws 0-1, gets its mean window-median beta over the nine grids of
+# beta_estimator.py --origins 8.
+# (OM)  the fall survives in a set if its lowest 20 km draw's nine-grid mean lies 0.02 or more above its highest 10 km
+#       draw's; it does not if some 10 km draw's mean lies at or above some 20 km draw's.
+# Predicted: it survives in all three sets.
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
