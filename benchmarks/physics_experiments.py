@@ -3380,7 +3380,8 @@ for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,)))
 # 0.124, 0.104, 0.121, 0.112 / 0.088, 0.091 (gap 0.013); CS 0.158, 0.148, 0.164, 0.166 / 0.118, 0.116 (gap 0.030); CW
 # 0.140, 0.131, 0.140, 0.130 / 0.103, 0.126 (gap 0.004). In every set every 10 km draw lies below every 20 km draw (24
 # pairs of 24), and the means of the draws fall by 0.026 (DS), 0.042 (CS) and 0.021 (CW): the fall is there, and about
-# half what the validation's grid alone showed (0.04-0.07). The eighteen months' spans over the nine grids: 0.031-0.076.
+# half what the validation's grid alone showed (0.044-0.058). The eighteen months' spans over the nine grids: 0.031-
+# 0.076.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
