@@ -35,6 +35,7 @@ from pathlib import Path
 
 import numpy as np
 from band_persistence import band_set
+from beta_estimator import pool_curves
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
@@ -110,9 +111,7 @@ def part_curves(g: ElementStrainRates, in_set: np.ndarray) -> dict:
 def pooled_beta(curves: list[dict], min_width_m: float = SPLIT_MIN_WIDTH_M) -> float:
     """β of the windows' curves pooled (the geometric mean of ⟨ε̇tot⟩ per width, widths counted
     from the widest every window has), fitted over the widths of at least ``min_width_m``."""
-    n = min(len(c["width_m"]) for c in curves)
-    w = np.array([c["width_m"][-n:] for c in curves]).mean(axis=0)
-    r = np.exp(np.log(np.array([c["rate_s"][-n:] for c in curves])).mean(axis=0))
+    w, r = pool_curves([c["width_m"] for c in curves], [c["rate_s"] for c in curves])
     k = w >= min_width_m
     return float(fit_power_law(w[k], r[k]).exponent)
 

@@ -113,11 +113,18 @@ def pooled_curve(rows: list) -> dict:
     10 boxes, so that every window has it), the mean width [km] and the geometric mean over the
     windows of ⟨ε̇tot⟩ [day⁻¹]. The ratio of two widths' values is the window-mean of the ratio on
     a log scale, so the slope between them is the windows' mean local β."""
-    n = min(len(r["rate_per_day_by_width"]) for r in rows)
-    widths = np.array([r["fit_widths_km"][-n:] for r in rows])
-    rates = np.array([r["rate_per_day_by_width"][-n:] for r in rows])
-    return {"width_km": [float(x) for x in widths.mean(axis=0)],
-            "rate_per_day": [float(x) for x in np.exp(np.log(rates).mean(axis=0))]}
+    widths, rates = pool_curves([r["fit_widths_km"] for r in rows], [r["rate_per_day_by_width"] for r in rows])
+    return {"width_km": [float(x) for x in widths], "rate_per_day": [float(x) for x in rates]}
+
+
+def pool_curves(widths: list, rates: list) -> tuple[np.ndarray, np.ndarray]:
+    """Curves ⟨ε̇tot⟩(L) of several windows (each a list of widths, narrowest first, and its rates)
+    pooled: the widths counted from the widest that every window has, their mean, and the geometric
+    mean of the rates per width."""
+    n = min(len(r) for r in rates)
+    w = np.array([x[-n:] for x in widths], dtype=np.float64)
+    r = np.array([x[-n:] for x in rates], dtype=np.float64)
+    return w.mean(axis=0), np.exp(np.log(r).mean(axis=0))
 
 
 def main(argv=None):
