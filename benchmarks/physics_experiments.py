@@ -3383,6 +3383,19 @@ for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,)))
 # half what the validation's grid alone showed (0.044-0.058). The eighteen months' spans over the nine grids: 0.031-
 # 0.076.
 
+# Written 2026-11-30 12:27 UTC, before its analysis (no new runs): rules OR and OM took, per box grid, the median of the
+# windows' beta and then the mean over the nine grids. The validation now reports (lagice.diagnostics.grid_averaged_beta,
+# window key beta_space_grid_mean) the other order: each window's beta is averaged over nine grids first (the default
+# corner and eight seeded offsets in [0, W_max) of the widest fitted box width), then the median over the windows is
+# taken. In the flagship's closed month the windows split into four near-locked ones (beta -0.002-0.029 on the default
+# grid) and five active ones (0.082-0.165), so a median of nine sits at that gap and a grid can flip it.
+# (GM)  the two orders agree if, in every run of rules OR and OM (the six months of OR; DS, CS, CW: 20 km draws 0-3,
+#       10 km draws 0-1), the window-median of the grid means lies within 0.01 of the grid-mean of the window medians.
+# (GF)  with the new order, the fall at the same cohesion survives in a set if its lowest 20 km draw lies 0.02 or more
+#       above its highest 10 km draw; it does not if some 10 km draw lies at or above some 20 km draw.
+# Predicted: GM fails for the flagship months (the median at the gap moves up to the active windows) and holds for the
+# energy family's months, whose windows are all active; GF as rule OM (survives in CS only).
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
