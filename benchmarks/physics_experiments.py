@@ -3384,11 +3384,12 @@ for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,)))
 # 0.076.
 
 # Written 2026-11-30 12:27 UTC, before its analysis (no new runs): rules OR and OM took, per box grid, the median of the
-# windows' beta and then the mean over the nine grids. The validation now reports (lagice.diagnostics.grid_averaged_beta,
-# window key beta_space_grid_mean) the other order: each window's beta is averaged over nine grids first (the default
-# corner and eight seeded offsets in [0, W_max) of the widest fitted box width), then the median over the windows is
-# taken. In the flagship's closed month the windows split into four near-locked ones (beta -0.002-0.029 on the default
-# grid) and five active ones (0.082-0.165), so a median of nine sits at that gap and a grid can flip it.
+# windows' beta and then the mean over the nine grids. The validation now reports
+# (lagice.diagnostics.grid_averaged_beta, window key beta_space_grid_mean) the other order: each window's beta is
+# averaged over nine grids first (the default corner and eight seeded offsets in [0, W_max) of the widest fitted box
+# width), then the median over the windows is taken. In the flagship's closed month the windows split into four
+# near-locked ones (beta -0.002-0.029 on the default grid) and five active ones (0.082-0.165), so a median of nine sits
+# at that gap and a grid can flip it.
 # (GM)  the two orders agree if, in every run of rules OR and OM (the six months of OR; DS, CS, CW: 20 km draws 0-3,
 #       10 km draws 0-1), the window-median of the grid means lies within 0.01 of the grid-mean of the window medians.
 # (GF)  with the new order, the fall at the same cohesion survives in a set if its lowest 20 km draw lies 0.02 or more

@@ -91,6 +91,11 @@ TARGETS = {
     "mean_total_deformation_rate_per_day": (0.01, 0.05, "RGPS winter, 10 km, 3 days: about 0.01–0.05 day⁻¹ "
                                             "(Girard 2010 ch. 2)", "band from the issue"),
 }
+#: β over nine box grids laid from different corners (lagice.diagnostics.grid_averaged_beta; a
+#: window's β moves by 0.01-0.05 with the grid): reported next to β against β's band, not counted
+#: among the six bands, so that the published count keeps its meaning
+GRID_BETA = "beta_space_grid_mean"
+GRID_BETA_LABEL = "β, mean over 9 box grids (not counted)"
 #: metrics window_statistics computes (the rate is its mean_total_s, converted to day⁻¹)
 WINDOW_TARGETS = tuple(k for k in TARGETS if k != "mean_total_deformation_rate_per_day")
 LABELS = {
@@ -786,6 +791,11 @@ def _basin_section(scene: str, b: dict, res: dict, figs: list[Path]) -> list[str
                  for r in keys]
         lines.append(f"| {LABELS[k]} | {src} | {band} ({note}) | " + " | ".join(cells) + " | "
                      + " | ".join(_inside(k, b[r]["median"][k]) for r in keys) + " |")
+        if k == "beta_space" and all(b[r]["median"].get(GRID_BETA) is not None for r in keys):
+            cells = [f"{_fmt(k, b[r]['median'][GRID_BETA])} [{_fmt(k, b[r]['min'][GRID_BETA])}, "
+                     f"{_fmt(k, b[r]['max'][GRID_BETA])}]" for r in keys]
+            lines.append(f"| {GRID_BETA_LABEL} | as β | {band} | " + " | ".join(cells) + " | "
+                         + " | ".join(_inside(k, b[r]["median"][GRID_BETA]) for r in keys) + " |")
     lines.append("")
     for r in keys:
         x = b[r]
@@ -809,14 +819,14 @@ def _basin_section(scene: str, b: dict, res: dict, figs: list[Path]) -> list[str
     for k in TARGETS:
         lines.append(f"| {LABELS[k]} | " + " | ".join(_fmt(k, b[r]['median_all_elements'][k]) for r in keys) + " |")
     lines += ["", "Per window (elements away from the coast; elements of remeshed patches left out):", "",
-              "| rheology | days | elements (left out) | β | tail shear | tail \\|div\\| | half-shear area | R² | "
-              "⟨ε̇tot⟩ (day⁻¹) |", "|---|---|---|---|---|---|---|---|---|"]
+              "| rheology | days | elements (left out) | β | β, 9 grids (sd) | tail shear | tail \\|div\\| | "
+              "half-shear area | R² | ⟨ε̇tot⟩ (day⁻¹) |", "|---|---|---|---|---|---|---|---|---|---|"]
     for key in keys:
         for w in b[key]["windows"]:
             i = w["interior"]
             lines.append(f"| {RHEOLOGIES[key]['label']} | {w['start_day']:.0f}–{w['end_day']:.0f} | "
                          f"{w['n_elements']} ({w['n_elements_lost']}) | {i['beta_space']:.3f} ± "
-                         f"{i['beta_space_stderr']:.3f} | {i['pdf_tail_exponent_shear']:.2f} "
+                         f"{i['beta_space_stderr']:.3f} | {_grid_beta_cell(i)} | {i['pdf_tail_exponent_shear']:.2f} "
                          f"(n={i['pdf_tail_n_shear']}) | "
                          f"{i['pdf_tail_exponent_divergence']:.2f} (n={i['pdf_tail_n_divergence']}) | "
                          f"{100 * i['localisation_half_shear_area_fraction']:.1f} % | "
@@ -825,6 +835,12 @@ def _basin_section(scene: str, b: dict, res: dict, figs: list[Path]) -> list[str
     for p in figs:
         lines += [f"![{p.stem}](figures/{p.name})", ""]
     return lines
+
+
+def _grid_beta_cell(i: dict) -> str:
+    """A window's β over nine box grids and its standard deviation (– in records made before it)."""
+    m, sd = i.get(GRID_BETA), i.get("beta_space_grid_sd")
+    return "–" if m is None or sd is None else f"{m:.3f} ({sd:.3f})"
 
 
 def headline(res: dict) -> list[str]:
@@ -839,6 +855,10 @@ def headline(res: dict) -> list[str]:
             v = res["basin"][s][k]["median"][m]
             cells.append(_fmt(m, v) + (_inside_mark(m, v) or " ✗"))
         lines.append(f"| {LABELS[m]} | {_fmt(m, lo)}–{_fmt(m, hi)} | " + " | ".join(cells) + " |")
+        if m == "beta_space" and all(res["basin"][s][k]["median"].get(GRID_BETA) is not None for s, k in cols):
+            cells = [_fmt(m, res["basin"][s][k]["median"][GRID_BETA])
+                     + (_inside_mark(m, res["basin"][s][k]["median"][GRID_BETA]) or " ✗") for s, k in cols]
+            lines.append(f"| {GRID_BETA_LABEL} | {_fmt(m, lo)}–{_fmt(m, hi)} | " + " | ".join(cells) + " |")
     lo, hi = WIND_FACTOR_BAND
     cells = []
     for s, k in cols:

@@ -109,6 +109,29 @@ def test_validation_headline_reports_the_wind_factor_against_its_band():
     assert cells == [f"{0.5 * (lo + hi):.4f} ✓", f"{0.3 * lo:.4f} ✗", "–", f"{1.5 * hi:.4f} ✗"]
 
 
+def test_validation_headline_adds_the_grid_mean_beta_row_only_when_every_run_has_it():
+    """The β over nine box grids is a row of its own under β, judged against β's band and not
+    counted; records made before it (no ``beta_space_grid_mean``) keep the old table."""
+    import validate
+
+    lo, hi = validate.TARGETS["beta_space"][:2]
+    base = {k: 0.5 * (a + b) for k, (a, b, _s, _n) in validate.TARGETS.items()}
+
+    def run(grid_beta):
+        median = dict(base) if grid_beta is None else {**base, validate.GRID_BETA: grid_beta}
+        return {"median": median, "remesh_events": 3, "drift_km": {"mean": 10.0, "max": 20.0},
+                "resolution_m": 10e3, "drift_response": None}
+
+    res = {"basin": {"closed": {"maxwell_eb": run(0.5 * (lo + hi))}, "strait": {"maxwell_eb": run(0.3 * lo)}}}
+    lines = validate.headline(res)
+    i = next(n for n, line in enumerate(lines) if line.startswith("| β, ⟨ε̇tot⟩"))
+    assert lines[i + 1].startswith(f"| {validate.GRID_BETA_LABEL} |")
+    cells = [c.strip() for c in lines[i + 1].strip("|").split("|")][2:]
+    assert cells == [f"{0.5 * (lo + hi):.2f} ✓", f"{0.3 * lo:.2f} ✗"]
+    res["basin"]["strait"]["maxwell_eb"] = run(None)
+    assert not any(line.startswith(f"| {validate.GRID_BETA_LABEL}") for line in validate.headline(res))
+
+
 def test_drift_response_store_keeps_the_published_records_in_a_fresh_checkout(tmp_path, monkeypatch):
     """A fresh checkout has no benchmarks/out/physics/drift_response.json: the first new run
     must be added to the published records, not replace them (it did until the tenth

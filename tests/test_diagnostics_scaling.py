@@ -40,6 +40,7 @@ import pytest
 from lagice.diagnostics import (
     coarse_grain,
     fit_power_law,
+    grid_averaged_beta,
     lagrangian_velocity_gradients,
     spatial_scaling,
     temporal_scaling,
@@ -226,3 +227,50 @@ def test_temporal_scaling_bad_arguments():
         temporal_scaling(series, tri, 1.0, window_steps=[5])
     with pytest.raises(ConfigError, match="nodes_xy_series"):
         temporal_scaling(xy, tri, 1.0)
+
+
+def test_grid_averaged_beta_refits_the_same_field_on_shifted_grids(mesh):
+    """The first grid is spatial_scaling's own; grid k is spatial_scaling with the corner moved
+    down-left by offsets_m[k], which lie in [0, widest fitted box width); mean and sd are over the grids."""
+    xy, tri = mesh
+    rates = velocity_gradients(xy, tri, slip_line_velocity(xy, S_M, DU, alternating=True))
+    sizes = np.array([2, 4, 8, 16]) * 1e3
+    first = spatial_scaling(rates, sizes)
+    gb = grid_averaged_beta(rates, n_grids=6, seed=3, box_sizes_m=sizes)
+    assert gb.betas[0] == first.fit.exponent
+    assert gb.offsets_m.shape == (6, 2) and np.all(gb.offsets_m[0] == 0.0)
+    widest = sizes[first.coarse.n_boxes >= 10].max()  # 16 km boxes: 25 of them in the 81 km square
+    assert np.all((gb.offsets_m[1:] >= 0.0) & (gb.offsets_m[1:] < widest))
+    corner = np.asarray(rates.bounds_m)[:2]
+    for k in range(1, 6):
+        sp = spatial_scaling(rates, sizes, origin_xy_m=corner - gb.offsets_m[k])
+        assert gb.betas[k] == sp.fit.exponent
+    assert gb.mean == pytest.approx(gb.betas.mean(), rel=1e-12)
+    assert gb.sd == pytest.approx(gb.betas.std(), rel=1e-12)
+    # alternating lines 9 km apart: boxes of 2-8 km hold at most one line, whatever the grid, so the
+    # grids differ only through the 16 km boxes (one or two lines); the fits must differ a little
+    assert gb.sd > 0.0
+    again = grid_averaged_beta(rates, n_grids=6, seed=3, box_sizes_m=sizes)
+    np.testing.assert_array_equal(again.betas, gb.betas)   # seeded: the same grids
+
+
+def test_grid_averaged_beta_keeps_a_sign_coherent_field_scale_free_on_every_grid(mesh):
+    """Same-sense slip lines: the mean over the counted boxes is Δu/s at every width on any grid
+    (the coarse-graining is linear), so β = 0 on each of the grids, not only on the default one."""
+    xy, tri = mesh
+    rates = velocity_gradients(xy, tri, slip_line_velocity(xy, S_M, DU))
+    gb = grid_averaged_beta(rates, n_grids=9, box_sizes_m=np.array([1, 2, 4, 8]) * 1e3,
+                            include_element_scale=False)   # the boxes alone, as the analytic case
+    assert np.all(np.isfinite(gb.betas))
+    assert np.abs(gb.betas).max() < 0.02
+    assert abs(gb.mean) < 0.02
+
+
+def test_grid_averaged_beta_bad_grid_count(mesh):
+    xy, tri = mesh
+    rates = velocity_gradients(xy, tri, slip_line_velocity(xy, S_M, DU))
+    for bad in (0, 2.5, True):
+        with pytest.raises(ConfigError, match="n_grids"):
+            grid_averaged_beta(rates, n_grids=bad)
+    one = grid_averaged_beta(rates, n_grids=1)
+    assert one.sd == 0.0 and one.betas.size == 1

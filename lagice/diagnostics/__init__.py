@@ -6,6 +6,7 @@ applies equally to model output and to RGPS-like Lagrangian data:
 - :func:`velocity_gradients`, :func:`lagrangian_velocity_gradients`:
   per-triangle gradients and invariants (divergence, shear, total; s-1);
 - :func:`coarse_grain`, :func:`spatial_scaling`: ⟨ε̇tot⟩(L) ∝ L^−β (Girard 2010 §3.5);
+  :func:`grid_averaged_beta`: β averaged over box grids laid from several corners;
 - :func:`temporal_scaling`: ⟨ε̇tot⟩(T) ∝ T^−α;
 - :func:`log_binned_pdf`, :func:`fit_power_law_tail`: PDFs and ML tail exponents;
 - :func:`localisation_area_fraction`, :func:`shear_divergence_r2`;
@@ -26,12 +27,14 @@ from lagice.diagnostics.report import (
 )
 from lagice.diagnostics.scaling import (
     CoarseGraining,
+    GridAveragedBeta,
     PowerLawFit,
     SpatialScaling,
     TemporalScaling,
     coarse_grain,
     default_box_sizes,
     fit_power_law,
+    grid_averaged_beta,
     spatial_scaling,
     temporal_scaling,
 )
@@ -63,7 +66,8 @@ __all__ = [
     "ElementStrainRates", "divergence_rate", "lagrangian_velocity_gradients", "shear_rate",
     "total_deformation_rate", "triangle_geometry", "velocity_gradients",
     "CoarseGraining", "PowerLawFit", "SpatialScaling", "TemporalScaling", "coarse_grain",
-    "default_box_sizes", "fit_power_law", "spatial_scaling", "temporal_scaling",
+    "default_box_sizes", "fit_power_law", "grid_averaged_beta", "GridAveragedBeta", "spatial_scaling",
+    "temporal_scaling",
     "LogBinnedPdf", "PowerLawTail", "fit_power_law_tail", "localisation_area_fraction",
     "log_binned_pdf", "shear_divergence_r2",
     "JSON_KEYS", "diagnose_arrays", "summarise", "write_figures", "write_json",

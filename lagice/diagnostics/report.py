@@ -12,7 +12,13 @@ from pathlib import Path
 import numpy as np
 
 from lagice.diagnostics._checks import as_points, as_triangles, choice, positive
-from lagice.diagnostics.scaling import MIN_FIT_BOXES, spatial_scaling, temporal_scaling
+from lagice.diagnostics.scaling import (
+    BETA_GRIDS,
+    MIN_FIT_BOXES,
+    grid_averaged_beta,
+    spatial_scaling,
+    temporal_scaling,
+)
 from lagice.diagnostics.statistics import (
     fit_power_law_tail,
     localisation_area_fraction,
@@ -40,6 +46,10 @@ JSON_KEYS = {
     "beta_space_stderr": "standard error of β",
     "beta_space_r2": "R² of the log–log fit",
     "beta_space_fit_range_m": "[L_min, L_max] (m) of the scales used in the β fit (scales with >= min_boxes boxes)",
+    "beta_space_grid_mean": "mean of β over box grids laid from several corners (the default one first; "
+                            "lagice.diagnostics.scaling.grid_averaged_beta): less dependent on where the boxes fall",
+    "beta_space_grid_sd": "standard deviation of β over those grids",
+    "beta_space_grids": "number of box grids of beta_space_grid_mean",
     "scaling_space": "{box_size_m, scale_m, mean_total_s, n_boxes} per scale (element scale first, box_size_m null)",
     "min_box_coverage": "minimum covered fraction of a box's W² for it to count",
     "alpha_time": "α of ⟨ε̇tot⟩ ∝ T^−α (null without a position time series)",
@@ -68,7 +78,7 @@ def summarise(nodes_xy0, nodes_xy1, triangles, dt_s, *, geometry="mid", box_size
               min_coverage=0.75, fit_range_m=None, include_element_scale=True, min_boxes=MIN_FIT_BOXES,
               nodes_xy_series=None, series_dt_s=None, window_steps=None, fit_range_s=None,
               tail_x_min_shear_s=None, tail_x_min_divergence_s=None, min_tail=50,
-              pdf_dynamic_range=1e6, pdf_bins_per_decade=10):
+              pdf_dynamic_range=1e6, pdf_bins_per_decade=10, beta_grids=BETA_GRIDS):
     """Compute all diagnostics of issue 7 from one window of node positions.
 
     Element-scale rates come from :func:`lagrangian_velocity_gradients`
@@ -90,6 +100,8 @@ def summarise(nodes_xy0, nodes_xy1, triangles, dt_s, *, geometry="mid", box_size
     box_sizes_m, min_coverage, fit_range_m, include_element_scale, min_boxes
         Passed to :func:`spatial_scaling` (``min_boxes``: boxes a scale needs to
         enter the β fit, default 10).
+    beta_grids : int
+        Box grids of ``beta_space_grid_mean`` (:func:`grid_averaged_beta`; default 9).
     nodes_xy_series : array_like (k+1, n, 2), optional
         Positions (m) every ``series_dt_s`` for the temporal scaling.
     series_dt_s : float, optional
@@ -133,7 +145,8 @@ def summarise(nodes_xy0, nodes_xy1, triangles, dt_s, *, geometry="mid", box_size
         rates, box_sizes_m=box_sizes_m, min_coverage=min_coverage, fit_range_m=fit_range_m,
         include_element_scale=include_element_scale, min_boxes=min_boxes,
         tail_x_min_shear_s=tail_x_min_shear_s, tail_x_min_divergence_s=tail_x_min_divergence_s,
-        min_tail=min_tail, pdf_dynamic_range=pdf_dynamic_range, pdf_bins_per_decade=pdf_bins_per_decade)
+        min_tail=min_tail, pdf_dynamic_range=pdf_dynamic_range, pdf_bins_per_decade=pdf_bins_per_decade,
+        beta_grids=beta_grids)
     out = {
         "schema_version": SCHEMA_VERSION,
         "n_nodes": int(x0.shape[0]),
@@ -157,7 +170,8 @@ def summarise(nodes_xy0, nodes_xy1, triangles, dt_s, *, geometry="mid", box_size
 
 def rate_statistics(rates, *, box_sizes_m=None, min_coverage=0.75, fit_range_m=None, include_element_scale=True,
                     min_boxes=MIN_FIT_BOXES, origin_xy_m=None, tail_x_min_shear_s=None,
-                    tail_x_min_divergence_s=None, min_tail=50, pdf_dynamic_range=1e6, pdf_bins_per_decade=10):
+                    tail_x_min_divergence_s=None, min_tail=50, pdf_dynamic_range=1e6, pdf_bins_per_decade=10,
+                    beta_grids=BETA_GRIDS):
     """The statistics of :func:`summarise` that depend only on the element rates.
 
     ``rates`` is an :class:`~lagice.diagnostics.strain.ElementStrainRates` of any
@@ -166,10 +180,12 @@ def rate_statistics(rates, *, box_sizes_m=None, min_coverage=0.75, fit_range_m=N
     corner of the box grid, see :func:`coarse_grain`). Returns ``(stats, arrays)``:
     the JSON keys from ``mean_divergence_s`` to ``shear_divergence_r2`` (no temporal
     scaling), and the result objects for figures (``rates``, ``spatial``, ``pdf``,
-    ``tail``)."""
+    ``tail``; ``beta_grids``: the box grids of ``beta_space_grid_mean``, :func:`grid_averaged_beta`)."""
     div, shear, tot = rates.divergence_s, rates.shear_s, rates.total_s
     sp = spatial_scaling(rates, box_sizes_m, min_coverage, fit_range_m, include_element_scale,
                          origin_xy_m=origin_xy_m, min_boxes=min_boxes)
+    gb = grid_averaged_beta(rates, beta_grids, 0, sp.coarse.box_size_m, min_coverage, fit_range_m,
+                            include_element_scale, min_boxes, origin_xy_m=origin_xy_m, first=sp)
     box_sizes = list(sp.coarse.box_size_m[np.isfinite(sp.coarse.mean_total_s)])
     n_boxes = list(sp.coarse.n_boxes[np.isfinite(sp.coarse.mean_total_s)])
     if include_element_scale:
@@ -190,6 +206,9 @@ def rate_statistics(rates, *, box_sizes_m=None, min_coverage=0.75, fit_range_m=N
         "beta_space_stderr": sp.fit.exponent_stderr,
         "beta_space_r2": sp.fit.r2,
         "beta_space_fit_range_m": list(sp.fit.fit_range),
+        "beta_space_grid_mean": gb.mean,
+        "beta_space_grid_sd": gb.sd,
+        "beta_space_grids": int(gb.betas.size),
         "scaling_space": {"box_size_m": box_sizes, "scale_m": list(sp.scale_m),
                           "mean_total_s": list(sp.mean_total_s), "n_boxes": [int(n) for n in n_boxes]},
         "min_box_coverage": sp.coarse.min_coverage,

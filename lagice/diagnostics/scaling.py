@@ -305,6 +305,96 @@ def spatial_scaling(rates, box_sizes_m=None, min_coverage=0.75, fit_range_m=None
     return SpatialScaling(cg, el_scale, el_mean, scale, mean, fit)
 
 
+#: box grids :func:`grid_averaged_beta` lays by default: the default corner and 8 seeded offsets of it
+BETA_GRIDS = 9
+
+
+@dataclass(frozen=True)
+class GridAveragedBeta:
+    """Result of :func:`grid_averaged_beta`: β fitted on several box grids.
+
+    Attributes
+    ----------
+    mean, sd : float
+        Mean and standard deviation (ddof 0) of β over the grids whose fit is finite.
+    betas : np.ndarray
+        β per grid, the default corner's first (NaN where a grid's fit failed).
+    offsets_m : np.ndarray
+        (n_grids, 2) shift of each grid's corner from the default corner (m); the first is (0, 0).
+    """
+
+    mean: float
+    sd: float
+    betas: np.ndarray
+    offsets_m: np.ndarray
+
+
+def grid_averaged_beta(rates, n_grids=BETA_GRIDS, seed=0, box_sizes_m=None, min_coverage=0.75,
+                       fit_range_m=None, include_element_scale=True, min_boxes=MIN_FIT_BOXES, origin_xy_m=None,
+                       first=None):
+    """β of :func:`spatial_scaling` averaged over box grids laid from different corners.
+
+    Where the boxes fall decides which bands share a box and which boxes a coast cuts,
+    so one grid's β carries an error of its own: in the winter basin, one month's
+    window-median β moves by 0.02–0.05 from grid to grid (docs/physics.md §4, "How far β
+    moves with the box grid"). Observed β (Marsan et al. 2004) averages over the boxes of
+    a whole basin and winter; a model basin holds far fewer, so this estimator averages
+    over grids instead. The first grid starts at :func:`coarse_grain`'s default corner; the
+    others at that corner shifted down and left by seeded offsets uniform in [0, L_max) in
+    x and y, where L_max is the widest box width the first grid's fit uses (its widest
+    box width if the fit used none). Box widths, coverage and the fit's rules are those of
+    :func:`spatial_scaling` on every grid.
+
+    Parameters
+    ----------
+    rates : ElementStrainRates
+    n_grids : int
+        Number of grids, the default one included (>= 1; default :data:`BETA_GRIDS`).
+    seed : int
+        Seed of the offsets (``numpy.random.default_rng``).
+    origin_xy_m : (float, float), optional
+        The first grid's corner (default: :func:`coarse_grain`'s).
+    first : SpatialScaling, optional
+        The default grid's :func:`spatial_scaling` with the same arguments, if already
+        computed (it is not computed again).
+
+    Returns
+    -------
+    GridAveragedBeta
+    """
+    if isinstance(n_grids, bool) or not isinstance(n_grids, (int, np.integer)) or n_grids < 1:
+        raise ConfigError(f"n_grids = {n_grids!r}; expected an integer >= 1 (box grids for β)")
+    if box_sizes_m is None:
+        box_sizes_m = default_box_sizes(rates)
+    if first is None:
+        first = spatial_scaling(rates, box_sizes_m, min_coverage, fit_range_m, include_element_scale,
+                                origin_xy_m=origin_xy_m, min_boxes=min_boxes)
+    if origin_xy_m is not None:
+        corner = np.asarray(origin_xy_m, dtype=np.float64).reshape(2)
+    else:
+        corner = (rates.centroid_xy_m.min(axis=0) if rates.bounds_m is None
+                  else np.asarray(rates.bounds_m, dtype=np.float64)[:2])
+    widest = first.fit.fit_range[1] if first.fit.n_points >= 2 else np.nan
+    if not np.isfinite(widest) or widest <= first.element_scale_m:
+        widest = float(np.max(box_sizes_m))
+    else:  # the fit's widest point is a box scale (the mean box's √area); take its box width
+        widths = np.asarray(first.coarse.box_size_m, dtype=np.float64)
+        scales = np.asarray(first.coarse.scale_m, dtype=np.float64)
+        ok = np.isfinite(scales) & (scales <= widest * (1 + 1e-12))
+        widest = float(widths[ok].max()) if ok.any() else float(np.max(box_sizes_m))
+    rng = np.random.default_rng(seed)
+    offsets = np.vstack([[0.0, 0.0], rng.uniform(0.0, widest, size=(int(n_grids) - 1, 2))])
+    betas = [first.fit.exponent]
+    for off in offsets[1:]:
+        sp = spatial_scaling(rates, box_sizes_m, min_coverage, fit_range_m, include_element_scale,
+                             origin_xy_m=corner - off, min_boxes=min_boxes)
+        betas.append(sp.fit.exponent)
+    betas = np.asarray(betas, dtype=np.float64)
+    ok = np.isfinite(betas)
+    return GridAveragedBeta(float(betas[ok].mean()) if ok.any() else float("nan"),
+                            float(betas[ok].std()) if ok.any() else float("nan"), betas, offsets)
+
+
 _WINDOW_BATCH_ELEMENTS = 1_000_000
 
 

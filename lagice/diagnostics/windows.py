@@ -32,11 +32,12 @@ class WindowError(LagiceError):
     """A window with too few elements followed through it (remeshing replaced them)."""
 
 #: the metrics :func:`window_statistics` summarises over the windows (keys of :func:`summarise`)
-WINDOW_METRICS = ("beta_space", "pdf_tail_exponent_divergence", "pdf_tail_exponent_shear",
+WINDOW_METRICS = ("beta_space", "beta_space_grid_mean", "pdf_tail_exponent_divergence", "pdf_tail_exponent_shear",
                   "localisation_half_shear_area_fraction", "shear_divergence_r2", "mean_total_s")
 
 #: per-window keys kept from :func:`summarise` (JSON-serialisable)
 WINDOW_KEYS = ("beta_space", "beta_space_stderr", "beta_space_r2", "beta_space_fit_range_m",
+               "beta_space_grid_mean", "beta_space_grid_sd", "beta_space_grids",
                "pdf_tail_exponent_shear", "pdf_tail_fit_range_shear_s", "pdf_tail_n_shear", "pdf_tail_ks_shear",
                "pdf_tail_exponent_divergence", "pdf_tail_fit_range_divergence_s", "pdf_tail_n_divergence",
                "pdf_tail_ks_divergence", "localisation_half_shear_area_fraction", "shear_divergence_r2",
