@@ -3396,6 +3396,17 @@ for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,)))
 #       above its highest 10 km draw; it does not if some 10 km draw lies at or above some 20 km draw.
 # Predicted: GM fails for the flagship months (the median at the gap moves up to the active windows) and holds for the
 # energy family's months, whose windows are all active; GF as rule OM (survives in CS only).
+# Result (GM, GF) (2026-11-30, 12:29 UTC): GM fails; the prediction was right for the closed flagship month and wrong
+# for the rest. Window-median of the nine-grid means against the nine-grid mean of the window medians (rules OR, OM):
+# F10-hthick-m10 0.088 against 0.059 (+0.029), F10s-hthick-m10 0.038 / 0.040, F10-hthick-eng-P-C3 0.091 / 0.093,
+# B20-hthick-eng-P-C3-m20 0.143 / 0.147; DS 20 km draws 0-3 0.121, 0.090, 0.128, 0.107 (against 0.124, 0.104, 0.121,
+# 0.112), 10 km 0.069, 0.081 (0.088, 0.091); CS 20 km 0.173, 0.149, 0.173, 0.176 (0.158, 0.148, 0.164, 0.166), 10 km
+# 0.114, 0.109 (0.118, 0.116); CW 20 km 0.151, 0.138, 0.156, 0.135 (0.140, 0.131, 0.140, 0.130), 10 km 0.100, 0.127
+# (0.103, 0.126). Six of 22 months differ by more than 0.01 (up to 0.029), two more by 0.010. One window's beta has a
+# standard deviation over the nine grids of 0.007-0.116 (median 0.027). GF as predicted: the fall survives in CS (gap
+# 0.035) and decides neither way in DS and CW (gaps 0.009, 0.009); every 10 km draw lies below every 20 km draw (24
+# pairs of 24); the means of the draws fall by 0.037 (DS), 0.056 (CS) and 0.032 (CW), against 0.026, 0.042 and 0.021
+# in the old order.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
