@@ -287,6 +287,11 @@ def git_commit() -> dict:
 #: the folders whose code decides a run's result (the model); a reused run made by another commit
 #: is the same run as one made now only if none of them changed in between
 MODEL_CODE = ("lagice", "forcing", "thermo")
+#: folders of MODEL_CODE that only analyse a finished run's snapshots: no module of a run's time
+#: stepping imports them (tests/test_bench_helpers.py runs ``lagice run`` and checks), and the
+#: statistics are recomputed from the snapshots at every analysis, so a change there does not make
+#: a reused run differ from one made now
+ANALYSIS_CODE = ("lagice/diagnostics",)
 
 
 def run_made_by(run: Path) -> str | None:
@@ -323,11 +328,13 @@ def model_code_changes(commit: str | None, modified=None) -> list | None:
     base, dirty = commit.removesuffix("-dirty"), commit.endswith("-dirty")
     if dirty and modified is None:
         return None
-    p = subprocess.run(["git", "diff", "--name-only", base, "--", *MODEL_CODE], cwd=ROOT, capture_output=True,
+    p = subprocess.run(["git", "diff", "--name-only", base, "--", *MODEL_CODE,
+                        *(f":(exclude){a}" for a in ANALYSIS_CODE)], cwd=ROOT, capture_output=True,
                        text=True, check=False)
     if p.returncode != 0:
         return None
-    own = [f for f in (modified or ()) if f.split("/")[0] in MODEL_CODE]
+    own = [f for f in (modified or ()) if f.split("/")[0] in MODEL_CODE
+           and not any(f.startswith(a + "/") for a in ANALYSIS_CODE)]
     return sorted(set(p.stdout.split()) | set(own))
 
 

@@ -132,6 +132,32 @@ def test_validation_headline_adds_the_grid_mean_beta_row_only_when_every_run_has
     assert not any(line.startswith(f"| {validate.GRID_BETA_LABEL}") for line in validate.headline(res))
 
 
+def test_a_run_never_imports_the_analysis_code_that_validate_leaves_out_of_its_provenance(tmp_path):
+    """validate.ANALYSIS_CODE (lagice/diagnostics) is left out of the model code whose changes
+    flag a reused run: that holds only while a run's time stepping never imports it. A real
+    ``lagice run`` (the compression plate, a few steps, with its plot) checks it, and the
+    provenance check must still see a change to the model proper."""
+    import subprocess
+    import sys
+
+    import validate
+
+    code = ("import sys; from lagice.cli import main; rc = main(['run', 'uniaxial_compression', '--out', sys.argv[1], "
+            "'--set', 'domain.resolution_m=12500', '--set', 'run.duration=2000s']); "
+            "print('LOADED', sorted(m for m in sys.modules if m.startswith('lagice.diagnostics'))); sys.exit(rc)")
+    r = subprocess.run([sys.executable, "-c", code, str(tmp_path / "run")], capture_output=True, text=True,
+                       timeout=600)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "run" / "snapshots").is_dir()
+    assert "LOADED []" in r.stdout, r.stdout[-500:]
+    assert validate.ANALYSIS_CODE == ("lagice/diagnostics",)
+    # the exclusion is only of the analysis folder: a model file modified in a dirty tree still counts
+    head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=validate.ROOT, capture_output=True, text=True).stdout.strip()
+    assert "lagice/diagnostics/scaling.py" not in validate.model_code_changes(head + "-dirty",
+                                                                              ["lagice/diagnostics/scaling.py"])
+    assert "lagice/model.py" in validate.model_code_changes(head + "-dirty", ["lagice/model.py"])
+
+
 def test_drift_response_store_keeps_the_published_records_in_a_fresh_checkout(tmp_path, monkeypatch):
     """A fresh checkout has no benchmarks/out/physics/drift_response.json: the first new run
     must be added to the published records, not replace them (it did until the tenth
