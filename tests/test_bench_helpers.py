@@ -152,7 +152,8 @@ def test_a_run_never_imports_the_analysis_code_that_validate_leaves_out_of_its_p
     assert "LOADED []" in r.stdout, r.stdout[-500:]
     assert validate.ANALYSIS_CODE == ("lagice/diagnostics",)
     # the exclusion is only of the analysis folder: a model file modified in a dirty tree still counts
-    head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=validate.ROOT, capture_output=True, text=True).stdout.strip()
+    head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=validate.ROOT, capture_output=True,
+                          text=True).stdout.strip()
     assert "lagice/diagnostics/scaling.py" not in validate.model_code_changes(head + "-dirty",
                                                                               ["lagice/diagnostics/scaling.py"])
     assert "lagice/model.py" in validate.model_code_changes(head + "-dirty", ["lagice/model.py"])
