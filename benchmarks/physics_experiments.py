@@ -3407,6 +3407,11 @@ for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,)))
 # 0.035) and decides neither way in DS and CW (gaps 0.009, 0.009); every 10 km draw lies below every 20 km draw (24
 # pairs of 24); the means of the draws fall by 0.037 (DS), 0.056 (CS) and 0.032 (CW), against 0.026, 0.042 and 0.021
 # in the old order.
+# Correction (2026-11-30, 12:31 UTC): the rule called the flagship's four low windows near-locked. They are not the
+# quiet ones: their rates are 0.0001-0.0049 per day (days 1-4, 10-13, 13-16, 19-22), while the window of days 16-19,
+# at 0.0003 per day, has beta 0.084. In the four low windows the interior's divergence has one sign (net over mean
+# |divergence| +0.58, -0.86, -0.96, -0.83) and one box over the whole interior keeps 0.66-0.75 of the element-mean
+# rate; in the five others 0.39-0.70.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
