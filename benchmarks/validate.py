@@ -197,7 +197,7 @@ def analyse_run(run: Path, days: float, buffer_m: float, window_days: float = 3.
     median, min and max over the windows) and the run's wall time, remeshing, outflow
     and mean speeds."""
     ws = window_statistics(run, window_days=window_days, coast_buffer_km=buffer_m / 1e3, start_day=spinup_days,
-                           end_day=days, metrics=WINDOW_TARGETS + ("mean_total_s",), keep_arrays=True,
+                           end_day=days, metrics=WINDOW_TARGETS + (GRID_BETA, "mean_total_s"), keep_arrays=True,
                            rgps_tracking_error_m=RGPS_TRACKING_ERROR_M)
     for part in ("median", "min", "max", "median_all_elements", "median_rgps", "median_rgps_cells"):
         v = ws[part].pop("mean_total_s")
@@ -1107,6 +1107,12 @@ def ensemble_lines(ens: dict) -> list[str]:
             mark = "" if med is None else (" ✓" if lo <= med <= hi else " ✗")
             lines.append(f"| {LABELS[k]} | {_fmt(k, lo)}–{_fmt(k, hi)} | " + " | ".join(cells)
                          + f" | {_fmt3(k, med)}{mark} | {st['n_inside']} of {st['n_members']} |")
+            gb = [e["members"][n]["median"].get(GRID_BETA) for n in names]
+            if k == "beta_space" and all(v is not None for v in gb):
+                med = float(np.median(gb))
+                lines.append(f"| {GRID_BETA_LABEL} | {_fmt(k, lo)}–{_fmt(k, hi)} | "
+                             + " | ".join(_fmt3(k, v) for v in gb) + f" | {_fmt3(k, med)}"
+                             + f"{' ✓' if lo <= med <= hi else ' ✗'} | {sum(lo <= v <= hi for v in gb)} of {len(gb)} |")
         wf = [(e["members"][n].get("drift_response") or {}).get("wind_factor") for n in names]
         if all(v is not None for v in wf):
             lo, hi = WIND_FACTOR_BAND
