@@ -3413,6 +3413,16 @@ for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,)))
 # |divergence| +0.58, -0.86, -0.96, -0.83) and one box over the whole interior keeps 0.66-0.75 of the element-mean
 # rate; in the five others 0.39-0.70.
 
+# Written 2026-11-30 12:40 UTC, before its analysis (no new runs; a diagnostic, not how RGPS is processed): rule GM
+# found that in four of the flagship's nine windows the interior deforms as one body (one-signed divergence; one box
+# over the whole interior keeps 0.66-0.75 of the element-mean rate). Is that uniform mode what holds the flagship's
+# beta down? Each window's element gradients, less the interior's area-weighted mean gradient (the uniform part), are
+# coarse-grained as the validation does, and beta averaged over the nine grids (grid_averaged_beta).
+# (UM)  the uniform mode holds beta down if, without it, the window-median beta rises by 0.04 or more in both basins
+#       of the validation month (from 0.088 closed, 0.038 strait) and in the median over each basin's eight months of
+#       weather; it does not if it rises by less than 0.02 in each.
+# Predicted: it holds beta down; without the uniform part beta rises into 0.12-0.20 in the validation month.
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
