@@ -108,6 +108,44 @@ def origin_spread(run_dir: Path, n_origins: int, seed: int = 0, window_days: flo
             "span": float(medians.max() - medians.min())}
 
 
+def less_uniform(rates):
+    """The element rates less the area-weighted mean gradient of the whole set (the part in which the
+    set deforms as one body): a diagnostic of what the uniform part does to β (rule UM), not how RGPS
+    is processed."""
+    from lagice.diagnostics.strain import ElementStrainRates
+
+    a = rates.area_m2
+    mean = (rates.gradient_s * a[:, None, None]).sum(axis=0) / a.sum()
+    return ElementStrainRates(rates.gradient_s - mean, a, rates.centroid_xy_m, rates.bounds_m)
+
+
+def uniform_mode(run_dir: Path, window_days: float = 3.0, start_day: float = 1.0,
+                 coast_buffer_m: float = 100e3) -> dict:
+    """Per validation window: β over nine box grids (:func:`lagice.diagnostics.grid_averaged_beta`) of
+    the interior's element rates as they are and less their uniform part (:func:`less_uniform`), the
+    element-mean rate [day⁻¹], the ratio of the interior's net rate (one box over the whole interior)
+    to it, and the net divergence over the mean |divergence|; and the window medians of the two β."""
+    from lagice.diagnostics.scaling import grid_averaged_beta
+    from lagice.diagnostics.strain import total_deformation_rate
+
+    rows = []
+    for s0 in window_starts_days(run_dir, window_days, start_day):
+        xy0, xy1, tri, dt, info = window_arrays(run_dir, s0 * DAY_S, (s0 + window_days) * DAY_S, coast_buffer_m)
+        rates = lagrangian_velocity_gradients(xy0, xy1, tri[info["interior"]], dt)
+        a = rates.area_m2
+        mean_rate = float(np.average(rates.total_s, weights=a))
+        net = (rates.gradient_s * a[:, None, None]).sum(axis=0) / a.sum()
+        div = rates.divergence_s
+        rows.append({"start_day": float(s0), "beta_grid_mean": grid_averaged_beta(rates).mean,
+                     "beta_grid_mean_less_uniform": grid_averaged_beta(less_uniform(rates)).mean,
+                     "rate_per_day": mean_rate * DAY_S,
+                     "net_to_mean_rate": float(total_deformation_rate(net[None])[0] / mean_rate),
+                     "net_to_mean_abs_divergence": float(np.average(div, weights=a) / np.average(np.abs(div),
+                                                                                                  weights=a))})
+    return {"windows": rows, "median": {k: float(np.median([r[k] for r in rows]))
+                                        for k in ("beta_grid_mean", "beta_grid_mean_less_uniform")}}
+
+
 def pooled_curve(rows: list) -> dict:
     """⟨ε̇tot⟩(L) pooled over the windows: per box width (counted from the widest with at least
     10 boxes, so that every window has it), the mean width [km] and the geometric mean over the
@@ -140,6 +178,8 @@ def main(argv=None):
     ap.add_argument("--origins", type=int, default=0, metavar="N",
                     help="also the window-median β with the box grid laid from N seeded random offsets of its "
                          "corner, and its spread (rule OR)")
+    ap.add_argument("--uniform-mode", action="store_true",
+                    help="also β over nine grids of each window less the interior's uniform part (rule UM)")
     args = ap.parse_args(argv)
     if args.origins < 0:
         raise SystemExit(f"beta_estimator: --origins {args.origins}: expected a number of offsets >= 0")
@@ -174,6 +214,18 @@ def main(argv=None):
             out[name]["origin_spread"] = o
             b = o["median_beta"]
             print(f"| {name} | {b[0]:.3f} | {min(b[1:]):.3f} – {max(b[1:]):.3f} | {o['span']:.3f} |", flush=True)
+        args.json.write_text(json.dumps(out, indent=1, allow_nan=True) + "\n")
+    if args.uniform_mode:
+        print("\nβ over nine box grids (window median), as it is and less the interior's uniform part (rule UM):")
+        print("| run | β | β less the uniform part | windows: β / less uniform / net-to-mean rate |")
+        print("|---|---|---|---|")
+        for name in args.runs:
+            u = uniform_mode(RUNS / name)
+            out[name]["uniform_mode"] = u
+            w = "; ".join(f"{r['beta_grid_mean']:.3f}/{r['beta_grid_mean_less_uniform']:.3f}/"
+                          f"{r['net_to_mean_rate']:.2f}" for r in u["windows"])
+            print(f"| {name} | {u['median']['beta_grid_mean']:.3f} | "
+                  f"{u['median']['beta_grid_mean_less_uniform']:.3f} | {w} |", flush=True)
         args.json.write_text(json.dumps(out, indent=1, allow_nan=True) + "\n")
     print(f"beta_estimator: wrote {args.json}", file=sys.stderr)
     if args.figure is not None:

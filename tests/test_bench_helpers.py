@@ -1096,3 +1096,32 @@ def test_beta_origin_spread_starts_from_the_validations_grid_and_moves_it(tmp_pa
     assert abs(o["median_beta"][0]) < 0.1
     assert o["span"] == pytest.approx(max(o["median_beta"]) - min(o["median_beta"]))
     assert o["span"] > 1e-3  # where the boxes fall against the band moves the fit
+
+
+def test_less_uniform_leaves_the_cancelling_part_of_a_field_and_raises_its_beta():
+    """beta_estimator.less_uniform (rule UM) on a field with an analytic split: a uniform strain G plus
+    eight alternating slip lines in a 72 km square. The lines' area-weighted mean gradient is the
+    boundary integral (1/A)∮u n ds, zero with an even number of alternating lines, so removing the
+    mean leaves exactly the lines. Boxes of 18 and 36 km hold an even number of lines whose slips cancel,
+    so the lines' β is large; the uniform part, which does not cancel, pulls it down."""
+    from beta_estimator import less_uniform
+
+    from lagice.diagnostics import grid_averaged_beta, velocity_gradients
+    from lagice.diagnostics.synthetic import jittered_grid_mesh, slip_line_velocity
+
+    length, spacing = 72e3, 9e3
+    xy, tri = jittered_grid_mesh(160, 160, length, length, jitter=0.2, seed=2)
+    lines = slip_line_velocity(xy, spacing, 0.1, alternating=True)
+    g = np.array([[2e-6, 1e-6], [0.0, -1e-6]])  # s-1: a uniform strain of the order of the lines' mean rate
+    both = velocity_gradients(xy, tri, lines + xy @ g.T)
+    alone = velocity_gradients(xy, tri, lines)
+    a = both.area_m2
+    assert np.allclose((alone.gradient_s * a[:, None, None]).sum(0) / a.sum(), 0.0, atol=1e-18)
+    rest = less_uniform(both)
+    np.testing.assert_allclose(rest.gradient_s, alone.gradient_s, atol=1e-15)
+    sizes = np.array([4.5, 9, 18, 36]) * 1e3
+    b_rest = grid_averaged_beta(rest, box_sizes_m=sizes, include_element_scale=False, min_boxes=1).mean
+    b_alone = grid_averaged_beta(alone, box_sizes_m=sizes, include_element_scale=False, min_boxes=1).mean
+    b_both = grid_averaged_beta(both, box_sizes_m=sizes, include_element_scale=False, min_boxes=1).mean
+    assert b_rest == pytest.approx(b_alone, abs=1e-9)
+    assert b_both < b_rest - 0.1   # the uniform part does not cancel, so it lowers β
