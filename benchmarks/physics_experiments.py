@@ -3422,6 +3422,15 @@ for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,)))
 #       of the validation month (from 0.088 closed, 0.038 strait) and in the median over each basin's eight months of
 #       weather; it does not if it rises by less than 0.02 in each.
 # Predicted: it holds beta down; without the uniform part beta rises into 0.12-0.20 in the validation month.
+# Result (UM) (2026-11-30, 13:24 UTC): decides neither way; the prediction was wrong. Window-median beta over nine
+# grids, as it is / less the uniform part: validation month closed 0.088 / 0.110 (+0.022), strait 0.038 / 0.114
+# (+0.076); medians over the eight months closed 0.053 / 0.106 (+0.054), strait 0.053 / 0.112 (+0.059); the sixteen
+# month-basins less the uniform part 0.078-0.122. The interior's net rate over the element-mean rate has month medians
+# 0.54-0.67 in all sixteen (a field with beta 0.2 from the element, ~7 km, to the interior, ~800 km, would give ~0.39).
+# Beyond the rule (no rule was written for these): the energy family's months rise more, 0.091 / 0.172 and
+# 0.069 / 0.169 at 10 km, 0.143 / 0.264 and 0.121 / 0.238 at 20 km, with net-to-mean medians 0.32-0.53. So removing
+# the interior's mean raises beta by 0.08-0.12 where the uniform part is no larger than an observed-like field's: the
+# operation raises beta by itself, and the rule could not tell what the uniform part costs. Withdrawn as a lead.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
