@@ -413,8 +413,10 @@ def _diagnose_windows(args, snaps, out, window_statistics) -> int:
         if w["n_elements_folded"]:
             lost += (f", {w['n_elements_folded']} inverted in the mid-window geometry left out "
                      f"({w['n_interior_folded']} inside the buffer)")
+        i = w["interior"]
         print(f"  days {w['start_day']:g}-{w['end_day']:g}: {w['n_elements']} elements{lost}, "
-              f"beta {_num(w['interior']['beta_space'])}")
+              f"beta {_num(i['beta_space'])} (over {i['beta_space_grids']} box grids "
+              f"{_num(i['beta_space_grid_mean'])} ± {_num(i['beta_space_grid_sd'])})")
     for key, med in res["median"].items():
         print(f"  {key}: median {_num(med)} [{_num(res['min'][key])}, {_num(res['max'][key])}]")
     if args.rgps_error_m is not None:

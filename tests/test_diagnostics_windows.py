@@ -119,6 +119,7 @@ def test_cli_diagnose_windows_on_a_real_run(tmp_path):
     r = _cli("diagnose", str(run), "--window-days", "1", "--start-day", "1", "--coast-buffer-km", "15",
              "--out", str(tmp_path / "win"))
     assert "3 back-to-back windows of 1 days" in r.stdout
+    assert r.stdout.count("(over 9 box grids ") == 3   # each window's β over nine grids, beside the default one
     got = json.loads((tmp_path / "win" / "window_statistics.json").read_text())
     ref = window_statistics(run, window_days=1.0, coast_buffer_km=15.0, start_day=1.0)
     assert [(w["start_day"], w["end_day"]) for w in got["windows"]] == [(1.0, 2.0), (2.0, 3.0), (3.0, 4.0)]
@@ -136,7 +137,8 @@ def test_cli_diagnose_windows_on_a_real_run(tmp_path):
     single = json.loads((tmp_path / "one" / "diagnostics.json").read_text())
     last = got["windows"][-1]
     assert single["n_elements"] == last["n_elements"]
-    for k in ("beta_space", "mean_shear_s", "pdf_tail_exponent_shear", "localisation_half_shear_area_fraction"):
+    for k in ("beta_space", "beta_space_grid_mean", "beta_space_grid_sd", "mean_shear_s", "pdf_tail_exponent_shear",
+              "localisation_half_shear_area_fraction"):
         assert single[k] == pytest.approx(last["interior"][k], rel=1e-12)
     # and the same numbers straight from the arrays
     xy0, xy1, tri, dt, info = window_arrays(run, 3 * DAY, 4 * DAY, 15e3)
