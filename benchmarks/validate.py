@@ -1027,10 +1027,33 @@ def analyse_ensemble(physics: Path, days: float, buffer_m: float, basin: dict) -
                                                                                                          buffer_m)
             members[n] = {"median": a["median"], "remesh_events": a["remesh_events"], "drift_km": a["drift_km"],
                           "rgps_median": a["rgps_view"]["median"], "drift_response": a.get("drift_response"),
+                          "windows_" + GRID_BETA: [w["interior"].get(GRID_BETA) for w in a["windows"]],
                           **{k: a.get(k) for k in ("run_dir", "made_by", "model_code_changed")}}
         out[scene] = {"members": members, "metrics": _member_stats(members, "median"),
-                      "rgps_metrics": _member_stats(members, "rgps_median")}
+                      "rgps_metrics": _member_stats(members, "rgps_median"),
+                      "pooled_" + GRID_BETA: pooled_windows(
+                          [m["windows_" + GRID_BETA] for m in members.values()])}
     return out
+
+
+#: resamples of the months in :func:`pooled_windows`' interval, and its seed
+POOLED_RESAMPLES, POOLED_SEED = 2000, 0
+
+
+def pooled_windows(per_month: list) -> dict | None:
+    """The median of a window statistic pooled over every window of every month, with a 90 % interval
+    from resampling the months with replacement (windows of one month share its weather and pack, so
+    the month is the unit; :data:`POOLED_RESAMPLES` seeded resamples). None if a month lacks the
+    statistic (records made before it)."""
+    if not per_month or any(v is None for m in per_month for v in m):
+        return None
+    months = [np.asarray(m, dtype=np.float64) for m in per_month]
+    rng = np.random.default_rng(POOLED_SEED)
+    picks = rng.integers(0, len(months), size=(POOLED_RESAMPLES, len(months)))
+    boot = np.array([np.median(np.concatenate([months[i] for i in row])) for row in picks])
+    return {"median": float(np.median(np.concatenate(months))), "interval_90": [float(np.quantile(boot, 0.05)),
+            float(np.quantile(boot, 0.95))], "n_windows": int(sum(m.size for m in months)),
+            "n_months": len(months)}
 
 
 def _carried(previous: dict) -> dict:
@@ -1124,6 +1147,13 @@ def ensemble_lines(ens: dict) -> list[str]:
         lines.append("| remesh events | | " + " | ".join(str(e["members"][n]["remesh_events"]) for n in names)
                      + " | | |")
         lines.append("")
+        pw = e.get("pooled_" + GRID_BETA)
+        if pw is not None:
+            lo, hi = TARGETS["beta_space"][:2]
+            a, b = pw["interval_90"]
+            lines += [f"All {pw['n_windows']} windows of the {pw['n_months']} months pooled: the median of β over "
+                      f"nine box grids is {pw['median']:.3f}, with a 90 % interval of {a:.3f}–{b:.3f} from "
+                      f"resampling the months ({POOLED_RESAMPLES} resamples); the band is {lo}–{hi}.", ""]
     return lines
 
 

@@ -1125,3 +1125,25 @@ def test_less_uniform_leaves_the_cancelling_part_of_a_field_and_raises_its_beta(
     b_both = grid_averaged_beta(both, box_sizes_m=sizes, include_element_scale=False, min_boxes=1).mean
     assert b_rest == pytest.approx(b_alone, abs=1e-9)
     assert b_both < b_rest - 0.1   # the uniform part does not cancel, so it lowers β
+
+
+def test_pooled_windows_resamples_months_not_windows():
+    """validate.pooled_windows: the median over every window of every month, and a 90 % interval from
+    resampling whole months. Identical months leave no spread; months that differ give an interval
+    that holds the pooled median and stays inside the months' range; a month without the statistic
+    (an old record) gives None."""
+    import validate
+
+    same = validate.pooled_windows([[0.05, 0.1, 0.15]] * 4)
+    assert same["median"] == pytest.approx(0.1) and same["interval_90"] == pytest.approx([0.1, 0.1])
+    assert same["n_windows"] == 12 and same["n_months"] == 4
+    months = [[0.02] * 9, [0.05] * 9, [0.08] * 9, [0.11] * 9, [0.14] * 9]
+    p = validate.pooled_windows(months)
+    assert p["median"] == pytest.approx(0.08)
+    lo, hi = p["interval_90"]
+    assert 0.02 <= lo < 0.08 < hi <= 0.14
+    # nine windows that split inside each month give a narrower interval than months that differ whole
+    mixed = validate.pooled_windows([[0.02, 0.05, 0.08, 0.11, 0.14, 0.02, 0.05, 0.08, 0.11]] * 5)
+    assert mixed["interval_90"][1] - mixed["interval_90"][0] < hi - lo
+    assert validate.pooled_windows([[0.1, None], [0.2, 0.3]]) is None
+    assert validate.pooled_windows([]) is None
