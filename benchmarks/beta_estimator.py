@@ -108,15 +108,21 @@ def origin_spread(run_dir: Path, n_origins: int, seed: int = 0, window_days: flo
             "span": float(medians.max() - medians.min())}
 
 
+def mean_gradient(rates) -> np.ndarray:
+    """The area-weighted mean velocity gradient [s⁻¹] of a set of elements: by Green's theorem the
+    gradient of the whole set as one cell (its boundary's velocities)."""
+    a = rates.area_m2
+    return (rates.gradient_s * a[:, None, None]).sum(axis=0) / a.sum()
+
+
 def less_uniform(rates):
     """The element rates less the area-weighted mean gradient of the whole set (the part in which the
     set deforms as one body): a diagnostic of what the uniform part does to β (rule UM), not how RGPS
     is processed."""
     from lagice.diagnostics.strain import ElementStrainRates
 
-    a = rates.area_m2
-    mean = (rates.gradient_s * a[:, None, None]).sum(axis=0) / a.sum()
-    return ElementStrainRates(rates.gradient_s - mean, a, rates.centroid_xy_m, rates.bounds_m)
+    return ElementStrainRates(rates.gradient_s - mean_gradient(rates), rates.area_m2, rates.centroid_xy_m,
+                              rates.bounds_m)
 
 
 def uniform_mode(run_dir: Path, window_days: float = 3.0, start_day: float = 1.0,
@@ -134,7 +140,7 @@ def uniform_mode(run_dir: Path, window_days: float = 3.0, start_day: float = 1.0
         rates = lagrangian_velocity_gradients(xy0, xy1, tri[info["interior"]], dt)
         a = rates.area_m2
         mean_rate = float(np.average(rates.total_s, weights=a))
-        net = (rates.gradient_s * a[:, None, None]).sum(axis=0) / a.sum()
+        net = mean_gradient(rates)
         div = rates.divergence_s
         rows.append({"start_day": float(s0), "beta_grid_mean": grid_averaged_beta(rates).mean,
                      "beta_grid_mean_less_uniform": grid_averaged_beta(less_uniform(rates)).mean,

@@ -1093,9 +1093,13 @@ def carry_ensembles(previous: dict, groups: list) -> dict:
 
 
 def _member_stats(members: dict, part: str) -> dict:
-    """Per metric over the members' ``part`` medians: median, min, max and how many are inside the band."""
+    """Per metric over the members' ``part`` medians: median, min, max and how many are inside the band
+    (and β over nine grids against β's band, where every member has it)."""
     stats = {}
-    for k, (lo, hi, _src, _n) in TARGETS.items():
+    bands = dict(TARGETS)
+    if all(m[part].get(GRID_BETA) is not None for m in members.values()):
+        bands[GRID_BETA] = TARGETS["beta_space"]
+    for k, (lo, hi, _src, _n) in bands.items():
         v = np.array([np.nan if m[part][k] is None else m[part][k] for m in members.values()])
         ok = np.isfinite(v)
         some = bool(ok.any())
@@ -1132,12 +1136,13 @@ def ensemble_lines(ens: dict) -> list[str]:
             mark = "" if med is None else (" ✓" if lo <= med <= hi else " ✗")
             lines.append(f"| {LABELS[k]} | {_fmt(k, lo)}–{_fmt(k, hi)} | " + " | ".join(cells)
                          + f" | {_fmt3(k, med)}{mark} | {st['n_inside']} of {st['n_members']} |")
-            gb = [e["members"][n]["median"].get(GRID_BETA) for n in names]
-            if k == "beta_space" and all(v is not None for v in gb):
-                med = float(np.median(gb))
+            gs = e["metrics"].get(GRID_BETA)
+            if k == "beta_space" and gs is not None:
+                med = gs["median"]
                 lines.append(f"| {GRID_BETA_LABEL} | {_fmt(k, lo)}–{_fmt(k, hi)} | "
-                             + " | ".join(_fmt3(k, v) for v in gb) + f" | {_fmt3(k, med)}"
-                             + f"{' ✓' if lo <= med <= hi else ' ✗'} | {sum(lo <= v <= hi for v in gb)} of {len(gb)} |")
+                             + " | ".join(_fmt3(k, e["members"][n]["median"][GRID_BETA]) for n in names)
+                             + f" | {_fmt3(k, med)}{' ✓' if lo <= med <= hi else ' ✗'} | "
+                             f"{gs['n_inside']} of {gs['n_members']} |")
         wf = [(e["members"][n].get("drift_response") or {}).get("wind_factor") for n in names]
         if all(v is not None for v in wf):
             lo, hi = WIND_FACTOR_BAND
