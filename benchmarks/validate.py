@@ -967,9 +967,8 @@ def write_report(res: dict, md: Path, figs: dict):
                   "and no value was chosen from them."
                   + "".join(f" Rows marked † were made on {c['date']} with the code of commit "
                             f"`{str(c['git_commit'])[:10]}` "
-                            "and the set of that day (the strength of every element recomputed at each remesh, the "
-                            "default until 2026-11-28), from the spin-up state made with it; they were not remade, and "
-                            "their reference is that set's own validation month (the first row)."
+                            "and carried from that day's report; they were not remade with this code, so their "
+                            "figures describe the code that made them (what differs is said in the summary)."
                             for c in {json.dumps(r["carried_from"], sort_keys=True): r["carried_from"]
                                       for r in res["sensitivity"].values() if r.get("carried_from")}.values()),
                   "", "| run | " + " | ".join(LABELS[k] for k in TARGETS)
