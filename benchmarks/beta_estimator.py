@@ -16,6 +16,11 @@ over the windows of:
 * the widest width used with 10 boxes, and the ratio of the element-scale ⟨ε̇tot⟩ to the
   ⟨ε̇tot⟩ at that width (observed: about 2 between 10 and 300 km, from β ≈ 0.2).
 
+``--pooled`` also prints, per run, β of one curve over every box of every window (default grid, and
+every box of the nine grids), as observed β is computed (Marsan et al. 2004; Girard et al. 2011;
+:func:`lagice.diagnostics.windows.pooled_window_scaling`), beside the window median, and the same
+pooled over all the runs named (one mesh; e.g. the eight months of a basin) (rule PC).
+
 ``--origins N`` also fits each window's β as the validation does with the box grid laid from N
 seeded random offsets of its corner (uniform in [0, 92 km) in x and y, the widest width fitted in the
 basin) besides the validation's own corner, and prints per run the spread of the window medians over
@@ -152,6 +157,32 @@ def uniform_mode(run_dir: Path, window_days: float = 3.0, start_day: float = 1.0
                                         for k in ("beta_grid_mean", "beta_grid_mean_less_uniform")}}
 
 
+def pooled_table(names: list, out: dict) -> None:
+    """Rule PC: per run the window median of β (default grid) and β of one curve over every box of
+    every window (default grid; every grid), then the same over every window of all the runs."""
+    from lagice.diagnostics.windows import pooled_window_scaling, window_statistics
+
+    print("\nβ as the window median and as one curve over every box of every window (rule PC):")
+    print("| run | window median, default grid | pooled, default grid | pooled, nine grids |")
+    print("|---|---|---|---|")
+    every = []
+    for name in names:
+        ws = window_statistics(RUNS / name, window_days=3.0, coast_buffer_km=100.0, start_day=1.0,
+                               metrics=("beta_space",))
+        every += ws["windows"]
+        pc = ws["pooled"]
+        out[name]["pooled"] = {"window_median": ws["median"]["beta_space"], "beta_space": pc["beta_space"],
+                               "beta_space_grids": pc["beta_space_grids"]}
+        print(f"| {name} | {ws['median']['beta_space']:.3f} | {pc['beta_space']:.3f} | "
+              f"{pc['beta_space_grids']:.3f} |", flush=True)
+    if len(names) > 1:
+        pc = pooled_window_scaling(every)
+        out["_pooled_over_runs"] = {"runs": list(names), "beta_space": pc["beta_space"],
+                                    "beta_space_grids": pc["beta_space_grids"], "n_windows": pc["n_windows"]}
+        print(f"| all {len(names)} runs, {pc['n_windows']} windows | | {pc['beta_space']:.3f} | "
+              f"{pc['beta_space_grids']:.3f} |")
+
+
 def pooled_curve(rows: list) -> dict:
     """⟨ε̇tot⟩(L) pooled over the windows: per box width (counted from the widest with at least
     10 boxes, so that every window has it), the mean width [km] and the geometric mean over the
@@ -184,6 +215,8 @@ def main(argv=None):
     ap.add_argument("--origins", type=int, default=0, metavar="N",
                     help="also the window-median β with the box grid laid from N seeded random offsets of its "
                          "corner, and its spread (rule OR)")
+    ap.add_argument("--pooled", action="store_true",
+                    help="also β of one curve over every box of every window, per run and over all runs (rule PC)")
     ap.add_argument("--uniform-mode", action="store_true",
                     help="also β over nine grids of each window less the interior's uniform part (rule UM)")
     args = ap.parse_args(argv)
@@ -220,6 +253,9 @@ def main(argv=None):
             out[name]["origin_spread"] = o
             b = o["median_beta"]
             print(f"| {name} | {b[0]:.3f} | {min(b[1:]):.3f} – {max(b[1:]):.3f} | {o['span']:.3f} |", flush=True)
+        args.json.write_text(json.dumps(out, indent=1, allow_nan=True) + "\n")
+    if args.pooled:
+        pooled_table(args.runs, out)
         args.json.write_text(json.dumps(out, indent=1, allow_nan=True) + "\n")
     if args.uniform_mode:
         print("\nβ over nine box grids (window median), as it is and less the interior's uniform part (rule UM):")

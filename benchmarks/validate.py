@@ -96,6 +96,10 @@ TARGETS = {
 #: among the six bands, so that the published count keeps its meaning
 GRID_BETA = "beta_space_grid_mean"
 GRID_BETA_LABEL = "β, mean over 9 box grids (not counted)"
+#: β as observed β is computed (Marsan et al. 2004; Girard et al. 2011): one slope of the mean over every box of
+#: every window (and of the nine grids), where the windows that deform most weigh most
+#: (lagice.diagnostics.windows.pooled_window_scaling); reported next to β, not counted among the six bands
+POOLED_BETA_LABEL = "β of one curve over every box of every window and 9 grids, as observed β is computed (not counted)"
 #: metrics window_statistics computes (the rate is its mean_total_s, converted to day⁻¹)
 WINDOW_TARGETS = tuple(k for k in TARGETS if k != "mean_total_deformation_rate_per_day")
 LABELS = {
@@ -213,7 +217,7 @@ def analyse_run(run: Path, days: float, buffer_m: float, window_days: float = 3.
             "outflow_m3": summary.get("volume_budget", {}).get("outflow_m3"),
             "mean_speed_m_s": mean_speeds(run),
             "median": ws["median"], "min": ws["min"], "max": ws["max"],
-            "median_all_elements": ws["median_all_elements"],
+            "median_all_elements": ws["median_all_elements"], "pooled": ws["pooled"],
             "mean_total_deformation_rate_per_day": ws["median"]["mean_total_deformation_rate_per_day"],
             "rgps_view": {"tracking_error_m": ws["rgps_tracking_error_m"], "cell_m": RGPS_CELL_M,
                           "median": ws["median_rgps"], "median_cells": ws["median_rgps_cells"]},
@@ -803,6 +807,12 @@ def _basin_section(scene: str, b: dict, res: dict, figs: list[Path]) -> list[str
                      f"{_fmt(k, b[r]['max'][GRID_BETA])}]" for r in keys]
             lines.append(f"| {GRID_BETA_LABEL} | as β | {band} | " + " | ".join(cells) + " | "
                          + " | ".join(_inside(k, b[r]["median"][GRID_BETA]) for r in keys) + " |")
+        if k == "beta_space" and all((b[r].get("pooled") or {}).get("beta_space_grids") is not None for r in keys):
+            vals = [b[r]["pooled"]["beta_space_grids"] for r in keys]
+            cells = [f"{_fmt(k, v)} (default grid {_fmt(k, b[r]['pooled']['beta_space'])})"
+                     for v, r in zip(vals, keys)]
+            lines.append(f"| {POOLED_BETA_LABEL} | Marsan et al. 2004; Girard et al. 2011 | {band} | "
+                         + " | ".join(cells) + " | " + " | ".join(_inside(k, v) for v in vals) + " |")
     lines.append("")
     for r in keys:
         x = b[r]
@@ -866,6 +876,11 @@ def headline(res: dict) -> list[str]:
             cells = [_fmt(m, res["basin"][s][k]["median"][GRID_BETA])
                      + (_inside_mark(m, res["basin"][s][k]["median"][GRID_BETA]) or " ✗") for s, k in cols]
             lines.append(f"| {GRID_BETA_LABEL} | {_fmt(m, lo)}–{_fmt(m, hi)} | " + " | ".join(cells) + " |")
+        if m == "beta_space" and all((res["basin"][s][k].get("pooled") or {}).get("beta_space_grids") is not None
+                                     for s, k in cols):
+            vals = [res["basin"][s][k]["pooled"]["beta_space_grids"] for s, k in cols]
+            lines.append(f"| {POOLED_BETA_LABEL} | {_fmt(m, lo)}–{_fmt(m, hi)} | "
+                         + " | ".join(_fmt(m, v) + (_inside_mark(m, v) or " ✗") for v in vals) + " |")
     lo, hi = WIND_FACTOR_BAND
     cells = []
     for s, k in cols:
@@ -1029,11 +1044,43 @@ def analyse_ensemble(physics: Path, days: float, buffer_m: float, basin: dict) -
             members[n] = {"median": a["median"], "remesh_events": a["remesh_events"], "drift_km": a["drift_km"],
                           "rgps_median": a["rgps_view"]["median"], "drift_response": a.get("drift_response"),
                           "windows_" + GRID_BETA: [w["interior"].get(GRID_BETA) for w in a["windows"]],
+                          "window_curves": [{"interior": {k: w["interior"].get(k) for k in
+                                                          ("scaling_space", "scaling_space_grids")}}
+                                            for w in a["windows"]],
+                          "pooled": a.get("pooled"),
                           **{k: a.get(k) for k in ("run_dir", "made_by", "model_code_changed")}}
         out[scene] = {"members": members, "metrics": _member_stats(members, "median"),
                       "rgps_metrics": _member_stats(members, "rgps_median"),
                       "pooled_" + GRID_BETA: pooled_windows(
-                          [m["windows_" + GRID_BETA] for m in members.values()])}
+                          [m["windows_" + GRID_BETA] for m in members.values()]),
+                      "pooled_curve": pooled_months([m["window_curves"] for m in members.values()])}
+    return out
+
+
+def pooled_months(per_month: list) -> dict | None:
+    """β of one curve over every box of every window of every month (default grid, and every grid),
+    as observed β is computed over a winter (:func:`lagice.diagnostics.windows.pooled_window_scaling`),
+    with a 90 % interval from resampling the months with replacement (:data:`POOLED_RESAMPLES`
+    seeded resamples; the month is the unit, as in :func:`pooled_windows`). None if a month's windows
+    lack their curves (records made before 2026-11-30)."""
+    from lagice.diagnostics.windows import pooled_window_scaling
+
+    if not per_month or any(not m or any(w["interior"].get("scaling_space") is None for w in m) for m in per_month):
+        return None
+    every = pooled_window_scaling([w for m in per_month for w in m])
+    rng = np.random.default_rng(POOLED_SEED)
+    picks = rng.integers(0, len(per_month), size=(POOLED_RESAMPLES, len(per_month)))
+    boot = {"beta_space": [], "beta_space_grids": []}
+    for row in picks:
+        r = pooled_window_scaling([w for i in row for w in per_month[i]])
+        for k in boot:
+            boot[k].append(r[k])
+    out = {"n_windows": every["n_windows"], "n_months": len(per_month), "curve": every["curve"]}
+    for k, v in boot.items():
+        v = np.asarray([np.nan if x is None else x for x in v], dtype=np.float64)
+        out[k] = every[k]
+        out[k + "_interval_90"] = (None if every[k] is None or not np.all(np.isfinite(v)) else
+                                   [float(np.quantile(v, 0.05)), float(np.quantile(v, 0.95))])
     return out
 
 
@@ -1160,7 +1207,23 @@ def ensemble_lines(ens: dict) -> list[str]:
             lines += [f"All {pw['n_windows']} windows of the {pw['n_months']} months pooled: the median of β over "
                       f"nine box grids is {pw['median']:.3f}, with a 90 % interval of {a:.3f}–{b:.3f} from "
                       f"resampling the months ({POOLED_RESAMPLES} resamples); the band is {lo}–{hi}.", ""]
+        pc = e.get("pooled_curve")
+        if pc is not None:
+            lo, hi = TARGETS["beta_space"][:2]
+
+            grids = ("" if pc.get("beta_space_grids") is None else
+                     f", and over every box of the nine grids {pc['beta_space_grids']:.3f}"
+                     f"{_interval_text(pc, 'beta_space_grids')}")
+            lines += [f"As observed β is computed (Marsan et al. 2004; Girard et al. 2011): one slope of the mean "
+                      f"over every box of every window of the {pc['n_months']} months, in which the windows that "
+                      f"deform most weigh most, β is {pc['beta_space']:.3f}{_interval_text(pc, 'beta_space')} on "
+                      f"the default box grid{grids}; the band is {lo}–{hi}. Not counted among the six bands.", ""]
     return lines
+
+
+def _interval_text(pooled: dict, key: str) -> str:
+    iv = pooled.get(key + "_interval_90")
+    return "" if iv is None else f" (90 % interval {iv[0]:.3f}–{iv[1]:.3f})"
 
 
 def rgps_view_lines(res: dict) -> list[str]:
@@ -1248,7 +1311,7 @@ def compression_lines(res: dict, figs: dict) -> list[str]:
 
 #: arrays left out of the copy of validation.json kept in docs/figures (the full file
 #: stays in --out)
-BULKY = ("pdf_shear", "pdf_divergence", "scaling_space", "beta_blocks")
+BULKY = ("pdf_shear", "pdf_divergence", "scaling_space", "scaling_space_grids", "beta_blocks", "window_curves")
 
 
 def _drop(obj, keys):

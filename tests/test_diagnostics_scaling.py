@@ -42,6 +42,8 @@ from lagice.diagnostics import (
     fit_power_law,
     grid_averaged_beta,
     lagrangian_velocity_gradients,
+    pooled_spatial_scaling,
+    scaling_curve,
     spatial_scaling,
     temporal_scaling,
     velocity_gradients,
@@ -274,3 +276,78 @@ def test_grid_averaged_beta_bad_grid_count(mesh):
             grid_averaged_beta(rates, n_grids=bad)
     one = grid_averaged_beta(rates, n_grids=1)
     assert one.sd == 0.0 and one.betas.size == 1
+
+
+def test_pooled_curve_is_the_mean_over_every_box_of_every_window(mesh):
+    """Pooling two windows' curves gives, at each width, the mean over the union of their boxes (and
+    at the element scale over the union of their elements), as observed β averages every box of every
+    3-day interval (Marsan et al. 2004); one curve pooled alone is itself."""
+    xy, tri = mesh
+    a = velocity_gradients(xy, tri, slip_line_velocity(xy, S_M, DU))
+    lower = tri[xy[tri].mean(axis=1)[:, 1] < 0.5 * L_M]   # a second window: the lower half of the square
+    b = velocity_gradients(xy, lower, slip_line_velocity(xy, S_M, 3 * DU, alternating=True))
+    spa, spb = spatial_scaling(a, W_M), spatial_scaling(b, W_M)
+    pooled = pooled_spatial_scaling([scaling_curve(spa), scaling_curve(spb)])
+    assert pooled.n_curves == 2
+    assert pooled.mean_total_s[0] == pytest.approx(np.concatenate([a.total_s, b.total_s]).mean(), rel=1e-12)
+    assert pooled.n_boxes[0] == a.total_s.size + b.total_s.size
+    k = 0
+    for ta, tb, sa, sb in zip(spa.coarse.box_total_s, spb.coarse.box_total_s, spa.coarse.box_scale_m,
+                              spb.coarse.box_scale_m):
+        if ta.size == 0 or tb.size == 0:
+            break
+        k += 1
+        assert pooled.mean_total_s[k] == pytest.approx(np.concatenate([ta, tb]).mean(), rel=1e-12)
+        assert pooled.scale_m[k] == pytest.approx(np.concatenate([sa, sb]).mean(), rel=1e-12)
+        assert pooled.n_boxes[k] == ta.size + tb.size
+        assert pooled.fewest_boxes[k] == min(ta.size, tb.size)
+    assert k >= 3
+    alone = pooled_spatial_scaling([scaling_curve(spa)])
+    np.testing.assert_allclose(alone.mean_total_s, spa.mean_total_s, rtol=1e-12)
+    assert alone.fit.exponent == pytest.approx(spa.fit.exponent, abs=1e-12)
+
+
+def test_pooled_beta_follows_the_window_that_deforms_most(mesh):
+    """Same-sense lines (β = 0 at every width) and alternating lines (β = 1 for W >= s), pooled over
+    the widths W >= s: the pooled mean is (Δu_a/s + Δu_b/W)/2, so its slope is that of the analytic
+    mean, near 1 when the alternating window deforms 100 times more and near 0 when it deforms 100
+    times less. The median of the two windows' own β is 0.5 either way."""
+    xy, tri = mesh
+    fit = (0.99 * S_M, 1.01 * L_M)
+
+    def curve(du, alternating):
+        r = velocity_gradients(xy, tri, slip_line_velocity(xy, S_M, du, alternating=alternating))
+        return scaling_curve(spatial_scaling(r, W_M, include_element_scale=False, min_boxes=1), False)
+
+    for du_a, du_b in ((DU, DU), (DU, 100 * DU), (100 * DU, DU)):
+        pooled = pooled_spatial_scaling([curve(du_a, False), curve(du_b, True)], min_boxes=1, fit_range_m=fit)
+        big = W_M >= S_M
+        analytic = 0.5 * (du_a / S_M + du_b / W_M[big])
+        np.testing.assert_allclose(pooled.mean_total_s[big], analytic, rtol=0.02)
+        expected = fit_power_law(W_M[big], analytic).exponent
+        assert pooled.fit.exponent == pytest.approx(expected, abs=0.02)
+        if du_b > du_a:
+            assert pooled.fit.exponent > 0.9
+        elif du_a > du_b:
+            assert pooled.fit.exponent < 0.1
+
+
+def test_pooled_spatial_scaling_refuses_curves_that_do_not_match(mesh):
+    xy, tri = mesh
+    r = velocity_gradients(xy, tri, slip_line_velocity(xy, S_M, DU))
+    c = scaling_curve(spatial_scaling(r, W_M))
+    other_mesh = scaling_curve(spatial_scaling(r, 2 * W_M))
+    with pytest.raises(ConfigError, match="box widths of the curves differ"):
+        pooled_spatial_scaling([c, other_mesh])
+    no_element = scaling_curve(spatial_scaling(r, W_M, include_element_scale=False), False)
+    with pytest.raises(ConfigError, match="1 of 2 curves start with the element scale"):
+        pooled_spatial_scaling([c, no_element])
+    with pytest.raises(ConfigError, match="no curve"):
+        pooled_spatial_scaling([])
+    with pytest.raises(ConfigError, match="not a scaling curve"):
+        pooled_spatial_scaling([{"scale_m": [1.0]}])
+    with pytest.raises(ConfigError, match="lengths"):
+        pooled_spatial_scaling([{**c, "n_boxes": c["n_boxes"][:-1]}])
+    for bad in (0, 2.5, True):
+        with pytest.raises(ConfigError, match="min_boxes"):
+            pooled_spatial_scaling([c], min_boxes=bad)

@@ -84,6 +84,13 @@ def test_windows_of_an_analytic_shear(shear_run):
         assert med == pytest.approx(np.mean(vals), rel=1e-12, abs=1e-15)
         assert res["min"][k] == min(vals) and res["max"][k] == max(vals)
     assert res["median"]["mean_total_s"] == pytest.approx(GAMMA, rel=1e-9)
+    # the curve over every box of both windows (the observations' estimator): a uniform rate is
+    # GAMMA in every box of every grid, so β = 0 pooled too, and the counts add up
+    pooled = res["pooled"]
+    assert pooled["n_windows"] == 2 and pooled["n_grid_curves"] == 2 * w[0]["interior"]["beta_space_grids"]
+    assert abs(pooled["beta_space"]) < 1e-9 and abs(pooled["beta_space_grids"]) < 1e-9
+    np.testing.assert_allclose(pooled["curve"]["mean_total_s"], GAMMA, rtol=1e-9)
+    assert pooled["curve"]["n_boxes"][0] == sum(x["n_elements"] for x in w)
     # a uniform shear rate has no spread: its R² against |divergence| and its PDF tail are
     # undefined in every window (NaN), and the summary says so (None), not a number
     assert all(np.isnan(x["interior"]["shear_divergence_r2"]) for x in w)

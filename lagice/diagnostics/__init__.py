@@ -7,6 +7,8 @@ applies equally to model output and to RGPS-like Lagrangian data:
   per-triangle gradients and invariants (divergence, shear, total; s-1);
 - :func:`coarse_grain`, :func:`spatial_scaling`: ⟨ε̇tot⟩(L) ∝ L^−β (Girard 2010 §3.5);
   :func:`grid_averaged_beta`: β averaged over box grids laid from several corners;
+  :func:`pooled_spatial_scaling`: β of the curve over every box of several windows or grids
+  (the observations' estimator);
 - :func:`temporal_scaling`: ⟨ε̇tot⟩(T) ∝ T^−α;
 - :func:`log_binned_pdf`, :func:`fit_power_law_tail`: PDFs and ML tail exponents;
 - :func:`localisation_area_fraction`, :func:`shear_divergence_r2`;
@@ -28,6 +30,7 @@ from lagice.diagnostics.report import (
 from lagice.diagnostics.scaling import (
     CoarseGraining,
     GridAveragedBeta,
+    PooledScaling,
     PowerLawFit,
     SpatialScaling,
     TemporalScaling,
@@ -35,6 +38,8 @@ from lagice.diagnostics.scaling import (
     default_box_sizes,
     fit_power_law,
     grid_averaged_beta,
+    pooled_spatial_scaling,
+    scaling_curve,
     spatial_scaling,
     temporal_scaling,
 )
@@ -67,7 +72,7 @@ __all__ = [
     "total_deformation_rate", "triangle_geometry", "velocity_gradients",
     "CoarseGraining", "PowerLawFit", "SpatialScaling", "TemporalScaling", "coarse_grain",
     "default_box_sizes", "fit_power_law", "grid_averaged_beta", "GridAveragedBeta", "spatial_scaling",
-    "temporal_scaling",
+    "temporal_scaling", "pooled_spatial_scaling", "PooledScaling", "scaling_curve",
     "LogBinnedPdf", "PowerLawTail", "fit_power_law_tail", "localisation_area_fraction",
     "log_binned_pdf", "shear_divergence_r2",
     "JSON_KEYS", "diagnose_arrays", "summarise", "write_figures", "write_json",

@@ -16,6 +16,7 @@ from lagice.diagnostics.scaling import (
     BETA_GRIDS,
     MIN_FIT_BOXES,
     grid_averaged_beta,
+    scaling_curve,
     spatial_scaling,
     temporal_scaling,
 )
@@ -51,6 +52,8 @@ JSON_KEYS = {
     "beta_space_grid_sd": "standard deviation of β over those grids",
     "beta_space_grids": "number of box grids of beta_space_grid_mean",
     "scaling_space": "{box_size_m, scale_m, mean_total_s, n_boxes} per scale (element scale first, box_size_m null)",
+    "scaling_space_grids": "the same curve on each grid of beta_space_grid_mean (the default one first), for "
+                           "lagice.diagnostics.scaling.pooled_spatial_scaling",
     "min_box_coverage": "minimum covered fraction of a box's W² for it to count",
     "alpha_time": "α of ⟨ε̇tot⟩ ∝ T^−α (null without a position time series)",
     "alpha_time_stderr": "standard error of α",
@@ -186,11 +189,6 @@ def rate_statistics(rates, *, box_sizes_m=None, min_coverage=0.75, fit_range_m=N
                          origin_xy_m=origin_xy_m, min_boxes=min_boxes)
     gb = grid_averaged_beta(rates, beta_grids, 0, sp.coarse.box_size_m, min_coverage, fit_range_m,
                             include_element_scale, min_boxes, origin_xy_m=origin_xy_m, first=sp)
-    box_sizes = list(sp.coarse.box_size_m[np.isfinite(sp.coarse.mean_total_s)])
-    n_boxes = list(sp.coarse.n_boxes[np.isfinite(sp.coarse.mean_total_s)])
-    if include_element_scale:
-        box_sizes = [None] + box_sizes
-        n_boxes = [int(div.size)] + n_boxes
     tail_s = fit_power_law_tail(shear, tail_x_min_shear_s, min_tail)
     tail_d = fit_power_law_tail(np.abs(div), tail_x_min_divergence_s, min_tail)
     dyn = positive("pdf_dynamic_range", pdf_dynamic_range)
@@ -209,8 +207,8 @@ def rate_statistics(rates, *, box_sizes_m=None, min_coverage=0.75, fit_range_m=N
         "beta_space_grid_mean": gb.mean,
         "beta_space_grid_sd": gb.sd,
         "beta_space_grids": int(gb.betas.size),
-        "scaling_space": {"box_size_m": box_sizes, "scale_m": list(sp.scale_m),
-                          "mean_total_s": list(sp.mean_total_s), "n_boxes": [int(n) for n in n_boxes]},
+        "scaling_space": scaling_curve(sp, include_element_scale),
+        "scaling_space_grids": list(gb.curves),
         "min_box_coverage": sp.coarse.min_coverage,
         "pdf_tail_exponent_shear": tail_s.exponent,
         "pdf_tail_exponent_shear_stderr": tail_s.exponent_stderr,

@@ -252,6 +252,7 @@ class SpatialScaling:
     scale_m: np.ndarray
     mean_total_s: np.ndarray
     fit: PowerLawFit
+    n_elements: int = 0
 
 
 MIN_FIT_BOXES = 10
@@ -302,7 +303,7 @@ def spatial_scaling(rates, box_sizes_m=None, min_coverage=0.75, fit_range_m=None
         mean = np.concatenate([[el_mean], mean])
         used = np.concatenate([[rates.total_s.size >= min_boxes], used])
     fit = fit_power_law(scale[used], mean[used], fit_range_m)
-    return SpatialScaling(cg, el_scale, el_mean, scale, mean, fit)
+    return SpatialScaling(cg, el_scale, el_mean, scale, mean, fit, int(rates.total_s.size))
 
 
 #: box grids :func:`grid_averaged_beta` lays by default: the default corner and 8 seeded offsets of it
@@ -321,12 +322,16 @@ class GridAveragedBeta:
         β per grid, the default corner's first (NaN where a grid's fit failed).
     offsets_m : np.ndarray
         (n_grids, 2) shift of each grid's corner from the default corner (m); the first is (0, 0).
+    curves : tuple of dict
+        Each grid's ⟨ε̇tot⟩(L) in the JSON form of :func:`scaling_curve` (the default corner's
+        first), for :func:`pooled_spatial_scaling`.
     """
 
     mean: float
     sd: float
     betas: np.ndarray
     offsets_m: np.ndarray
+    curves: tuple = field(default=(), repr=False)
 
 
 def grid_averaged_beta(rates, n_grids=BETA_GRIDS, seed=0, box_sizes_m=None, min_coverage=0.75,
@@ -385,14 +390,140 @@ def grid_averaged_beta(rates, n_grids=BETA_GRIDS, seed=0, box_sizes_m=None, min_
     rng = np.random.default_rng(seed)
     offsets = np.vstack([[0.0, 0.0], rng.uniform(0.0, widest, size=(int(n_grids) - 1, 2))])
     betas = [first.fit.exponent]
+    curves = [scaling_curve(first, include_element_scale)]
     for off in offsets[1:]:
         sp = spatial_scaling(rates, box_sizes_m, min_coverage, fit_range_m, include_element_scale,
                              origin_xy_m=corner - off, min_boxes=min_boxes)
         betas.append(sp.fit.exponent)
+        curves.append(scaling_curve(sp, include_element_scale))
     betas = np.asarray(betas, dtype=np.float64)
     ok = np.isfinite(betas)
     return GridAveragedBeta(float(betas[ok].mean()) if ok.any() else float("nan"),
-                            float(betas[ok].std()) if ok.any() else float("nan"), betas, offsets)
+                            float(betas[ok].std()) if ok.any() else float("nan"), betas, offsets, tuple(curves))
+
+
+def scaling_curve(sp, include_element_scale=True) -> dict:
+    """A :class:`SpatialScaling`'s ⟨ε̇tot⟩(L) as JSON: ``{"box_size_m", "scale_m", "mean_total_s",
+    "n_boxes"}`` over the box widths that hold a counted box, the element scale first (``box_size_m``
+    None, ``n_boxes`` the number of elements) when ``include_element_scale``. The form of the
+    ``scaling_space`` key of :func:`lagice.diagnostics.summarise`."""
+    ok = np.isfinite(sp.coarse.mean_total_s)
+    sizes = [float(w) for w in sp.coarse.box_size_m[ok]]
+    counts = [int(n) for n in sp.coarse.n_boxes[ok]]
+    if include_element_scale:
+        sizes = [None] + sizes
+        counts = [int(sp.n_elements)] + counts
+    return {"box_size_m": sizes, "scale_m": [float(x) for x in sp.scale_m],
+            "mean_total_s": [float(x) for x in sp.mean_total_s], "n_boxes": counts}
+
+
+
+@dataclass(frozen=True)
+class PooledScaling:
+    """Result of :func:`pooled_spatial_scaling`: one ⟨ε̇tot⟩(L) over every box of several curves.
+
+    Attributes
+    ----------
+    scale_m : ndarray (k,)
+        Scale L per width (m): the box-count-weighted mean of the curves' scales; the element
+        scale first where the curves have it.
+    mean_total_s : ndarray (k,)
+        ⟨ε̇tot⟩ (s-1) over every counted box of every curve at the width.
+    n_boxes : ndarray (k,) int
+        Counted boxes (elements, for the element scale) over all curves.
+    fewest_boxes : ndarray (k,) int
+        The fewest boxes any one curve counts at the width (a width enters the fit only if this
+        is at least ``min_boxes``).
+    n_curves : int
+    fit : PowerLawFit
+        β of the pooled curve (``fit.exponent``).
+    """
+
+    scale_m: np.ndarray
+    mean_total_s: np.ndarray
+    n_boxes: np.ndarray
+    fewest_boxes: np.ndarray
+    n_curves: int
+    fit: PowerLawFit
+
+
+def pooled_spatial_scaling(curves, min_boxes=MIN_FIT_BOXES, fit_range_m=None, width_tolerance=0.25):
+    """β of ⟨ε̇tot⟩(L) averaged over every box of several curves: the observations' estimator.
+
+    Observed β is not a median of single windows' slopes. Marsan et al. (2004) average ε̇tot
+    over every box of width L in the whole basin and every 3-day interval of the period,
+    then fit one slope; Girard et al. (2011) merge the periods of a month into one curve. So
+    the windows (and box grids) that deform most weigh most. Given curves of single windows
+    or grids (:func:`scaling_curve`, the ``scaling_space`` of
+    :func:`lagice.diagnostics.summarise`), the pooled ⟨ε̇tot⟩ at a width is
+    ``Σ n_c ⟨ε̇tot⟩_c / Σ n_c``, the mean over all their counted boxes, and its scale the
+    box-weighted mean of theirs. The element scale is pooled the same way, over elements.
+
+    Parameters
+    ----------
+    curves : sequence of dict
+        ``{"box_size_m", "scale_m", "mean_total_s", "n_boxes"}`` each. Box widths are matched
+        in order (the k-th box width of every curve) over the widths every curve holds; they
+        must agree within ``width_tolerance`` (relative), so curves of different meshes are
+        refused. Either every curve starts with the element scale (``box_size_m`` None) or none.
+    min_boxes : int
+        A width enters the fit only if every curve counts at least this many boxes at it (the
+        rule of each window's own fit, default :data:`MIN_FIT_BOXES`).
+    fit_range_m : (float, float), optional
+        Inclusive range of scales L (m) of the fit.
+
+    Returns
+    -------
+    PooledScaling
+
+    Raises
+    ------
+    ConfigError
+        No curve, a curve with mismatched lists, widths that do not agree, or element scales
+        in some curves only.
+    """
+    if isinstance(min_boxes, bool) or not isinstance(min_boxes, (int, np.integer)) or min_boxes < 1:
+        raise ConfigError(f"min_boxes = {min_boxes!r}; expected an integer >= 1 (boxes per scale in the β fit)")
+    tol = check_range("width_tolerance", width_tolerance, 0.0, None)
+    curves = list(curves)
+    if not curves:
+        raise ConfigError("pooled_spatial_scaling: no curve to pool")
+    rows = []
+    for i, c in enumerate(curves):
+        try:
+            w = list(c["box_size_m"])
+            sc, m, n = (np.asarray(c[k], dtype=np.float64) for k in ("scale_m", "mean_total_s", "n_boxes"))
+        except (KeyError, TypeError) as exc:
+            raise ConfigError(f"pooled_spatial_scaling: curve {i} is not a scaling curve "
+                              "({box_size_m, scale_m, mean_total_s, n_boxes})") from exc
+        if not (len(w) == sc.size == m.size == n.size):
+            raise ConfigError(f"pooled_spatial_scaling: curve {i} has lists of lengths {len(w)}, {sc.size}, "
+                              f"{m.size}, {n.size}; expected one entry per scale in each")
+        rows.append((w, sc, m, n))
+    has_el = [bool(r[0]) and r[0][0] is None for r in rows]
+    if any(has_el) != all(has_el):
+        raise ConfigError(f"pooled_spatial_scaling: {sum(has_el)} of {len(rows)} curves start with the element "
+                          "scale; pool curves made alike (include_element_scale)")
+    el = int(has_el[0])
+    k_common = min(len(r[0]) - el for r in rows)
+    widths = np.array([[float(r[0][el + k]) for k in range(k_common)] for r in rows]).reshape(len(rows), k_common)
+    if k_common and np.any(widths.max(axis=0) > (1.0 + tol) * widths.min(axis=0)):
+        k = int(np.argmax(widths.max(axis=0) / widths.min(axis=0)))
+        raise ConfigError(f"pooled_spatial_scaling: the box widths of the curves differ: width {k} spans "
+                          f"{widths[:, k].min():.4g}-{widths[:, k].max():.4g} m (more than {100 * tol:g} %); "
+                          "curves of different meshes or box sequences cannot be pooled")
+    n_rows = el + k_common
+    sc = np.array([r[1][:n_rows] for r in rows]).reshape(len(rows), n_rows)
+    m = np.array([r[2][:n_rows] for r in rows]).reshape(len(rows), n_rows)
+    n = np.array([r[3][:n_rows] for r in rows]).reshape(len(rows), n_rows)
+    n_tot = n.sum(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.where(n_tot > 0, (n * np.where(n > 0, m, 0.0)).sum(axis=0) / n_tot, np.nan)
+        scale = np.where(n_tot > 0, (n * np.where(n > 0, sc, 0.0)).sum(axis=0) / n_tot, np.nan)
+    fewest = n.min(axis=0)
+    used = fewest >= min_boxes
+    fit = fit_power_law(scale[used], mean[used], fit_range_m)
+    return PooledScaling(scale, mean, n_tot.astype(np.int64), fewest.astype(np.int64), len(rows), fit)
 
 
 _WINDOW_BATCH_ELEMENTS = 1_000_000

@@ -41,8 +41,8 @@ WINDOW_KEYS = ("beta_space", "beta_space_stderr", "beta_space_r2", "beta_space_f
                "pdf_tail_exponent_shear", "pdf_tail_fit_range_shear_s", "pdf_tail_n_shear", "pdf_tail_ks_shear",
                "pdf_tail_exponent_divergence", "pdf_tail_fit_range_divergence_s", "pdf_tail_n_divergence",
                "pdf_tail_ks_divergence", "localisation_half_shear_area_fraction", "shear_divergence_r2",
-               "mean_total_s", "mean_shear_s", "mean_abs_divergence_s", "scaling_space", "pdf_shear",
-               "pdf_divergence", "element_scale_m")
+               "mean_total_s", "mean_shear_s", "mean_abs_divergence_s", "scaling_space", "scaling_space_grids",
+               "pdf_shear", "pdf_divergence", "element_scale_m")
 #: the per-window keys kept for the RGPS view (:data:`WINDOW_KEYS` without the PDFs)
 RGPS_WINDOW_KEYS = tuple(k for k in WINDOW_KEYS if k not in ("pdf_shear", "pdf_divergence"))
 
@@ -258,7 +258,8 @@ def window_statistics(run_dir, window_days: float = 3.0, coast_buffer_km: float 
     "n_elements_folded", "n_interior_folded" (summed over the windows: elements left out because
     their mid-window geometry is inverted, :func:`window_arrays`),
     "median", "min", "max": {metric: value over the windows, interior elements},
-    "median_all_elements": {metric: median, all elements}}``. A window in which
+    "median_all_elements": {metric: median, all elements}, "pooled": β of the interior's curve
+    pooled over every box of every window (:func:`pooled_window_scaling`)}``. A window in which
     remeshing replaced (nearly) all the elements cannot be followed: it is listed
     in ``skipped`` with the reason, not in ``windows``. A metric that is NaN in some
     windows is summarised over the others (``None`` if NaN in all)."""
@@ -286,9 +287,38 @@ def window_statistics(run_dir, window_days: float = 3.0, coast_buffer_km: float 
            "n_elements_folded": int(sum(w["n_elements_folded"] for w in windows)),
            "n_interior_folded": int(sum(w["n_interior_folded"] for w in windows)),
            "median": over(np.median, "interior"), "min": over(np.min, "interior"),
-           "max": over(np.max, "interior"), "median_all_elements": over(np.median, "all")}
+           "max": over(np.max, "interior"), "median_all_elements": over(np.median, "all"),
+           "pooled": pooled_window_scaling(windows)}
     if rgps_tracking_error_m is not None:
         out["rgps_tracking_error_m"] = float(rgps_tracking_error_m)
         out["median_rgps"] = over(np.median, "rgps")
         out["median_rgps_cells"] = over(np.median, "rgps_cells")
     return out
+
+
+def pooled_window_scaling(windows, part: str = "interior") -> dict:
+    """β of ⟨ε̇tot⟩(L) over every box of every window, as observed β is computed (Marsan et al.
+    2004; Girard et al. 2011; :func:`lagice.diagnostics.scaling.pooled_spatial_scaling`): the
+    windows that deform most weigh most, where the median of the windows' own β weighs a locked
+    window as much as a storm.
+
+    ``windows``: per-window dicts of :func:`window_summary` (or records with their ``part``'s
+    ``scaling_space`` and ``scaling_space_grids``), of one run or of several runs of one mesh.
+    Returns ``{"n_windows", "beta_space" (the default box grid), "beta_space_fit_range_m",
+    "curve": {"scale_m", "mean_total_s", "n_boxes"}, "beta_space_grids" (every box of
+    every grid of every window; None where a window lacks its grids' curves), "n_grid_curves"}``."""
+    from lagice.diagnostics.scaling import pooled_spatial_scaling
+
+    windows = list(windows)
+    if not windows:
+        raise ConfigError("pooled_window_scaling: no window")
+    one = pooled_spatial_scaling([w[part]["scaling_space"] for w in windows])
+    grids = [w[part].get("scaling_space_grids") for w in windows]
+    every = None if any(not g for g in grids) else pooled_spatial_scaling([c for g in grids for c in g])
+    return {"n_windows": len(windows), "beta_space": one.fit.exponent,
+            "beta_space_fit_range_m": list(one.fit.fit_range),
+            "curve": {"scale_m": [float(x) for x in one.scale_m],
+                              "mean_total_s": [float(x) for x in one.mean_total_s],
+                              "n_boxes": [int(n) for n in one.n_boxes]},
+            "beta_space_grids": None if every is None else every.fit.exponent,
+            "n_grid_curves": 0 if every is None else every.n_curves}
