@@ -3451,6 +3451,15 @@ for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,)))
 # window median, not counted among the six bands, whatever it shows; the issue defines beta's band on the median of
 # windows, and that stays the headline's key. If the pooled beta lands inside the band in both basins, the docs say the
 # observations' own estimator puts the flagship there while the issue's does not.
+# Result (PC) (2026-11-30, 15:05 UTC): all three hold, as predicted. Window median / pooled, default grid / pooled,
+# nine grids (docs/figures/beta_pooled.json): closed months 2026 0.082/0.112/0.086, 2027 0.043/0.054/0.051, 2028
+# 0.042/0.015/0.037, 2029 0.005/0.045/0.037, 2030 0.039/0.041/0.057, 2031 0.064/0.070/0.064, 2032 0.063/0.070/0.068,
+# 2033 0.046/0.051/0.052; strait 0.035/0.112/0.091, 0.048/0.053/0.050, 0.046/0.022/0.048, 0.024/0.039/0.027,
+# 0.040/0.046/0.067, 0.071/0.064/0.056, 0.052/0.070/0.065, 0.041/0.046/0.053. PC1: pooled above the median in 13 of
+# 16 (not in the calm month 2028 in either basin, nor the strait's 2031). PC2: all 72 windows pooled 0.063 closed and
+# 0.061 strait (nine grids 0.060, 0.059). PC3: EVP 0.060/0.056 closed, 0.060/0.067 strait. The observations'
+# estimator lifts the flagship's beta by about 0.01 over eight months (0.11 in the validation month) and leaves it
+# 0.11 below the band.
 
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
