@@ -1147,3 +1147,32 @@ def test_pooled_windows_resamples_months_not_windows():
     assert mixed["interval_90"][1] - mixed["interval_90"][0] < hi - lo
     assert validate.pooled_windows([[0.1, None], [0.2, 0.3]]) is None
     assert validate.pooled_windows([]) is None
+
+
+def test_pooled_months_pool_every_box_and_resample_months():
+    """validate.pooled_months: β of one curve over every box of every window of every month (the
+    observations' estimator), with a 90 % interval from resampling months. Months that fall as L^−b
+    with the same b give b and no spread, whatever their rates; a calm month and a storm month with
+    different b give the storm's b nearly (the storm weighs most), inside the interval; a month
+    without curves gives None."""
+    import validate
+
+    widths = [10e3, 20e3, 40e3, 80e3]
+
+    def window(rate, b, n=40):
+        curve = {"box_size_m": [None] + widths, "scale_m": [5e3] + widths,
+                 "mean_total_s": [rate * (s / 5e3) ** -b for s in [5e3] + widths],
+                 "n_boxes": [n * 16] + [max(n // 4 ** k, 10) for k in range(4)]}
+        return {"interior": {"scaling_space": curve, "scaling_space_grids": [curve, curve]}}
+
+    same = validate.pooled_months([[window(1e-7, 0.2)] * 3, [window(1e-9, 0.2)] * 3])
+    assert same["beta_space"] == pytest.approx(0.2, abs=1e-9)
+    assert same["beta_space_grids"] == pytest.approx(0.2, abs=1e-9)
+    assert same["beta_space_interval_90"] == pytest.approx([0.2, 0.2], abs=1e-9)
+    assert same["n_windows"] == 6 and same["n_months"] == 2
+    mixed = validate.pooled_months([[window(1e-7, 0.2)] * 3, [window(1e-10, 0.0)] * 3])
+    assert 0.19 < mixed["beta_space"] < 0.2
+    lo, hi = mixed["beta_space_interval_90"]
+    assert 0.0 <= lo <= mixed["beta_space"] <= hi <= 0.2 + 1e-9
+    assert validate.pooled_months([[window(1e-7, 0.2)], [{"interior": {"scaling_space": None}}]]) is None
+    assert validate.pooled_months([]) is None
