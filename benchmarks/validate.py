@@ -99,7 +99,7 @@ GRID_BETA_LABEL = "β, mean over 9 box grids (not counted)"
 #: β as observed β is computed (Marsan et al. 2004; Girard et al. 2011): one slope of the mean over every box of
 #: every window (and of the nine grids), where the windows that deform most weigh most
 #: (lagice.diagnostics.windows.pooled_window_scaling); reported next to β, not counted among the six bands
-POOLED_BETA_LABEL = "β of one curve over every box of every window and 9 grids, as observed β is computed (not counted)"
+POOLED_BETA_LABEL = "β, one curve over every box of every window and grid (as observed β is computed; not counted)"
 #: metrics window_statistics computes (the rate is its mean_total_s, converted to day⁻¹)
 WINDOW_TARGETS = tuple(k for k in TARGETS if k != "mean_total_deformation_rate_per_day")
 LABELS = {
