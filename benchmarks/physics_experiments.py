@@ -3461,6 +3461,16 @@ for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,)))
 # estimator lifts the flagship's beta by about 0.01 over eight months (0.11 in the validation month) and leaves it
 # 0.11 below the band.
 
+# Written 2026-11-30 15:07 UTC, before its analysis (no new runs): does beta's fall from 40 and 20 km to 10 km survive
+# the observations' estimator (rule PC's pooled curve)? The energy + P_max family's validation month, closed basin, at
+# C_lab x3 and x4 on three meshes (B40-hthick-eng-P-C3-m40, B40-hthick-eng-P-C4-m40, B20-hthick-eng-P-C3-m20,
+# B20-hthick-eng-P-C4-m20, F10-hthick-eng-P-C3, F10-hthick-eng-P-C4), and the effective envelope's validation month at
+# 10 km (F10[s]-hthick-eff-m10), pooled over nine grids.
+# (PF)  the fall survives if, at each factor, the 10 km pooled beta lies 0.03 or more below the 20 km one; it goes if it
+#       lies within 0.01 of it or above.
+# (PE)  the effective envelope's month stays inside the band (0.17-0.20, within 0.02 of its edges) in both basins.
+# Predicted: PF survives at both factors (10 km 0.09-0.13, 20 km 0.14-0.19); PE holds.
+
 def command(scene, overrides, res, days, out) -> list:
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
