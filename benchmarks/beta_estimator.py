@@ -161,6 +161,7 @@ def pooled_table(names: list, out: dict) -> None:
     """Rule PC: per run the window median of β (default grid) and β of one curve over every box of
     every window (default grid; every grid), then the same over every window of all the runs."""
     from lagice.diagnostics.windows import pooled_window_scaling, window_statistics
+    from lagice.errors import ConfigError
 
     print("\nβ as the window median and as one curve over every box of every window (rule PC):")
     print("| run | window median, default grid | pooled, default grid | pooled, nine grids |")
@@ -173,10 +174,14 @@ def pooled_table(names: list, out: dict) -> None:
         pc = ws["pooled"]
         out[name]["pooled"] = {"window_median": ws["median"]["beta_space"], "beta_space": pc["beta_space"],
                                "beta_space_grids": pc["beta_space_grids"]}
-        print(f"| {name} | {ws['median']['beta_space']:.3f} | {pc['beta_space']:.3f} | "
-              f"{pc['beta_space_grids']:.3f} |", flush=True)
+        print(f"| {name} | {ws['median']['beta_space']:.4f} | {pc['beta_space']:.4f} | "
+              f"{pc['beta_space_grids']:.4f} |", flush=True)
     if len(names) > 1:
-        pc = pooled_window_scaling(every)
+        try:
+            pc = pooled_window_scaling(every)
+        except ConfigError as e:   # runs on different meshes: their box widths differ, nothing to pool
+            print(f"(the runs are not pooled together: {e})")
+            return
         out["_pooled_over_runs"] = {"runs": list(names), "beta_space": pc["beta_space"],
                                     "beta_space_grids": pc["beta_space_grids"], "n_windows": pc["n_windows"]}
         print(f"| all {len(names)} runs, {pc['n_windows']} windows | | {pc['beta_space']:.3f} | "
