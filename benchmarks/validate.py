@@ -987,14 +987,16 @@ def write_report(res: dict, md: Path, figs: dict):
                             for c in {json.dumps(r["carried_from"], sort_keys=True): r["carried_from"]
                                       for r in res["sensitivity"].values() if r.get("carried_from")}.values()),
                   "", "| run | " + " | ".join(LABELS[k] for k in TARGETS)
-                  + f" | {GRID_BETA_LABEL} | remesh events | mean speed (m s⁻¹) |",
-                  "|---|" + "---|" * (len(TARGETS) + 3)]
+                  + f" | {GRID_BETA_LABEL} | {POOLED_BETA_LABEL} | remesh events | mean speed (m s⁻¹) |",
+                  "|---|" + "---|" * (len(TARGETS) + 4)]
         for n, r in res["sensitivity"].items():
             gb = r["median"].get(GRID_BETA)
+            pb = (r.get("pooled") or {}).get("beta_space_grids")
             lines.append(f"| {r.get('label', SENSITIVITY[n][2])}{' †' if r.get('carried_from') else ''} | "
                          + " | ".join(
                 f"{_fmt(k, r['median'][k])} ({_inside(k, r['median'][k])})" for k in TARGETS)
                 + (" | –" if gb is None else f" | {_fmt('beta_space', gb)}")
+                + (" | –" if pb is None else f" | {_fmt('beta_space', pb)}")
                 + f" | {r['remesh_events']} | {np.mean(r['mean_speed_m_s'][1:]):.2g} |")
         lines.append("")
     lines += ensemble_lines(res.get("weather_ensemble") or {})
