@@ -220,7 +220,8 @@ def analyse_run(run: Path, days: float, buffer_m: float, window_days: float = 3.
             "median_all_elements": ws["median_all_elements"], "pooled": ws["pooled"],
             "mean_total_deformation_rate_per_day": ws["median"]["mean_total_deformation_rate_per_day"],
             "rgps_view": {"tracking_error_m": ws["rgps_tracking_error_m"], "cell_m": RGPS_CELL_M,
-                          "median": ws["median_rgps"], "median_cells": ws["median_rgps_cells"]},
+                          "median": ws["median_rgps"], "median_cells": ws["median_rgps_cells"],
+                          "pooled": ws["pooled_rgps"], "pooled_cells": ws["pooled_rgps_cells"]},
             "resolution_m": run_resolution_m(run), "run_command": cfg.get("command"), "run_dir": str(run),
             "drift_km": drift_km(run, days), "drift_response": drift_response(run), **reuse_notice(run)}
 
@@ -1252,6 +1253,15 @@ def rgps_view_lines(res: dict) -> list[str]:
             cells.append(" / ".join(_fmt(m, v) + _inside_mark(m, v) for v in
                                     (r["median"][m], r["rgps_view"]["median_cells"][m], r["rgps_view"]["median"][m])))
         lines.append(f"| {LABELS[m]} | {_fmt(m, lo)}–{_fmt(m, hi)} | " + " | ".join(cells) + " |")
+        if m == "beta_space" and all(res["basin"][sc][k].get("pooled")
+                                     and res["basin"][sc][k]["rgps_view"].get("pooled") for sc, k in cols):
+            cells = []
+            for sc, k in cols:
+                r = res["basin"][sc][k]
+                vals = (r["pooled"]["beta_space_grids"], r["rgps_view"]["pooled_cells"]["beta_space_grids"],
+                        r["rgps_view"]["pooled"]["beta_space_grids"])
+                cells.append(" / ".join(_fmt(m, v) + _inside_mark(m, v) for v in vals))
+            lines.append(f"| {POOLED_BETA_LABEL} | {_fmt(m, lo)}–{_fmt(m, hi)} | " + " | ".join(cells) + " |")
     lines.append("")
     ens = res.get("weather_ensemble") or {}
     if any("rgps_metrics" in e for e in ens.values()):

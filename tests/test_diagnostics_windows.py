@@ -175,6 +175,10 @@ def test_window_statistics_as_rgps_would_see_them(shear_run):
         assert w["rgps"]["mean_total_s"] > w["rgps_cells"]["mean_total_s"]
     assert res["median_rgps_cells"]["mean_total_s"] == pytest.approx(GAMMA, rel=1e-9)
     assert res["rgps_tracking_error_m"] == 100.0
+    # the pooled curve on the cells: a uniform rate has β = 0 without error; the error adds rate at the
+    # cell scale that cancels in larger boxes, so β > 0 with it
+    assert abs(res["pooled_rgps_cells"]["beta_space_grids"]) < 1e-9
+    assert res["pooled_rgps"]["beta_space_grids"] > 0.0
     # the model part is unchanged by asking for the operator
     plain = window_statistics(shear_run, window_days=3.0, coast_buffer_km=60.0, start_day=1.0)
     assert plain["median"] == res["median"]

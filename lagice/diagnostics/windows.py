@@ -251,7 +251,8 @@ def window_statistics(run_dir, window_days: float = 3.0, coast_buffer_km: float 
         keep_arrays: keep the element maps of each window (see :func:`window_summary`).
         rgps_tracking_error_m, rgps_seed: also the statistics as RGPS would see them
             (see :func:`window_summary`), summarised as ``median_rgps`` (with the
-            tracking error) and ``median_rgps_cells`` (the same cells without it).
+            tracking error) and ``median_rgps_cells`` (the same cells without it), and
+            ``pooled_rgps``, ``pooled_rgps_cells`` (:func:`pooled_window_scaling` on those cells).
 
     Returns ``{"window_days", "coast_buffer_km", "start_day", "windows": [per-window
     dicts of :func:`window_summary`], "skipped": [{"start_day", "end_day", "reason"}],
@@ -293,6 +294,8 @@ def window_statistics(run_dir, window_days: float = 3.0, coast_buffer_km: float 
         out["rgps_tracking_error_m"] = float(rgps_tracking_error_m)
         out["median_rgps"] = over(np.median, "rgps")
         out["median_rgps_cells"] = over(np.median, "rgps_cells")
+        out["pooled_rgps"] = pooled_window_scaling(windows, "rgps")
+        out["pooled_rgps_cells"] = pooled_window_scaling(windows, "rgps_cells")
     return out
 
 
