@@ -317,7 +317,7 @@ def test_pooled_beta_follows_the_window_that_deforms_most(mesh):
 
     def curve(du, alternating):
         r = velocity_gradients(xy, tri, slip_line_velocity(xy, S_M, du, alternating=alternating))
-        return scaling_curve(spatial_scaling(r, W_M, include_element_scale=False, min_boxes=1), False)
+        return scaling_curve(spatial_scaling(r, W_M, include_element_scale=False, min_boxes=1))
 
     for du_a, du_b in ((DU, DU), (DU, 100 * DU), (100 * DU, DU)):
         pooled = pooled_spatial_scaling([curve(du_a, False), curve(du_b, True)], min_boxes=1, fit_range_m=fit)
@@ -339,7 +339,7 @@ def test_pooled_spatial_scaling_refuses_curves_that_do_not_match(mesh):
     other_mesh = scaling_curve(spatial_scaling(r, 2 * W_M))
     with pytest.raises(ConfigError, match="box widths of the curves differ"):
         pooled_spatial_scaling([c, other_mesh])
-    no_element = scaling_curve(spatial_scaling(r, W_M, include_element_scale=False), False)
+    no_element = scaling_curve(spatial_scaling(r, W_M, include_element_scale=False))
     with pytest.raises(ConfigError, match="1 of 2 curves start with the element scale"):
         pooled_spatial_scaling([c, no_element])
     with pytest.raises(ConfigError, match="no curve"):

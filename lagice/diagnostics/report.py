@@ -207,7 +207,7 @@ def rate_statistics(rates, *, box_sizes_m=None, min_coverage=0.75, fit_range_m=N
         "beta_space_grid_mean": gb.mean,
         "beta_space_grid_sd": gb.sd,
         "beta_space_grids": int(gb.betas.size),
-        "scaling_space": scaling_curve(sp, include_element_scale),
+        "scaling_space": scaling_curve(sp),
         "scaling_space_grids": list(gb.curves),
         "min_box_coverage": sp.coarse.min_coverage,
         "pdf_tail_exponent_shear": tail_s.exponent,

@@ -390,32 +390,31 @@ def grid_averaged_beta(rates, n_grids=BETA_GRIDS, seed=0, box_sizes_m=None, min_
     rng = np.random.default_rng(seed)
     offsets = np.vstack([[0.0, 0.0], rng.uniform(0.0, widest, size=(int(n_grids) - 1, 2))])
     betas = [first.fit.exponent]
-    curves = [scaling_curve(first, include_element_scale)]
+    curves = [scaling_curve(first)]
     for off in offsets[1:]:
         sp = spatial_scaling(rates, box_sizes_m, min_coverage, fit_range_m, include_element_scale,
                              origin_xy_m=corner - off, min_boxes=min_boxes)
         betas.append(sp.fit.exponent)
-        curves.append(scaling_curve(sp, include_element_scale))
+        curves.append(scaling_curve(sp))
     betas = np.asarray(betas, dtype=np.float64)
     ok = np.isfinite(betas)
     return GridAveragedBeta(float(betas[ok].mean()) if ok.any() else float("nan"),
                             float(betas[ok].std()) if ok.any() else float("nan"), betas, offsets, tuple(curves))
 
 
-def scaling_curve(sp, include_element_scale=True) -> dict:
+def scaling_curve(sp) -> dict:
     """A :class:`SpatialScaling`'s ⟨ε̇tot⟩(L) as JSON: ``{"box_size_m", "scale_m", "mean_total_s",
     "n_boxes"}`` over the box widths that hold a counted box, the element scale first (``box_size_m``
-    None, ``n_boxes`` the number of elements) when ``include_element_scale``. The form of the
+    None, ``n_boxes`` the number of elements) where the scaling includes it. The form of the
     ``scaling_space`` key of :func:`lagice.diagnostics.summarise`."""
     ok = np.isfinite(sp.coarse.mean_total_s)
     sizes = [float(w) for w in sp.coarse.box_size_m[ok]]
     counts = [int(n) for n in sp.coarse.n_boxes[ok]]
-    if include_element_scale:
+    if sp.scale_m.size == len(sizes) + 1:   # the element scale comes first
         sizes = [None] + sizes
         counts = [int(sp.n_elements)] + counts
     return {"box_size_m": sizes, "scale_m": [float(x) for x in sp.scale_m],
             "mean_total_s": [float(x) for x in sp.mean_total_s], "n_boxes": counts}
-
 
 
 @dataclass(frozen=True)
