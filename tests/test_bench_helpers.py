@@ -1176,3 +1176,31 @@ def test_pooled_months_pool_every_box_and_resample_months():
     assert 0.0 <= lo <= mixed["beta_space"] <= hi <= 0.2 + 1e-9
     assert validate.pooled_months([[window(1e-7, 0.2)], [{"interior": {"scaling_space": None}}]]) is None
     assert validate.pooled_months([]) is None
+
+
+def test_a_clean_reproduction_names_the_code_of_a_run_made_from_a_modified_tree(tmp_path):
+    """validate.reuse_notice: a run made from a modified work tree (its files recorded, none of them
+    model code) and made again bit for bit from a clean checkout is attributed to the clean commit,
+    the first maker kept as made_first_by; a reproduction that is no cleaner leaves the first maker."""
+    import json
+
+    from validate import reuse_notice
+
+    from lagice.io.cf import git_commit
+
+    head = git_commit().removesuffix("-dirty")
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "lagice_run.json").write_text(json.dumps({"git_commit": head + "-dirty",
+                                                     "git_modified_files": ["README.md"]}))
+    (run / "reproduced.json").write_text(json.dumps({"max_abs_difference": 0.0, "reproduced_by": head,
+                                                     "modified_files": []}))
+    got = reuse_notice(run)
+    assert got["made_by"] == head and got["made_first_by"] == head + "-dirty"
+    assert isinstance(got["model_code_changed"], list)   # the code that made it is known
+    (run / "reproduced.json").write_text(json.dumps({"max_abs_difference": 0.0, "reproduced_by": head + "-dirty",
+                                                     "modified_files": ["docs/x.md"]}))
+    assert reuse_notice(run)["made_by"] == head + "-dirty"
+    (run / "reproduced.json").write_text(json.dumps({"max_abs_difference": 1e-9, "reproduced_by": head,
+                                                     "modified_files": []}))
+    assert reuse_notice(run)["made_by"] == head + "-dirty"   # not the same run: not a reproduction
