@@ -354,10 +354,10 @@ def reuse_notice(run: Path) -> dict:
     if rep is not None and rep.get("max_abs_difference") == 0:
         again = model_code_changes(rep.get("reproduced_by"), rep.get("modified_files"))
         # the reproduction names the code when it is closer to this commit's, or as close and made from a
-        # clean checkout where the first run was made from a modified work tree
-        cleaner = (str(by).endswith("-dirty") and not str(rep.get("reproduced_by")).endswith("-dirty"))
+        # clean checkout (the newer record, and no modified work tree to explain)
+        clean = not str(rep.get("reproduced_by")).endswith("-dirty")
         if again is not None and (changed is None or len(again) < len(changed)
-                                  or (len(again) == len(changed) and cleaner)):
+                                  or (len(again) == len(changed) and clean)):
             print(f"validate: {run.name}: made by {str(by)[:10]}, reproduced bit for bit by "
                   f"{str(rep['reproduced_by'])[:10]} on {rep.get('date')}", flush=True)
             made, by, changed = by, rep["reproduced_by"], again

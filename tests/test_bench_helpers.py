@@ -1181,7 +1181,8 @@ def test_pooled_months_pool_every_box_and_resample_months():
 def test_a_clean_reproduction_names_the_code_of_a_run_made_from_a_modified_tree(tmp_path):
     """validate.reuse_notice: a run made from a modified work tree (its files recorded, none of them
     model code) and made again bit for bit from a clean checkout is attributed to the clean commit,
-    the first maker kept as made_first_by; a reproduction that is no cleaner leaves the first maker."""
+    the first maker kept as made_first_by; a reproduction from a modified tree, or one that differs,
+    leaves the first maker."""
     import json
 
     from validate import reuse_notice
