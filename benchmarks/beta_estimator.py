@@ -57,10 +57,12 @@ DEFAULT_RUNS = ("F10", "F10s", "F10-w2027", "F10-heal-K50-w2027", "B20", "B20x2"
 
 def run_estimates(run_dir: Path, window_days: float = 3.0, start_day: float = 1.0,
                   coast_buffer_m: float = 100e3) -> dict:
-    """Per-window β for several minimum box counts, and their medians over the windows."""
-    rows = []
+    """Per-window β for several minimum box counts, and their medians over the windows (``_interiors``:
+    each window's interior statistics, for :func:`pooled_table`; not JSON)."""
+    rows, interiors = [], []
     for s0 in window_starts_days(run_dir, window_days, start_day):
         s = window_summary(run_dir, s0 * DAY_S, window_days * DAY_S, coast_buffer_m)["interior"]
+        interiors.append(s)
         sc = s["scaling_space"]
         scale = np.asarray(sc["scale_m"], float)
         mean = np.asarray(sc["mean_total_s"], float)
@@ -86,7 +88,7 @@ def run_estimates(run_dir: Path, window_days: float = 3.0, start_day: float = 1.
     keys = [k for k in rows[0] if k not in ("start_day", "scales_km", "n_boxes", "fit_widths_km",
                                             "rate_per_day_by_width")]
     return {"windows": rows, "median": {k: float(np.median([r[k] for r in rows])) for k in keys},
-            "curve": pooled_curve(rows)}
+            "curve": pooled_curve(rows), "_interiors": interiors}
 
 
 #: the range [m] of the --origins offsets of the box grid's corner: the widest width fitted in the basin
@@ -157,25 +159,25 @@ def uniform_mode(run_dir: Path, window_days: float = 3.0, start_day: float = 1.0
                                         for k in ("beta_grid_mean", "beta_grid_mean_less_uniform")}}
 
 
-def pooled_table(names: list, out: dict) -> None:
-    """Rule PC: per run the window median of β (default grid) and β of one curve over every box of
+def pooled_table(interiors: dict, out: dict) -> None:
+    """Rule PC: per run (``interiors``: run name → its windows' interior statistics, from
+    :func:`run_estimates`) the window median of β (default grid) and β of one curve over every box of
     every window (default grid; every grid), then the same over every window of all the runs."""
-    from lagice.diagnostics.windows import pooled_window_scaling, window_statistics
+    from lagice.diagnostics.windows import pooled_window_scaling
     from lagice.errors import ConfigError
 
     print("\nβ as the window median and as one curve over every box of every window (rule PC):")
     print("| run | window median, default grid | pooled, default grid | pooled, nine grids |")
     print("|---|---|---|---|")
-    every = []
+    names, every = list(interiors), []
     for name in names:
-        ws = window_statistics(RUNS / name, window_days=3.0, coast_buffer_km=100.0, start_day=1.0,
-                               metrics=("beta_space",))
-        every += ws["windows"]
-        pc = ws["pooled"]
-        out[name]["pooled"] = {"window_median": ws["median"]["beta_space"], "beta_space": pc["beta_space"],
+        windows = [{"interior": i} for i in interiors[name]]
+        every += windows
+        pc = pooled_window_scaling(windows)
+        median = float(np.median([i["beta_space"] for i in interiors[name]]))
+        out[name]["pooled"] = {"window_median": median, "beta_space": pc["beta_space"],
                                "beta_space_grids": pc["beta_space_grids"]}
-        print(f"| {name} | {ws['median']['beta_space']:.4f} | {pc['beta_space']:.4f} | "
-              f"{pc['beta_space_grids']:.4f} |", flush=True)
+        print(f"| {name} | {median:.4f} | {pc['beta_space']:.4f} | {pc['beta_space_grids']:.4f} |", flush=True)
     if len(names) > 1:
         try:
             pc = pooled_window_scaling(every)
@@ -235,8 +237,10 @@ def main(argv=None):
     print("| run | β, every width | β, ≥ 4 boxes | β, ≥ 10 boxes | β, ≥ 10 boxes, widths ≥ 10 km "
           "| widest width with ≥ 10 boxes (km) | ⟨ε̇tot⟩ element / widest |")
     print("|---|---|---|---|---|---|---|")
+    interiors = {}
     for name in args.runs:
         r = run_estimates(RUNS / name)
+        interiors[name] = r.pop("_interiors")
         out[name] = r
         m = r["median"]
         print(f"| {name} | {m['beta_min_boxes_1']:.3f} | {m['beta_min_boxes_4']:.3f} | "
@@ -260,7 +264,7 @@ def main(argv=None):
             print(f"| {name} | {b[0]:.3f} | {min(b[1:]):.3f} – {max(b[1:]):.3f} | {o['span']:.3f} |", flush=True)
         args.json.write_text(json.dumps(out, indent=1, allow_nan=True) + "\n")
     if args.pooled:
-        pooled_table(args.runs, out)
+        pooled_table(interiors, out)
         args.json.write_text(json.dumps(out, indent=1, allow_nan=True) + "\n")
     if args.uniform_mode:
         print("\nβ over nine box grids (window median), as it is and less the interior's uniform part (rule UM):")

@@ -23,6 +23,7 @@ import math
 
 import numpy as np
 
+from lagice.diagnostics.scaling import pooled_spatial_scaling
 from lagice.errors import ConfigError, LagiceError
 
 DAY_S = 86400.0
@@ -310,8 +311,6 @@ def pooled_window_scaling(windows, part: str = "interior") -> dict:
     Returns ``{"n_windows", "beta_space" (the default box grid), "beta_space_fit_range_m",
     "curve": {"scale_m", "mean_total_s", "n_boxes"}, "beta_space_grids" (every box of
     every grid of every window; None where a window lacks its grids' curves), "n_grid_curves"}``."""
-    from lagice.diagnostics.scaling import pooled_spatial_scaling
-
     windows = list(windows)
     if not windows:
         raise ConfigError("pooled_window_scaling: no window")
@@ -321,7 +320,7 @@ def pooled_window_scaling(windows, part: str = "interior") -> dict:
     return {"n_windows": len(windows), "beta_space": one.fit.exponent,
             "beta_space_fit_range_m": list(one.fit.fit_range),
             "curve": {"scale_m": [float(x) for x in one.scale_m],
-                              "mean_total_s": [float(x) for x in one.mean_total_s],
-                              "n_boxes": [int(n) for n in one.n_boxes]},
+                      "mean_total_s": [float(x) for x in one.mean_total_s],
+                      "n_boxes": [int(n) for n in one.n_boxes]},
             "beta_space_grids": None if every is None else every.fit.exponent,
             "n_grid_curves": 0 if every is None else every.n_curves}
