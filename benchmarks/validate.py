@@ -1217,7 +1217,6 @@ def ensemble_lines(ens: dict) -> list[str]:
         pc = e.get("pooled_curve")
         if pc is not None:
             lo, hi = TARGETS["beta_space"][:2]
-
             grids = ("" if pc.get("beta_space_grids") is None else
                      f", and over every box of the nine grids {pc['beta_space_grids']:.3f}"
                      f"{_interval_text(pc, 'beta_space_grids')}")
