@@ -3503,6 +3503,16 @@ add_month_own_spinup("src-m10", SOURCED, "neXtSIM's ocean turning angle (25°) a
 add_weather_ensemble("src-m10", SOURCED + from_spinup("H1125-src-m10"),
                      "with neXtSIM's turning angle and lead-closing thickness",
                      "neXtSIM's turning angle and hnull", ENSEMBLE_SEEDS + MORE_SEEDS, suffix=", eight months")
+# If NS holds, the controls the validation reads are made again with the same two values (defined before the numbers):
+EXPERIMENTS["E10h-src-m10"] = ("closed", SOURCED + from_spinup("H1125-src-m10") + EVP, 10e3, 28,
+                               "EVP control with neXtSIM's turning angle and lead-closing thickness")
+EXPERIMENTS["E10hs-src-m10"] = ("strait", SOURCED + from_spinup("H1125-src-m10") + EVP, 10e3, 28,
+                                "EVP control, strait, with neXtSIM's turning angle and lead-closing thickness")
+for _key, _lo, _hi, _what in SENSITIVITY_CHANGES:
+    for _sign, _change in (("-50", _lo), ("+50", _hi)):
+        EXPERIMENTS[f"X10h-{_key}{_sign}-src-m10"] = (
+            "closed", SOURCED + from_spinup("H1125-src-m10") + [_change], 10e3, 28,
+            f"{_what} {_sign.replace('-', '−')} %, 10 km, with neXtSIM's turning angle and lead-closing thickness")
 
 
 def paired_band_moves(candidate: list, reference: list, records: dict, draws: int = 2000, seed: int = 0) -> dict:
@@ -3524,6 +3534,43 @@ def paired_band_moves(candidate: list, reference: list, records: dict, draws: in
                          for i in idx])
         lo, hi = (float(q) for q in np.quantile(boot, [0.05, 0.95]))
         out[k] = {"move": float(move), "lo": lo, "hi": hi, "worse": bool(lo > 0.0)}
+    return out
+
+
+def paired_report(candidate: str, reference: str) -> dict:
+    """Print :func:`paired_band_moves` of two groups of :data:`ENSEMBLES` (members paired in
+    order, i.e. by wind seed), with each group's medians and, where ``drift_response.json``
+    has every member, the median paired change of the wind factor and of the drift's angle to
+    the geostrophic wind (positive: to the left)."""
+    allr = json.loads((OUT / "experiments.json").read_text())
+    for g in (candidate, reference):
+        if g not in ENSEMBLES:
+            raise SystemExit(f"physics: unknown group {g!r}; known: {list(ENSEMBLES)}")
+        missing = [n for n in ENSEMBLES[g] if n not in allr]
+        if missing:
+            raise SystemExit(f"physics: group {g!r} lacks runs {missing}; run them first")
+    cand, ref = ENSEMBLES[candidate], ENSEMBLES[reference]
+    moves = paired_band_moves(cand, ref, allr)
+    print(f"physics: paired {candidate!r} against {reference!r} ({len(cand)} months; a move is away from the band, "
+          f"the rate's in log10; 90 % interval over 2000 resamples of the months)")
+    for k, m in moves.items():
+        mc = float(np.median([allr[n]["median"][k] for n in cand]))
+        mr = float(np.median([allr[n]["median"][k] for n in ref]))
+        print(f"  {k:40s} {mc:9.4g} against {mr:9.4g}: move {m['move']:+.4f} [{m['lo']:+.4f}, {m['hi']:+.4f}]"
+              + ("  WORSE" if m["worse"] else ""))
+    store = OUT / "drift_response.json"
+    fits = json.loads(store.read_text()) if store.exists() else {}
+    out = {"moves": moves}
+    if all(n in fits for n in cand + ref):
+        for key, label in (("factor", "wind factor"), ("angle_deg", "angle to the geostrophic wind (deg, + left)")):
+            d = [fits[c]["fit"][key] - fits[r]["fit"][key] for c, r in zip(cand, ref)]
+            out[key] = {"median_change": float(np.median(d)), "changes": d}
+            print(f"  {label}: medians {np.median([fits[n]['fit'][key] for n in cand]):.4g} against "
+                  f"{np.median([fits[n]['fit'][key] for n in ref]):.4g}; median paired change {np.median(d):+.4g} "
+                  f"(months: {', '.join(f'{x:+.3g}' for x in d)})")
+    else:
+        print(f"  (no drift fits for every member in {store}: run benchmarks/drift_response.py on them)")
+    print("  worse in: " + (", ".join(k for k, m in moves.items() if m["worse"]) or "nothing"))
     return out
 
 
@@ -4119,7 +4166,7 @@ def leads_table(records: dict, fits: dict, leads=LEADS) -> str:
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("what", choices=("list", "run", "table", "spread", "spinup", "analyse", "figure", "screen",
-                                    "beta-by-rate", "leads", "figure-shear"))
+                                    "paired", "beta-by-rate", "leads", "figure-shear"))
     ap.add_argument("names", nargs="*")
     ap.add_argument("--force", action="store_true", help="run again even if the run finished")
     ap.add_argument("--box", type=float, nargs=4, default=None, metavar=("X0", "X1", "Y0", "Y1"),
@@ -4170,6 +4217,10 @@ def main(argv=None):
             raise SystemExit("physics: screen needs two groups of ENSEMBLES: CANDIDATE REFERENCE")
         screen(*args.names, args.beta_tolerance, args.rate_tolerance, args.band_gain, args.rate_gain,
                None if args.wind_factor_band is None else tuple(args.wind_factor_band))
+    elif args.what == "paired":  # CANDIDATE_GROUP REFERENCE_GROUP: rule NS's paired test
+        if len(args.names) != 2:
+            raise SystemExit("physics: paired needs two groups of ENSEMBLES: CANDIDATE REFERENCE")
+        paired_report(*args.names)
     elif args.what == "figure":  # the cohesion and a storm window's shear: run NAME against run REF
         figure_strength(*args.names)
     elif args.what == "figure-shear":  # FIG_NAME RUN [RUN ...]: the storm window's shear side by side

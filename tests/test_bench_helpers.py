@@ -61,6 +61,48 @@ def test_screen_verdict_counts_bands_and_applies_the_stated_tolerances():
     assert not screen_verdict(ref, ref, beta_tolerance=1.0, rate_tolerance_factor=10.0)["passes"]  # no band gained
 
 
+def test_paired_band_moves_tells_a_shift_from_the_months_spread():
+    """Rule NS's test (forty-ninth session): the move of an eight-month median away from its
+    band, with a 90 % interval from resampling months in pairs. The same runs move by
+    nothing; a β lowered by 0.03 in every month is worse with an interval clear of 0; one
+    month moved alone leaves the interval across 0; a metric that stays inside its band does
+    not move; a rate moved closer to its band is a negative move; unequal lists are refused."""
+    from physics_experiments import TARGETS, paired_band_moves
+
+    rng = np.random.default_rng(3)
+    base = {"beta_space": 0.03 + 0.04 * rng.random(8), "pdf_tail_exponent_shear": 2.0 + 0.4 * rng.random(8),
+            "pdf_tail_exponent_divergence": 1.8 + 1.2 * rng.random(8),
+            "localisation_half_shear_area_fraction": 0.03 + 0.05 * rng.random(8),
+            "shear_divergence_r2": 0.65 + 0.15 * rng.random(8),
+            "mean_total_deformation_rate_per_day": 10 ** (-3.5 + 1.5 * rng.random(8))}
+    assert set(base) == set(TARGETS)
+
+    def records(tag, change):
+        return {f"{tag}{i}": {"median": {k: float(change(k, i, v[i])) for k, v in base.items()}} for i in range(8)}
+
+    ref = records("r", lambda k, i, v: v)
+    names_r = list(ref)
+    same = paired_band_moves(names_r, names_r, ref)
+    assert all(m["move"] == 0.0 and m["lo"] == 0.0 and m["hi"] == 0.0 and not m["worse"] for m in same.values())
+    lower = records("c", lambda k, i, v: v - 0.03 if k == "beta_space" else v)
+    allr = {**ref, **lower}
+    m = paired_band_moves(list(lower), names_r, allr)
+    assert m["beta_space"]["move"] == pytest.approx(0.03) and m["beta_space"]["lo"] > 0 and m["beta_space"]["worse"]
+    one = records("o", lambda k, i, v: v - 0.03 if (k == "beta_space" and i == 0) else v)
+    m = paired_band_moves(list(one), names_r, {**ref, **one})
+    assert m["beta_space"]["lo"] <= 0.0 <= m["beta_space"]["hi"] and not m["beta_space"]["worse"]
+    # R² shifted inside its band (0.73-0.93) in every month: no move; the rate x2 towards its band: closer
+    inside = records("i", lambda k, i, v: (0.80 if k == "shear_divergence_r2" else
+                                           2 * v if k == "mean_total_deformation_rate_per_day" else v))
+    inside_ref = records("j", lambda k, i, v: 0.85 if k == "shear_divergence_r2" else v)
+    m = paired_band_moves(list(inside), list(inside_ref), {**inside, **inside_ref})
+    assert m["shear_divergence_r2"]["move"] == 0.0 and not m["shear_divergence_r2"]["worse"]
+    rate = m["mean_total_deformation_rate_per_day"]
+    assert rate["move"] < 0 and rate["hi"] < 0
+    with pytest.raises(ValueError, match="7 candidate runs against 8"):
+        paired_band_moves(names_r[:7], names_r, ref)
+
+
 def test_screen_verdict_applies_the_twelfth_sessions_rule():
     """The two-stage rule of 2026-11-27 (at least as many bands, the rate ×2 or more, β no
     more than 0.005 further, the wind factor in 0.006-0.010) on the eight-month medians the
