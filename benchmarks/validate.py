@@ -141,11 +141,16 @@ WIND_FACTOR_BAND = THORNDIKE_COLONY_WINTER["factor"]
 #: gmsh made from the coast's pieces), and the shipped spin-up state is the one made so
 #: (spinup-H1125-m10.npz): the runs are F10-hthick-m10 / F10s-hthick-m10, E10h-m10 / E10hs-m10 and
 #: X10h-*-m10; the runs of the 8 km mesh keep their records (docs/figures/physics_experiments.json).
-PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-m10", "strait_maxwell_eb": "F10s-hthick-m10",
-                "closed_evp": "E{evp}h-m10", "strait_evp": "E{evp}hs-m10", "sensitivity_base": "F10-hthick-m10",
-                "sensitivity_strength-50": "X10h-str-50-m10", "sensitivity_strength+50": "X10h-str+50-m10",
-                "sensitivity_drag-50": "X10h-drag-50-m10", "sensitivity_drag+50": "X10h-drag+50-m10",
-                "sensitivity_wind-50": "X10h-wind-50-m10", "sensitivity_wind+50": "X10h-wind+50-m10"}
+#: Since 2026-11-30 (forty-ninth session, rule NS of physics_experiments.py) the flagship turns the ocean drag by
+#: neXtSIM's 25° and closes leads at neXtSIM's 0.25 m, and the shipped spin-up state is the one made so
+#: (spinup-H1125-src-m10.npz): the runs are F10-hthick-src-m10 / F10s-hthick-src-m10, E10h-src-m10 /
+#: E10hs-src-m10 and X10h-*-src-m10; the runs with 0° and 0.1 m are the comparison ensemble below.
+PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-src-m10", "strait_maxwell_eb": "F10s-hthick-src-m10",
+                "closed_evp": "E{evp}h-src-m10", "strait_evp": "E{evp}hs-src-m10",
+                "sensitivity_base": "F10-hthick-src-m10",
+                "sensitivity_strength-50": "X10h-str-50-src-m10", "sensitivity_strength+50": "X10h-str+50-src-m10",
+                "sensitivity_drag-50": "X10h-drag-50-src-m10", "sensitivity_drag+50": "X10h-drag+50-src-m10",
+                "sensitivity_wind-50": "X10h-wind-50-src-m10", "sensitivity_wind+50": "X10h-wind+50-src-m10"}
 #: the weather ensemble of the flagship Maxwell-EB runs (--from-physics): the validation run
 #: (wind seed 2026, the scene's) and the same set-up under the winds of seeds 2027-2033 for
 #: the shipped pack (eight months since 2026-11-26), 2027-2029 for the pack shipped before
@@ -153,8 +158,12 @@ PHYSICS_RUNS = {"closed_maxwell_eb": "F10-hthick-m10", "strait_maxwell_eb": "F10
 #: weather: whether a metric is inside its band is read from how many members are inside.
 #: The pack shipped before 2026-11-25 (F10-1125...) is the comparison.
 PHYSICS_ENSEMBLE = {
-    "closed": ["F10-hthick-m10"] + [f"F10-hthick-m10-w{y}" for y in range(2027, 2034)],
-    "strait": ["F10s-hthick-m10"] + [f"F10s-hthick-m10-w{y}" for y in range(2027, 2034)],
+    "closed": ["F10-hthick-src-m10"] + [f"F10-hthick-src-m10-w{y}" for y in range(2027, 2034)],
+    "strait": ["F10s-hthick-src-m10"] + [f"F10s-hthick-src-m10-w{y}" for y in range(2027, 2034)],
+    "closed, no ocean turning and leads closed at 0.1 m (before 2026-11-30)":
+        ["F10-hthick-m10"] + [f"F10-hthick-m10-w{y}" for y in range(2027, 2034)],
+    "strait, no ocean turning and leads closed at 0.1 m (before 2026-11-30)":
+        ["F10s-hthick-m10"] + [f"F10s-hthick-m10-w{y}" for y in range(2027, 2034)],
     "closed, the 8 km mesh gmsh made from the coast's pieces (before 2026-11-29)":
         ["F10-hthick-newc"] + [f"F10-hthick-newc-w{y}" for y in range(2027, 2034)],
     "strait, the 8 km mesh gmsh made from the coast's pieces (before 2026-11-29)":
