@@ -4141,6 +4141,9 @@ LEADS = (
     ("σ/√(1 − d) + compressive term, C_lab ×3, relaxation time × Δx / 20 km (crack band; own spin-up)",
      "F10-hthick-eng-P-C3-CB20", "F10s-hthick-eng-P-C3-CB20",
      "The rate and the scaling law; a crack band for the viscous flow"),
+    ("neXtSIM's ocean turning angle 25° and lead-closing thickness 0.25 m on the mesh at the size asked (own spin-up; "
+     "shipped since the forty-ninth session)", "F10-hthick-src-m10", "F10s-hthick-src-m10",
+     "neXtSIM's values for the two unsourced settings"),
 )
 
 
