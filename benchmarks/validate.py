@@ -943,9 +943,13 @@ def provenance_line(prov: dict) -> str:
     """The report's sentence on which code made the runs it reads."""
     if not prov["by_commit"]:
         return ""
-    made = "; ".join(f"`{c[:10]}`{' (a modified work tree)' if c.endswith('-dirty') else ''} ({len(v)} "
+    # where no run's model code changed or is unknown, every run made from a modified work tree had its files
+    # recorded and none of them was model code: say so, rather than leave "modified" open
+    same = not (prov["changed"] or prov["unknown"])
+    tree = " (a work tree modified outside the model code)" if same else " (a modified work tree)"
+    made = "; ".join(f"`{c[:10]}`{tree if c.endswith('-dirty') else ''} ({len(v)} "
                      f"run{'s' if len(v) > 1 else ''})" for c, v in prov["by_commit"].items())
-    if prov["changed"] or prov["unknown"]:
+    if not same:
         return (f"Runs made by the code of {made}. The model code (lagice/, forcing/, thermo/) of this commit differs "
                 f"from that of {len(prov['changed'])} of the runs, in {', '.join(f'`{f}`' for f in prov['files'])}, "
                 f"and is not known for {len(prov['unknown'])}: their figures describe the code that made them "

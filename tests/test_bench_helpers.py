@@ -1220,6 +1220,23 @@ def test_pooled_months_pool_every_box_and_resample_months():
     assert validate.pooled_months([]) is None
 
 
+def test_provenance_line_says_where_a_modified_tree_was_modified():
+    """validate.provenance_line: runs made from modified work trees whose recorded files are all outside
+    the model code are labelled so, with the model code the same; where a run's model code changed, the
+    label stays "a modified work tree" and the files are named."""
+    from validate import provenance_line
+
+    prov = {"by_commit": {"abc1234567-dirty": ["A", "B"], "def7654321": ["C"]}, "changed": [], "unknown": [],
+            "files": []}
+    line = provenance_line(prov)
+    assert "`abc1234567` (a work tree modified outside the model code) (2 runs)" in line
+    assert "`def7654321` (1 run)" in line and "is the same in this commit" in line
+    changed = {**prov, "changed": ["A"], "files": ["lagice/fem.py"]}
+    line = provenance_line(changed)
+    assert "`abc1234567` (a modified work tree) (2 runs)" in line
+    assert "differs from that of 1 of the runs, in `lagice/fem.py`" in line
+
+
 def test_a_clean_reproduction_names_the_code_of_a_run_made_from_a_modified_tree(tmp_path):
     """validate.reuse_notice: a run made from a modified work tree (its files recorded, none of them
     model code) and made again bit for bit from a clean checkout is attributed to the clean commit,
