@@ -737,10 +737,12 @@ def test_keys_of_components_that_are_off_are_named_once_and_change_nothing(tmp_p
     ("winter_basin_pack", {"thermo.enabled": False, "healing.law": "constant", "forcing.air_temperature": None,
                            "thermo.params": {"new_ice_thickness_m": 0.2}},
      [("thermo.params", {"new_ice_thickness_m": 0.2}, "thermodynamics is off: thermo.enabled = false")]),
-    # a scene's undamaged new ice with thermodynamics switched off by --set: named, not refused
+    # a scene's undamaged new ice with thermodynamics switched off by --set: named, not refused; so is the
+    # flagship's own [thermo.params] (neXtSIM's lead-closing thickness, since 2026-11-30)
     ("winter_basin_pack", {"thermo.enabled": False, "healing.law": "constant", "forcing.air_temperature": None,
                            "thermo.new_ice_undamaged": True},
-     [("thermo.new_ice_undamaged", True, "thermodynamics is off (thermo.enabled = false): no new ice forms")]),
+     [("thermo.params", {"new_ice_thickness_m": 0.25}, "thermodynamics is off: thermo.enabled = false"),
+      ("thermo.new_ice_undamaged", True, "thermodynamics is off (thermo.enabled = false): no new ice forms")]),
     # a scene's [healing.params] with its law switched to one that takes none
     ("winter_basin_pack", {"healing.law": "none", "healing.params": {"time_scale_days": 10.0}},
      [("healing.params", {"time_scale_days": 10.0}, "healing.law = 'none' takes no parameters")]),
