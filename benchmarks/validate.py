@@ -1087,20 +1087,53 @@ def pooled_months(per_month: list) -> dict | None:
 
     if not per_month or any(not m or any(w["interior"].get("scaling_space") is None for w in m) for m in per_month):
         return None
-    every = pooled_window_scaling([w for m in per_month for w in m])
+    every = pooled_window_scaling([w for m in per_month for w in m])   # also checks that the curves pool
     rng = np.random.default_rng(POOLED_SEED)
     picks = rng.integers(0, len(per_month), size=(POOLED_RESAMPLES, len(per_month)))
-    boot = {"beta_space": [], "beta_space_grids": []}
-    for row in picks:
-        r = pooled_window_scaling([w for i in row for w in per_month[i]])
-        for k in boot:
-            boot[k].append(r[k])
+    boot = {"beta_space": _resampled_betas([[w["interior"]["scaling_space"] for w in m] for m in per_month],
+                                           picks)}
+    grids = [[c for w in m for c in (w["interior"].get("scaling_space_grids") or [])] for m in per_month]
+    boot["beta_space_grids"] = (_resampled_betas(grids, picks) if every["beta_space_grids"] is not None
+                                else [None] * len(picks))
     out = {"n_windows": every["n_windows"], "n_months": len(per_month), "curve": every["curve"]}
     for k, v in boot.items():
         v = np.asarray([np.nan if x is None else x for x in v], dtype=np.float64)
         out[k] = every[k]
         out[k + "_interval_90"] = (None if every[k] is None or not np.all(np.isfinite(v)) else
                                    [float(np.quantile(v, 0.05)), float(np.quantile(v, 0.95))])
+    return out
+
+
+def _resampled_betas(per_month: list, picks) -> list:
+    """β of :func:`lagice.diagnostics.scaling.pooled_spatial_scaling` over the curves of the months in
+    each row of ``picks`` (month indices, with repeats), from each month's box-weighted sums made once:
+    the same pooled ⟨ε̇tot⟩ and scale at each width, the same widths (those every curve holds, each
+    counted in at least :data:`~lagice.diagnostics.scaling.MIN_FIT_BOXES` boxes by every curve) and the
+    same fit as pooling the rows' curves one by one, to round-off (the sums are added in another order),
+    in a fraction of its time (``tests/test_bench_helpers.py``). The curves must pool (checked by the
+    caller over every month)."""
+    from lagice.diagnostics.scaling import MIN_FIT_BOXES, fit_power_law
+
+    sums = []   # per month: rows, Σ n ⟨ε̇⟩, Σ n L, Σ n, min n (over the month's curves, per width)
+    for curves in per_month:
+        el = int(curves[0]["box_size_m"][0] is None)
+        rows = el + min(len(c["box_size_m"]) - el for c in curves)
+        n = np.array([np.asarray(c["n_boxes"], dtype=np.float64)[:rows] for c in curves])
+        m = np.array([np.asarray(c["mean_total_s"], dtype=np.float64)[:rows] for c in curves])
+        sc = np.array([np.asarray(c["scale_m"], dtype=np.float64)[:rows] for c in curves])
+        sums.append((rows, (n * np.where(n > 0, m, 0.0)).sum(axis=0), (n * np.where(n > 0, sc, 0.0)).sum(axis=0),
+                     n.sum(axis=0), n.min(axis=0)))
+    out = []
+    for row in picks:
+        months, counts = np.unique(row, return_counts=True)
+        rows = min(sums[i][0] for i in months)
+        nm, ns, n_tot = (sum(c * sums[i][j][:rows] for i, c in zip(months, counts)) for j in (1, 2, 3))
+        fewest = np.min([sums[i][4][:rows] for i in months], axis=0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mean = np.where(n_tot > 0, nm / n_tot, np.nan)
+            scale = np.where(n_tot > 0, ns / n_tot, np.nan)
+        used = fewest >= MIN_FIT_BOXES
+        out.append(fit_power_law(scale[used], mean[used]).exponent)
     return out
 
 
