@@ -712,6 +712,88 @@ def figures_basin(basin: dict, fig_dir: Path, scene: str) -> list[Path]:
     return paths
 
 
+def figure_ensemble_bands(ens: dict, basin: dict, fig_dir: Path) -> Path | None:
+    """Every month of each weather ensemble analysed in this report (not those carried from an older
+    report) against the observed bands, one panel per statistic: a dot per month (ringed: the validation
+    month), a bar at the median over the months, the band shaded, and the EVP month of the same basin
+    (×); the last panel is β as observed β is computed (one slope over every box of every window of the
+    months, with its 90 % interval from resampling them). For the reader who looks rather than reads
+    the tables of the section. None if no ensemble was analysed."""
+    groups = [(g, e) for g, e in ens.items() if "carried_from" not in e]
+    if not groups:
+        return None
+    keys = list(TARGETS) + ["wind_factor"]
+    fig = _fig(4.0 * 4, 3.7 * 2)
+    axes = fig.subplots(2, 4).ravel()
+    rng = np.random.default_rng(0)   # the dots' horizontal jitter only
+
+    def wind_factor(r):
+        return (r.get("drift_response") or {}).get("wind_factor")
+
+    def tick(g):   # "closed" / "strait"; an older set-up's group is faded, marked and named below the panels
+        scene, _, note = g.partition(", ")
+        return scene if not note else f"{scene}\n(older set)"
+
+    def style(x, g):
+        return {"color": "tab:red" if g.startswith("closed") else "tab:orange", "alpha": 1.0 if "," not in g else 0.45}
+
+    for ax, k in zip(axes, keys):
+        lo, hi = WIND_FACTOR_BAND if k == "wind_factor" else TARGETS[k][:2]
+        ax.axhspan(lo, hi, color="0.85", zorder=0, label="observed band")
+        for x, (g, e) in enumerate(groups):
+            names = list(e["members"])
+            vals = np.array([np.nan if v is None else v for v in
+                             (wind_factor(e["members"][n]) if k == "wind_factor" else e["members"][n]["median"][k]
+                              for n in names)], dtype=np.float64)
+            st = style(x, g)
+            xs = x + rng.uniform(-0.18, 0.18, vals.size)
+            ax.plot(xs, vals, "o", ms=4, **st, label="a month (Maxwell-EB)" if x == 0 else None)
+            ax.plot(xs[:1], vals[:1], "o", ms=9, mfc="none", color="k", alpha=st["alpha"],
+                    label="validation month" if x == 0 else None)
+            if np.isfinite(vals).any():
+                med = float(np.nanmedian(vals))
+                ax.plot([x - 0.3, x + 0.3], [med, med], "-", lw=2.5, **st,
+                        label="median of the months" if x == 0 else None)
+            evp = (basin.get(g) or {}).get("evp")
+            if evp is not None:
+                v = wind_factor(evp) if k == "wind_factor" else evp["median"].get(k)
+                if v is not None:
+                    ax.plot([x], [v], "x", ms=8, mew=2, color="tab:blue",
+                            label="EVP, validation month" if x == 0 else None)
+        title = ("wind factor |A| (Thorndike and Colony 1982, winter)" if k == "wind_factor"
+                 else LABELS[k].replace("\\|", "|"))
+        ax.set_title(title, fontsize=8)
+        if k in ("mean_total_deformation_rate_per_day", "wind_factor"):
+            ax.set_yscale("log")
+    ax = axes[len(keys)]
+    lo, hi = TARGETS["beta_space"][:2]
+    ax.axhspan(lo, hi, color="0.85", zorder=0)
+    for x, (g, e) in enumerate(groups):
+        pc = e.get("pooled_curve") or {}
+        b, iv = pc.get("beta_space_grids"), pc.get("beta_space_grids_interval_90")
+        if b is not None:
+            err = None if iv is None else [[b - iv[0]], [iv[1] - b]]
+            ax.errorbar([x], [b], yerr=err, fmt="s", ms=6, capsize=4, **style(x, g))
+    ax.set_ylim(0, max(0.22, ax.get_ylim()[1]))
+    ax.set_title("β as observed β is computed: one slope over\nevery box of every window (90 % interval)",
+                 fontsize=8)
+    for ax in axes[:len(keys) + 1]:
+        ax.set_xticks(range(len(groups)))
+        ax.set_xticklabels([tick(g) for g, _ in groups], fontsize=7)
+        ax.set_xlim(-0.6, len(groups) - 0.4)
+        ax.grid(True, axis="y", alpha=0.3)
+    axes[0].legend(fontsize=6, loc="upper right")
+    fig.suptitle("Weather ensembles of the flagship (10 km, 28 days): each month's medians of its 3-day windows "
+                 "against the observed bands (grey)", fontsize=10)
+    older = sorted({g.partition(", ")[2] for g, _ in groups if ", " in g})
+    if older:
+        fig.text(0.5, 0.005, "older set (faded): " + "; ".join(older), ha="center", fontsize=8)
+    fig.tight_layout(rect=(0, 0.025 if older else 0, 1, 1))
+    p = fig_dir / "validation_ensemble_bands.png"
+    fig.savefig(p, dpi=110)
+    return p
+
+
 def figure_compression(c: dict, fig_dir: Path) -> Path:
     d = c["_plot"]
     fig = _fig(15, 5.2)
@@ -1017,7 +1099,7 @@ def write_report(res: dict, md: Path, figs: dict):
                 + (" | –" if pb is None else f" | {_fmt('beta_space', pb)}")
                 + f" | {r['remesh_events']} | {np.mean(r['mean_speed_m_s'][1:]):.2g} |")
         lines.append("")
-    lines += ensemble_lines(res.get("weather_ensemble") or {})
+    lines += ensemble_lines(res.get("weather_ensemble") or {}, figs.get("ensemble"))
     lines += rgps_view_lines(res)
     mi = res.get("mesh_imprint") or {}
     if mi:
@@ -1208,8 +1290,9 @@ def _member_stats(members: dict, part: str) -> dict:
     return stats
 
 
-def ensemble_lines(ens: dict) -> list[str]:
-    """Markdown: per basin, each member's medians and how many members are inside each band."""
+def ensemble_lines(ens: dict, figure: Path | None = None) -> list[str]:
+    """Markdown: per basin, each member's medians and how many members are inside each band (and the
+    figure of :func:`figure_ensemble_bands` first, where there is one)."""
     if not ens:
         return []
     months = sorted({len(e["members"]) for e in ens.values()})
@@ -1220,6 +1303,8 @@ def ensemble_lines(ens: dict) -> list[str]:
              + " ".join(n for e in ens.values() for n in list(e["members"])[1:]) + "`; `PHYSICS_ENSEMBLE` of "
              "`benchmarks/validate.py`). Medians of the 3-day windows per member; the last columns give "
              "the median over the members and how many members are inside the band.", ""]
+    if figure is not None:
+        lines += [f"![every month against the observed bands](figures/{figure.name})", ""]
     for scene, e in ens.items():
         names = list(e["members"])
         c = e.get("carried_from")
@@ -1553,6 +1638,8 @@ def main(argv=None):
     ensemble = analyse_ensemble(physics, days, args.coast_buffer_km * 1e3, basin) if physics is not None else {}
     if previous is not None:
         ensemble.update(carry_ensembles(previous, [g for g in PHYSICS_ENSEMBLE if g not in ensemble]))
+    if ensemble:
+        figs["ensemble"] = figure_ensemble_bands(ensemble, basin, args.fig_dir)
     mi_json = args.fig_dir / "mesh_imprint.json"
     if mi_json.exists():
         imprint["rotation_test"] = rotation_test_summary(json.loads(mi_json.read_text()))

@@ -1248,6 +1248,35 @@ def test_pooled_months_resamples_equal_pooling_each_resample_curve_by_curve():
     assert len({round(b, 6) for b in slow if np.isfinite(b)}) > 100
 
 
+def test_ensemble_figure_draws_the_analysed_groups_and_the_report_links_it(tmp_path):
+    """validate.figure_ensemble_bands: a PNG of the ensembles analysed in this report, none when every
+    group was carried from an older report (their numbers are not re-read); the ensemble section of the
+    report links the figure it is given, and no figure when given none."""
+    import matplotlib.image as mpimg
+    import validate
+
+    def member(k):
+        med = {m: (lo + hi) / 2 * (0.5 + 0.1 * k) for m, (lo, hi, _s, _n) in validate.TARGETS.items()}
+        med[validate.GRID_BETA] = med["beta_space"]
+        return {"median": med, "drift_response": {"wind_factor": 0.004 + 0.0005 * k}, "remesh_events": k}
+
+    group = {"members": {f"R{k}": member(k) for k in range(4)},
+             "metrics": {m: {"median": 0.1, "n_inside": 1, "n_members": 4} for m in
+                         [*validate.TARGETS, validate.GRID_BETA]},
+             "pooled_curve": {"beta_space_grids": 0.06, "beta_space_grids_interval_90": [0.05, 0.07],
+                              "beta_space": 0.06, "n_months": 4}}
+    basin = {"closed": {"evp": member(9)}}
+    carried = {"closed, older": {**group, "carried_from": {"date": "2026-11-01", "git_commit": "abc"}}}
+    assert validate.figure_ensemble_bands(carried, basin, tmp_path) is None
+    p = validate.figure_ensemble_bands({"closed": group, **carried}, basin, tmp_path)
+    assert p == tmp_path / "validation_ensemble_bands.png"
+    img = mpimg.imread(p)
+    assert img.shape[0] > 500 and img.shape[1] > 1000 and img[..., :3].std() > 0.05   # drawn, not blank
+    assert f"![every month against the observed bands](figures/{p.name})" in validate.ensemble_lines(
+        {"closed": group}, p)
+    assert not any("validation_ensemble_bands" in line for line in validate.ensemble_lines({"closed": group}))
+
+
 def test_provenance_line_says_where_a_modified_tree_was_modified():
     """validate.provenance_line: runs made from modified work trees whose recorded files are all outside
     the model code are labelled so, with the model code the same; where a run's model code changed, the
