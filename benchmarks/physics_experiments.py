@@ -53,6 +53,17 @@ SHORT = {"beta_space": "β", "pdf_tail_exponent_shear": "tail sh", "pdf_tail_exp
          "localisation_half_shear_area_fraction": "half-shear area", "shear_divergence_r2": "R²",
          "mean_total_deformation_rate_per_day": "⟨ε̇tot⟩ d⁻¹"}
 SCENES = {"closed": "winter_basin_pack", "strait": "winter_basin_pack_strait"}
+#: the folder of the scene files a run (``NAME``) or spin-up (``spinup:NAME``) reads, where it is not examples/
+#: (scene files of an earlier commit, written by :func:`prepare_inputs`)
+SCENE_DIRS: dict = {}
+EXAMPLES = ROOT / "examples"
+
+
+def scene_file(name: str) -> Path:
+    """The scene file of experiment ``name`` (:data:`EXPERIMENTS`), or of spin-up ``spinup:NAME``."""
+    if name.startswith("spinup:"):
+        return SCENE_DIRS.get(name, EXAMPLES) / "winter_basin_spinup.toml"
+    return SCENE_DIRS.get(name, EXAMPLES) / f"{SCENES[EXPERIMENTS[name][0]]}.toml"
 #: the EVP comparison rheology on the same scene (as benchmarks/validate.py)
 EVP = ["solver.name=evp", "rheology.law=viscous_plastic", "healing.law=none", "solver.dt=30min",
        "solver.substeps=300"]
@@ -208,6 +219,118 @@ def prepare_inputs():
     if not BASIN_ARCH.exists():
         OUT.mkdir(parents=True, exist_ok=True)
         BASIN_ARCH.write_text(json.dumps(archipelago_basin()))
+    write_scenes(SCENES_BEFORE_NS_COMMIT, SCENES_BEFORE_NS)
+
+
+#: the scene files :func:`write_scenes` takes from an earlier commit (together, so that ``extends`` finds its base)
+BASIN_SCENE_FILES = ("winter_basin_pack.toml", "winter_basin_pack_strait.toml", "winter_basin_spinup.toml")
+
+
+def write_scenes(commit: str, folder: Path) -> None:
+    """The basin scene files of ``commit`` (:data:`BASIN_SCENE_FILES`, from git) into ``folder``, where
+    missing. Their relative paths (coast, spin-up state) are read from the checkout's root, as lagice
+    reads them from the working folder or the repository."""
+    for f in BASIN_SCENE_FILES:
+        target = folder / f
+        if target.exists():
+            continue
+        blob = subprocess.run(["git", "show", f"{commit}:examples/{f}"], cwd=ROOT, capture_output=True, check=False)
+        if blob.returncode != 0:
+            raise SystemExit(f"physics: cannot read examples/{f} of commit {commit} from git "
+                             f"({blob.stderr.decode().strip()}); the experiments defined before it need a git checkout")
+        folder.mkdir(parents=True, exist_ok=True)
+        target.write_bytes(blob.stdout)
+
+
+def resolved_settings(cmd: list) -> dict:
+    """The physics settings (:func:`lagice.scenes.config.physics_view`, flattened to ``table.key``) that a
+    ``lagice run`` command ``cmd`` (:func:`command`, or a run's recorded command line) resolves to with
+    this checkout's lagice; its scene file relative to the checkout's root unless absolute."""
+    from lagice.scenes.config import load_scene, physics_view
+
+    scene = Path(cmd[cmd.index("run") + 1])
+    sets = [cmd[i + 1] for i, c in enumerate(cmd) if c == "--set"]
+    view = physics_view(load_scene(str(scene if scene.is_absolute() else ROOT / scene), sets))
+
+    def flat(d, pre=""):
+        for k, v in d.items():
+            if isinstance(v, dict):
+                yield from flat(v, f"{pre}{k}.")
+            else:
+                yield f"{pre}{k}", v
+    return dict(flat({k: v for k, v in view.items() if not k.startswith("_")}))
+
+
+def made_settings(name: str) -> tuple[dict | None, str]:
+    """The physics settings run ``name`` was made with: its recorded command (its folder's marker, or
+    else its record in ``experiments.json``) resolved with this checkout's lagice against the scene
+    files of the commit that made it (from git, :func:`write_scenes`), so that settings added to lagice
+    since (with defaults) do not count as a change. ``(None, why)`` where that cannot be told."""
+    marker = OUT / name / "lagice_run.json"
+    info = json.loads(marker.read_text()) if marker.exists() else None
+    if info is not None:
+        line, commit, modified = info.get("command"), info.get("git_commit"), info.get("git_modified_files") or []
+    else:
+        rec = (json.loads((OUT / "experiments.json").read_text()) if (OUT / "experiments.json").exists()
+               else {}).get(name)
+        if rec is None:
+            return None, "no record"
+        line, commit, modified = rec.get("command"), rec.get("made_by"), None
+    if not line or not commit or str(commit).startswith("unknown"):
+        return None, "its command or commit is not recorded"
+    if (modified is None and str(commit).endswith("-dirty")) or any(f.startswith("examples/") for f in modified or ()):
+        return None, f"made from a modified work tree ({commit}) whose scene files may differ from the commit's"
+    argv = shlex.split(line)
+    argv = argv[next(i for i, a in enumerate(argv) if a.endswith("lagice") or a.endswith("cli.py")):]
+    scene = Path(argv[argv.index("run") + 1])
+    if scene.name in BASIN_SCENE_FILES and (scene.parent.name == "examples"):
+        sha = str(commit).removesuffix("-dirty")
+        folder = OUT / f"scenes-{sha[:7]}"
+        write_scenes(sha, folder)
+        argv[argv.index("run") + 1] = str(folder / scene.name)
+    return resolved_settings(argv), ""
+
+
+def settings_report(names: list) -> int:
+    """For each of ``names`` (default: every run folder of a defined experiment), whether its definition
+    still resolves to the settings the run was made with (:func:`made_settings`); 1 if any does not."""
+    names = names or sorted(d.name for d in OUT.iterdir() if (d / "lagice_run.json").exists() and d.name in EXPERIMENTS)
+    counts = {"same": 0, "differ": 0, "unknown": 0}
+    for n in names:
+        scene, overrides, res, days, _ = EXPERIMENTS[n]
+        made, why = made_settings(n)
+        if made is None:
+            counts["unknown"] += 1
+            print(f"  {n}: cannot be told ({why})")
+            continue
+        now = resolved_settings(command(scene, overrides, res, days, OUT / n, scene_file(n)))
+        diff = sorted(k for k in set(made) | set(now) if made.get(k, "<absent>") != now.get(k, "<absent>"))
+        counts["differ" if diff else "same"] += 1
+        if diff:
+            print(f"  {n}: DIFFERS in {', '.join(diff)}")
+    print(f"physics: settings of {len(names)} runs against their definitions: {counts['same']} the same, "
+          f"{counts['differ']} different, {counts['unknown']} not known")
+    return int(counts["differ"] > 0)
+
+
+def check_settings(name: str, cmd: list) -> None:
+    """Refuse to make run ``name`` again with other settings than those it was made with
+    (:func:`made_settings`): a scene file or the definition changed since, and the run published under the
+    name would silently be replaced by another. The keys that differ are named. A run whose settings
+    cannot be told (no record, a modified work tree) is made, with a note."""
+    made, why = made_settings(name)
+    if made is None:
+        if why != "no record":
+            print(f"physics: note: {name}: the settings it was made with cannot be checked ({why})", flush=True)
+        return
+    now = resolved_settings(cmd)
+    diff = sorted(k for k in set(made) | set(now) if made.get(k, "<absent>") != now.get(k, "<absent>"))
+    if diff:
+        shown = "; ".join(f"{k}: {made.get(k, '<absent>')!r} then, {now.get(k, '<absent>')!r} now" for k in diff[:6])
+        raise SystemExit(f"physics: {name} was made with other settings than its definition gives now ({shown}"
+                         f"{'; ...' if len(diff) > 6 else ''}; scene {cmd[cmd.index('run') + 1]}): a scene file or "
+                         f"the definition changed since. Define the new run under a new name, or remove "
+                         f"{OUT / name} and its record in experiments.json to replace it")
 
 
 def archipelago_basin(channel_m: float = 25e3) -> dict:
@@ -3477,6 +3600,23 @@ for _ell, _draws20, _draws10 in ((20, (0, 1, 2, 3), (0, 1)), (40, (0, 1), (0,)))
 # 0.204, 0.210 on the mesh at the size asked). So the observations' estimator keeps the mesh dependence.
 
 # --- 2026-11-30 (forty-ninth session): neXtSIM's values for the two unsourced settings -------------------------
+#: The scene files as they were before the forty-ninth session (commit 0ca93c4, 2026-11-30) shipped neXtSIM's ocean
+#: turning angle and lead-closing thickness in winter_basin_pack.toml: every definition above this point was made
+#: from them. ``prepare_inputs`` writes them from git (the three basin scenes of that commit's parent, together so
+#: that ``extends`` finds its base), and those definitions read them, so that a name still makes the run published
+#: under it (with today's scene it would silently make another run; ``check_settings`` refuses that wherever the
+#: run's own settings fingerprint is known). Definitions older than an earlier change of a scene file were made
+#: from older files still; ``check_settings`` finds those whose folders or records hold a fingerprint. The
+#: shipped spin-up ``shipped`` follows today's scene by design.
+SCENES_BEFORE_NS_COMMIT = "293da50"
+SCENES_BEFORE_NS = OUT / f"scenes-{SCENES_BEFORE_NS_COMMIT}"
+for _name in EXPERIMENTS:
+    SCENE_DIRS.setdefault(_name, SCENES_BEFORE_NS)
+for _name, (_over, _target, _res) in SPINUPS.items():
+    if _over is not None and _name != "shipped":
+        SCENE_DIRS.setdefault(f"spinup:{_name}", SCENES_BEFORE_NS)
+
+
 # Written 2026-11-30 16:52 UTC, before any run. Two values of the shipped set have no source (docs/physics.md §4, the
 # parameter table): the ocean turning angle 0° (neXtSIM turns the ocean drag by 25°, dynamics.oceanic_turning_angle)
 # and the lead-closing thickness 0.1 m (neXtSIM's thermo.hnull 0.25 m). Both were screened alone on the 8 km mesh
@@ -3524,6 +3664,32 @@ for _key, _lo, _hi, _what in SENSITIVITY_CHANGES:
         EXPERIMENTS[f"X10h-{_key}{_sign}-src-m10"] = (
             "closed", SOURCED + from_spinup("H1125-src-m10") + [_change], 10e3, 28,
             f"{_what} {_sign.replace('-', '−')} %, 10 km, with neXtSIM's turning angle and lead-closing thickness")
+
+
+# Written 2026-11-30 19:24 UTC, before its runs (fiftieth session). The 20 km lead eff-C8-cap97 (the effective envelope,
+# damage cap 0.97, C_lab x8: two calibrations) kept beta in 0.14-0.23 over eight months at 20 km (median 0.171, wind
+# factor 0.0078, 3 bands inside: beta, the half-shear area, the rate); its 10 km validation month fell to beta 0.157
+# with 1 band inside, and docs/physics.md section 5 lists "the 10 km months of any such set" as not done. Its eight
+# months at 10 km, closed basin, from its own 10 km spin-up (H1125-eff-C8-cap97 made again), with the scene files of
+# before 2026-11-30 as its 20 km months had (SCENES_BEFORE_NS): F10-hthick-eff-C8-cap97 (the validation month made
+# again) and -w2027 ... -w2033.
+# (R10) the lead survives at 10 km if its eight-month median beta lies in 0.14-0.23, its median wind factor in
+#       0.006-0.010 and at least 3 bands are inside, as at 20 km.
+# (F10) reported, not a test: the fall of each statistic from 20 to 10 km month by month (`paired` against the 20 km
+#       group, paired by wind seed; a move is away from the band, with its 90 % interval over resampled months).
+# (P)   the validation month made again reproduces its record of 02:24 UTC (beta 0.15672, rate 0.0079055 per day):
+#       the model code changed since only by options that are off (damage_length_m, crack_band_length_m).
+# Predicted: (R10) fails: median beta 0.13-0.15 with the wind factor inside (0.0060-0.0075) and 1-2 bands (tails
+#       lighter than observed, the half-shear area near 3 %); beta lower at 10 km in at least 6 of the 8 months, by
+#       0.02-0.04 in the median; (P) holds.
+EFF_C8_CAP97_10KM = "10 km, effective envelope, cap 0.97, C_lab x8, closed, eight months"
+for _seed in ENSEMBLE_SEEDS + MORE_SEEDS:
+    _name = f"F10-hthick-eff-C8-cap97-w{_seed}"
+    EXPERIMENTS[_name] = ("closed", EXPERIMENTS["F10-hthick-eff-C8-cap97"][1] + [f"forcing.wind.seed={_seed}"], 10e3,
+                          28, f"F10-hthick-eff-C8-cap97, the weather of wind seed {_seed}")
+    SCENE_DIRS[_name] = SCENES_BEFORE_NS
+ENSEMBLES[EFF_C8_CAP97_10KM] = ["F10-hthick-eff-C8-cap97"] + [f"F10-hthick-eff-C8-cap97-w{y}" for y in
+                                                              ENSEMBLE_SEEDS + MORE_SEEDS]
 
 
 def paired_band_moves(candidate: list, reference: list, records: dict, draws: int = 2000, seed: int = 0) -> dict:
@@ -3581,11 +3747,13 @@ def paired_report(candidate: str, reference: str) -> dict:
     return out
 
 
-def command(scene, overrides, res, days, out) -> list:
+def command(scene, overrides, res, days, out, scene_path: Path | None = None) -> list:
+    """The ``lagice run`` command of a run: the basin ``scene``'s file (``scene_path``, default
+    examples/), the run's length, resolution and output, and its ``overrides``."""
     sets = [f"run.duration={days:g}d", "output.every=1d", f"domain.resolution_m={res:g}", "output.plot=false",
             "run.progress=false", "checkpoint.every=7d", *overrides]
-    cmd = [sys.executable, "-m", "lagice.cli", "run", str(ROOT / "examples" / f"{SCENES[scene]}.toml"),
-           "--out", str(out)]
+    path = scene_path if scene_path is not None else EXAMPLES / f"{SCENES[scene]}.toml"
+    cmd = [sys.executable, "-m", "lagice.cli", "run", str(path), "--out", str(out)]
     for s in sets:
         cmd += ["--set", s]
     return cmd
@@ -3664,8 +3832,9 @@ def git_commit() -> str:
 def run_experiment(name: str, force: bool = False, run: bool = True) -> dict:
     scene, overrides, res, days, what = EXPERIMENTS[name]
     out = OUT / name
-    cmd = command(scene, overrides, res, days, out)
+    cmd = command(scene, overrides, res, days, out, scene_file(name))
     if run and (force or not run_finished(out)):  # a stopped run is run again
+        check_settings(name, cmd)
         OUT.mkdir(parents=True, exist_ok=True)
         t0 = time.perf_counter()
         print(f"physics: run {name}: {what}", flush=True)
@@ -3681,6 +3850,8 @@ def run_experiment(name: str, force: bool = False, run: bool = True) -> dict:
     r = analyse(name, out, days)
     threads = os.environ.get("NUMBA_NUM_THREADS", "1")
     command_line = f"NUMBA_NUM_THREADS={threads} lagice run " + " ".join(shlex.quote(str(c)) for c in cmd[4:])
+    marker = out / "lagice_run.json"
+    r["settings_fingerprint"] = json.loads(marker.read_text()).get("fingerprint") if marker.exists() else None
     r.update({"scene": SCENES[scene], "overrides": overrides, "resolution_m": res, "days": days, "what": what,
               "command": command_line.replace(str(ROOT) + "/", "")})
     _store(r)
@@ -3719,11 +3890,13 @@ def check_names(names: list) -> None:
     for n in names:
         if n not in EXPERIMENTS:
             raise SystemExit(f"physics: unknown experiment {n!r}; known: {list(EXPERIMENTS)}")
+        if SCENE_DIRS.get(n) == SCENES_BEFORE_NS:
+            write_scenes(SCENES_BEFORE_NS_COMMIT, SCENES_BEFORE_NS)
         scene, overrides = EXPERIMENTS[n][:2]
         try:
-            load_scene(SCENES[scene], overrides)
+            load_scene(str(scene_file(n)), overrides)
         except LagiceError as exc:
-            raise SystemExit(f"physics: experiment {n!r} (scene {SCENES[scene]}) does not resolve: {exc}") from None
+            raise SystemExit(f"physics: experiment {n!r} (scene {scene_file(n)}) does not resolve: {exc}") from None
 
 
 def queues(names: list, jobs: int) -> list:
@@ -4045,7 +4218,7 @@ def spinup(name="shipped", days=14):
     if overrides is None:
         raise SystemExit(f"physics: spin-up {name!r} is taken from git history (prepare_inputs), not remade")
     out = OUT / ("spinup" if name == "shipped" else f"spinup-{name}")
-    cmd = [sys.executable, "-m", "lagice.cli", "run", str(ROOT / "examples" / "winter_basin_spinup.toml"), "--out",
+    cmd = [sys.executable, "-m", "lagice.cli", "run", str(scene_file(f"spinup:{name}")), "--out",
            str(out), "--set", f"run.duration={days:g}d", "--set", f"domain.resolution_m={res:g}"]
     for o in overrides:
         cmd += ["--set", o]
@@ -4182,7 +4355,7 @@ def leads_table(records: dict, fits: dict, leads=LEADS) -> str:
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("what", choices=("list", "run", "table", "spread", "spinup", "analyse", "figure", "screen",
-                                    "paired", "beta-by-rate", "leads", "figure-shear"))
+                                    "paired", "beta-by-rate", "leads", "figure-shear", "settings"))
     ap.add_argument("names", nargs="*")
     ap.add_argument("--force", action="store_true", help="run again even if the run finished")
     ap.add_argument("--box", type=float, nargs=4, default=None, metavar=("X0", "X1", "Y0", "Y1"),
@@ -4204,8 +4377,10 @@ def main(argv=None):
     args = ap.parse_intermixed_args(argv)
     if args.jobs != 1 and args.what != "run":
         raise SystemExit(f"physics: --jobs applies to 'run' only (asked with {args.what!r})")
-    if args.what in ("run", "spinup"):
+    if args.what in ("run", "spinup", "settings"):
         prepare_inputs()
+    if args.what == "settings":   # does each run's definition still make the run in its folder (or record)?
+        return settings_report(args.names)
     if args.what == "list":
         for k, (sc, ov, res, days, what) in EXPERIMENTS.items():
             print(f"{k}: {SCENES[sc]} {res / 1e3:g} km {days} d: {what}\n    {' '.join(ov)}")
@@ -4246,4 +4421,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

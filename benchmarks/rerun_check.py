@@ -35,16 +35,44 @@ RECORD = "reproduced.json"
 
 
 def rerun_command(run: Path, out: Path) -> list:
-    """The run's ``lagice run`` command (from its marker) with ``--out`` pointing at ``out``."""
+    """The run's ``lagice run`` command (from its marker) with ``--out`` pointing at ``out``. A scene
+    file of the checkout's examples/ is read as the commit that made the run had it (:func:`scene_files_of`,
+    in a folder beside ``out``): a scene file changed since would otherwise make another run, and the
+    comparison would blame the code."""
     marker = run / "lagice_run.json"
     if not marker.exists():
         raise SystemExit(f"rerun_check: {run} has no lagice_run.json: not a lagice run folder")
-    argv = shlex.split(json.loads(marker.read_text()).get("command") or "")
+    info = json.loads(marker.read_text())
+    argv = shlex.split(info.get("command") or "")
     if len(argv) < 3 or argv[1] != "run" or "--out" not in argv:
         raise SystemExit(f"rerun_check: {marker}: its command is not a 'lagice run ... --out ...' command: {argv}")
     argv = [sys.executable, "-m", "lagice.cli", *argv[1:]]
     argv[argv.index("--out") + 1] = str(out)
+    scene = Path(argv[4])
+    commit, modified = str(info.get("git_commit") or ""), info.get("git_modified_files")
+    if scene.suffix == ".toml" and scene.parent.resolve() == (ROOT / "examples").resolve() and commit:
+        if any(f.startswith("examples/") for f in modified or ()) or (modified is None and commit.endswith("-dirty")):
+            print(f"rerun_check: {run.name}: made from a work tree whose scene files were modified; today's "
+                  f"{scene.name} is read", flush=True)
+        else:
+            argv[4] = str(scene_files_of(commit.removesuffix("-dirty"), out.parent / "examples") / scene.name)
     return [a for a in argv if a not in ("--overwrite", "--resume")]
+
+
+def scene_files_of(commit: str, folder: Path) -> Path:
+    """The scene files (``examples/*.toml``) of ``commit`` from git, written into ``folder`` (together, so
+    that ``extends`` finds its base; their relative paths to data are read from the checkout's root)."""
+    names = subprocess.run(["git", "ls-tree", "--name-only", commit, "examples/"], cwd=ROOT, capture_output=True,
+                           text=True, check=False)
+    if names.returncode != 0:
+        raise SystemExit(f"rerun_check: commit {commit} is not in this checkout's git history "
+                         f"({names.stderr.strip()}); its scene files cannot be read")
+    folder.mkdir(parents=True, exist_ok=True)
+    for f in names.stdout.split():
+        if f.endswith(".toml"):
+            blob = subprocess.run(["git", "show", f"{commit}:{f}"], cwd=ROOT, capture_output=True, check=True)
+            (folder / Path(f).name).write_bytes(blob.stdout)
+    return folder
 
 
 #: netCDF4/HDF5 is not safe to call from two threads at once: with ``--jobs 2`` two comparisons that

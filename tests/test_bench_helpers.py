@@ -263,6 +263,7 @@ def test_physics_run_queues_deal_the_runs_round_robin_and_check_names_first(monk
     overrides do not resolve, stops the command before any run starts."""
     import physics_experiments as pe
 
+    monkeypatch.setattr(pe, "SCENE_DIRS", {})   # today's scene files (those of an earlier commit come from git)
     names = ["F10-hthick-hnullsp", "F10s-hthick-hnullsp", "F10-hthick-hnullsp-w2027", "F10s-hthick-hnullsp-w2027",
              "F10-hthick-hnullsp-w2028"]
     assert pe.queues(names, 2) == [names[0::2], names[1::2]]
@@ -281,7 +282,8 @@ def test_physics_run_queues_deal_the_runs_round_robin_and_check_names_first(monk
            "F10-twice": (scene, [*overrides, "run.seed=1", "run.seed=2"], *rest)}
     monkeypatch.setattr(pe, "EXPERIMENTS", {**pe.EXPERIMENTS, **bad})
     for name in bad:
-        with pytest.raises(SystemExit, match=rf"experiment '{name}' \(scene winter_basin_pack\) does not resolve"):
+        with pytest.raises(SystemExit, match=rf"experiment '{name}' \(scene \S*winter_basin_pack\.toml\) does not "
+                                             "resolve"):
             pe.run_queues(names + [name], 2)
     assert started == []
     # the command line takes the names before or after --jobs (argparse read none after it, 2026-11-29)
@@ -319,7 +321,7 @@ def test_physics_queue_goes_on_after_a_failed_run_and_then_fails(monkeypatch):
     assert tried == names[2:]
 
 
-def test_every_physics_experiment_resolves_to_a_valid_scene():
+def test_every_physics_experiment_resolves_to_a_valid_scene(tmp_path, monkeypatch):
     """Each run and spin-up of benchmarks/physics_experiments.py is a bundled scene with
     ``--set`` overrides; a key given twice with two values or a key the scene does not know
     would stop that run only when its turn came (hours into a queue). All of them resolve
@@ -329,17 +331,69 @@ def test_every_physics_experiment_resolves_to_a_valid_scene():
 
     from lagice.scenes.config import load_scene
 
+    # the definitions made before 2026-11-30's scene change read that commit's scene files (written from git)
+    folder = tmp_path / "scenes"
+    try:
+        pe.write_scenes(pe.SCENES_BEFORE_NS_COMMIT, folder)
+    except SystemExit as exc:   # a clone without that commit (shallow): said, not silently passed
+        pytest.skip(f"git history without commit {pe.SCENES_BEFORE_NS_COMMIT}: {exc}")
+    monkeypatch.setattr(pe, "SCENE_DIRS", {k: folder for k in pe.SCENE_DIRS})
     shipped = {sc: load_scene(name) for sc, name in pe.SCENES.items()}
     for name, (scene, overrides, _res, _days, _what) in pe.EXPERIMENTS.items():
-        cfg = load_scene(pe.SCENES[scene], overrides)
+        cfg = load_scene(str(pe.scene_file(name)), overrides)
         assert cfg["scene"]["name"] == shipped[scene]["scene"]["name"], name
-    for overrides, _target, _res in pe.SPINUPS.values():
+    for name, (overrides, _target, _res) in pe.SPINUPS.items():
         if overrides is not None:
-            load_scene("winter_basin_spinup", overrides)
+            load_scene(str(pe.scene_file(f"spinup:{name}")), overrides)
+    # a definition made before the change keeps the values of then; the runs of the change read today's scene
+    before = load_scene(str(pe.scene_file("F10-hthick-m10")), pe.EXPERIMENTS["F10-hthick-m10"][1])
+    after = load_scene(str(pe.scene_file("F10-hthick-src-m10")), pe.EXPERIMENTS["F10-hthick-src-m10"][1])
+    assert before["forcing"]["drag"].get("turning_angle_deg", 0.0) == 0.0
+    assert after["forcing"]["drag"]["turning_angle_deg"] == 25.0
+    assert pe.scene_file("F10-hthick-src-m10") == pe.EXAMPLES / "winter_basin_pack.toml"
     # the screened set's own overrides reach the scene
     cfg = load_scene(pe.SCENES["closed"], pe.EXPERIMENTS["F10-hthick-str50hnullsp"][1])
     assert cfg["rheology"]["strength_lab_pa"] == 1.4e6 and cfg["thermo"]["params"]["new_ice_thickness_m"] == 0.25
     assert cfg != shipped["closed"]
+
+
+def test_a_physics_run_is_not_made_again_under_its_name_with_other_settings(tmp_path, monkeypatch):
+    """physics_experiments.check_settings: a run recorded as made from a commit's scene file with some
+    overrides may be made again by a definition that resolves to the same settings (with the scene
+    files of that commit, from git), and is refused, naming the key, once the definition (or the scene)
+    gives another value; a run made from a work tree whose scene files were modified cannot be checked
+    and is let through (with a note)."""
+    import json
+    import subprocess
+
+    import physics_experiments as pe
+
+    head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=pe.ROOT, capture_output=True, text=True,
+                          check=True).stdout.strip()
+    if subprocess.run(["git", "diff", "--quiet", "HEAD", "--", "examples"], cwd=pe.ROOT).returncode != 0:
+        pytest.skip("examples/ differs from HEAD in this work tree: the test compares HEAD's scene files")
+    monkeypatch.setattr(pe, "OUT", tmp_path)
+    name = "T10-check"
+    (tmp_path / name).mkdir()
+    made = pe.command("closed", ["rheology.friction=0.9"], 10e3, 28, tmp_path / name)
+    line = " ".join(made[2:]).replace("lagice.cli", str(pe.ROOT / "lagice" / "cli.py"), 1)
+    marker = {"command": line, "git_commit": head, "git_modified_files": [], "fingerprint": "x"}
+    (tmp_path / name / "lagice_run.json").write_text(json.dumps(marker))
+    pe.check_settings(name, pe.command("closed", ["rheology.friction=0.9"], 10e3, 28, tmp_path / name))
+    with pytest.raises(SystemExit, match="rheology.friction: 0.9 then, 0.8 now"):
+        pe.check_settings(name, pe.command("closed", ["rheology.friction=0.8"], 10e3, 28, tmp_path / name))
+    # the scene file of another folder (today's is copied there with one value changed): refused too
+    other = tmp_path / "scenes-other"
+    pe.write_scenes("HEAD", other)
+    text = (other / "winter_basin_pack.toml").read_text()
+    (other / "winter_basin_pack.toml").write_text(text.replace("air_drag = 2.0e-3", "air_drag = 1.5e-3"))
+    with pytest.raises(SystemExit, match="forcing.drag.air_drag"):
+        pe.check_settings(name, pe.command("closed", ["rheology.friction=0.9"], 10e3, 28, tmp_path / name,
+                                           other / "winter_basin_pack.toml"))
+    # made from a work tree whose scene files were modified: not checked
+    marker["git_modified_files"] = ["examples/winter_basin_pack.toml"]
+    (tmp_path / name / "lagice_run.json").write_text(json.dumps(marker))
+    pe.check_settings(name, pe.command("closed", ["rheology.friction=0.8"], 10e3, 28, tmp_path / name))
 
 
 def test_beta_components_separate_a_coherent_convergence_from_cancelling_shear():
@@ -893,6 +947,35 @@ def test_a_run_made_again_from_its_folder_record_is_the_same_bit_for_bit(tmp_pat
     ds.to_netcdf(last)
     diff = compare_runs(run, copy)
     assert diff["differ"] == [name] and diff["max_abs_difference"] == pytest.approx(1.0, rel=1e-6)
+
+
+def test_a_run_is_made_again_from_the_scene_files_of_its_commit(tmp_path):
+    """rerun_check.rerun_command: a run whose recorded scene is a file of examples/ is made again from that
+    file as the run's commit had it (from git), not as the work tree has it now; a run made from a work
+    tree whose scene files were modified reads today's file (said)."""
+    import json
+    import subprocess
+
+    from rerun_check import ROOT, rerun_command
+
+    head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True,
+                          check=True).stdout.strip()
+    scene = ROOT / "examples" / "winter_basin_pack.toml"
+    run = tmp_path / "run"
+    run.mkdir()
+    marker = {"command": f"{ROOT / 'lagice' / 'cli.py'} run {scene} --out {run} --set run.duration=1d",
+              "git_commit": head, "git_modified_files": []}
+    (run / "lagice_run.json").write_text(json.dumps(marker))
+    cmd = rerun_command(run, tmp_path / "again" / "run")
+    assert cmd[4] == str(tmp_path / "again" / "examples" / "winter_basin_pack.toml")
+    committed = subprocess.run(["git", "show", f"{head}:examples/winter_basin_pack.toml"], cwd=ROOT,
+                               capture_output=True, check=True).stdout
+    assert Path(cmd[4]).read_bytes() == committed
+    assert (tmp_path / "again" / "examples" / "winter_basin_pack_strait.toml").exists()   # its `extends` base too
+    assert cmd[cmd.index("--out") + 1] == str(tmp_path / "again" / "run") and "--set" in cmd
+    marker["git_modified_files"] = ["examples/winter_basin_pack.toml"]
+    (run / "lagice_run.json").write_text(json.dumps(marker))
+    assert rerun_command(run, tmp_path / "again2" / "run")[4] == str(scene)
 
 
 def test_rotation_summary_carries_the_ensemble_verdicts_and_their_intervals():
