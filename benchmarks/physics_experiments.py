@@ -64,6 +64,8 @@ def scene_file(name: str) -> Path:
     if name.startswith("spinup:"):
         return SCENE_DIRS.get(name, EXAMPLES) / "winter_basin_spinup.toml"
     return SCENE_DIRS.get(name, EXAMPLES) / f"{SCENES[EXPERIMENTS[name][0]]}.toml"
+
+
 #: the EVP comparison rheology on the same scene (as benchmarks/validate.py)
 EVP = ["solver.name=evp", "rheology.law=viscous_plastic", "healing.law=none", "solver.dt=30min",
        "solver.substeps=300"]
@@ -291,6 +293,18 @@ def made_settings(name: str) -> tuple[dict | None, str]:
     return resolved_settings(argv), ""
 
 
+def settings_changed(name: str, cmd: list) -> tuple[list | None, str]:
+    """The settings in which command ``cmd`` differs from those run ``name`` was made with
+    (:func:`made_settings`), as ``[(key, then, now), ...]`` (``"<absent>"`` where one side lacks the key);
+    ``(None, why)`` where they cannot be told."""
+    made, why = made_settings(name)
+    if made is None:
+        return None, why
+    now = resolved_settings(cmd)
+    return [(k, made.get(k, "<absent>"), now.get(k, "<absent>")) for k in sorted(set(made) | set(now))
+            if made.get(k, "<absent>") != now.get(k, "<absent>")], ""
+
+
 def settings_report(names: list) -> int:
     """For each of ``names`` (default: every run folder of a defined experiment), whether its definition
     still resolves to the settings the run was made with (:func:`made_settings`); 1 if any does not."""
@@ -298,16 +312,14 @@ def settings_report(names: list) -> int:
     counts = {"same": 0, "differ": 0, "unknown": 0}
     for n in names:
         scene, overrides, res, days, _ = EXPERIMENTS[n]
-        made, why = made_settings(n)
-        if made is None:
+        diff, why = settings_changed(n, command(scene, overrides, res, days, OUT / n, scene_file(n)))
+        if diff is None:
             counts["unknown"] += 1
             print(f"  {n}: cannot be told ({why})")
             continue
-        now = resolved_settings(command(scene, overrides, res, days, OUT / n, scene_file(n)))
-        diff = sorted(k for k in set(made) | set(now) if made.get(k, "<absent>") != now.get(k, "<absent>"))
         counts["differ" if diff else "same"] += 1
         if diff:
-            print(f"  {n}: DIFFERS in {', '.join(diff)}")
+            print(f"  {n}: DIFFERS in {', '.join(k for k, _a, _b in diff)}")
     print(f"physics: settings of {len(names)} runs against their definitions: {counts['same']} the same, "
           f"{counts['differ']} different, {counts['unknown']} not known")
     return int(counts["differ"] > 0)
@@ -318,15 +330,13 @@ def check_settings(name: str, cmd: list) -> None:
     (:func:`made_settings`): a scene file or the definition changed since, and the run published under the
     name would silently be replaced by another. The keys that differ are named. A run whose settings
     cannot be told (no record, a modified work tree) is made, with a note."""
-    made, why = made_settings(name)
-    if made is None:
+    diff, why = settings_changed(name, cmd)
+    if diff is None:
         if why != "no record":
             print(f"physics: note: {name}: the settings it was made with cannot be checked ({why})", flush=True)
         return
-    now = resolved_settings(cmd)
-    diff = sorted(k for k in set(made) | set(now) if made.get(k, "<absent>") != now.get(k, "<absent>"))
     if diff:
-        shown = "; ".join(f"{k}: {made.get(k, '<absent>')!r} then, {now.get(k, '<absent>')!r} now" for k in diff[:6])
+        shown = "; ".join(f"{k}: {a!r} then, {b!r} now" for k, a, b in diff[:6])
         raise SystemExit(f"physics: {name} was made with other settings than its definition gives now ({shown}"
                          f"{'; ...' if len(diff) > 6 else ''}; scene {cmd[cmd.index('run') + 1]}): a scene file or "
                          f"the definition changed since. Define the new run under a new name, or remove "
