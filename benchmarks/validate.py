@@ -734,7 +734,7 @@ def figure_ensemble_bands(ens: dict, basin: dict, fig_dir: Path) -> Path | None:
         scene, _, note = g.partition(", ")
         return scene if not note else f"{scene}\n(older set)"
 
-    def style(x, g):
+    def style(g):
         return {"color": "tab:red" if g.startswith("closed") else "tab:orange", "alpha": 1.0 if "," not in g else 0.45}
 
     for ax, k in zip(axes, keys):
@@ -745,7 +745,7 @@ def figure_ensemble_bands(ens: dict, basin: dict, fig_dir: Path) -> Path | None:
             vals = np.array([np.nan if v is None else v for v in
                              (wind_factor(e["members"][n]) if k == "wind_factor" else e["members"][n]["median"][k]
                               for n in names)], dtype=np.float64)
-            st = style(x, g)
+            st = style(g)
             xs = x + rng.uniform(-0.18, 0.18, vals.size)
             ax.plot(xs, vals, "o", ms=4, **st, label="a month (Maxwell-EB)" if x == 0 else None)
             ax.plot(xs[:1], vals[:1], "o", ms=9, mfc="none", color="k", alpha=st["alpha"],
@@ -773,7 +773,7 @@ def figure_ensemble_bands(ens: dict, basin: dict, fig_dir: Path) -> Path | None:
         b, iv = pc.get("beta_space_grids"), pc.get("beta_space_grids_interval_90")
         if b is not None:
             err = None if iv is None else [[b - iv[0]], [iv[1] - b]]
-            ax.errorbar([x], [b], yerr=err, fmt="s", ms=6, capsize=4, **style(x, g))
+            ax.errorbar([x], [b], yerr=err, fmt="s", ms=6, capsize=4, **style(g))
     ax.set_ylim(0, max(0.22, ax.get_ylim()[1]))
     ax.set_title("β as observed β is computed: one slope over\nevery box of every window (90 % interval)",
                  fontsize=8)
