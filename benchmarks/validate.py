@@ -1188,35 +1188,18 @@ def pooled_months(per_month: list) -> dict | None:
 
 def _resampled_betas(per_month: list, picks) -> list:
     """β of :func:`lagice.diagnostics.scaling.pooled_spatial_scaling` over the curves of the months in
-    each row of ``picks`` (month indices, with repeats), from each month's box-weighted sums made once:
-    the same pooled ⟨ε̇tot⟩ and scale at each width, the same widths (those every curve holds, each
-    counted in at least :data:`~lagice.diagnostics.scaling.MIN_FIT_BOXES` boxes by every curve) and the
-    same fit as pooling the rows' curves one by one, to round-off (the sums are added in another order),
-    in a fraction of its time (``tests/test_bench_helpers.py``). The curves must pool (checked by the
-    caller over every month)."""
-    from lagice.diagnostics.scaling import MIN_FIT_BOXES, fit_power_law
+    each row of ``picks`` (month indices, with repeats), pooling each month's curves once into one curve
+    (with its ``fewest_boxes``) and then the rows' month curves: the same β as pooling the rows' curves
+    one by one, to round-off (the sums are added in another order), in a fraction of its time
+    (``tests/test_bench_helpers.py``). The curves must pool (checked by the caller over every month)."""
+    from lagice.diagnostics.scaling import pooled_spatial_scaling
 
-    sums = []   # per month: rows, Σ n ⟨ε̇⟩, Σ n L, Σ n, min n (over the month's curves, per width)
+    months = []
     for curves in per_month:
-        el = int(curves[0]["box_size_m"][0] is None)
-        rows = el + min(len(c["box_size_m"]) - el for c in curves)
-        n = np.array([np.asarray(c["n_boxes"], dtype=np.float64)[:rows] for c in curves])
-        m = np.array([np.asarray(c["mean_total_s"], dtype=np.float64)[:rows] for c in curves])
-        sc = np.array([np.asarray(c["scale_m"], dtype=np.float64)[:rows] for c in curves])
-        sums.append((rows, (n * np.where(n > 0, m, 0.0)).sum(axis=0), (n * np.where(n > 0, sc, 0.0)).sum(axis=0),
-                     n.sum(axis=0), n.min(axis=0)))
-    out = []
-    for row in picks:
-        months, counts = np.unique(row, return_counts=True)
-        rows = min(sums[i][0] for i in months)
-        nm, ns, n_tot = (sum(c * sums[i][j][:rows] for i, c in zip(months, counts)) for j in (1, 2, 3))
-        fewest = np.min([sums[i][4][:rows] for i in months], axis=0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            mean = np.where(n_tot > 0, nm / n_tot, np.nan)
-            scale = np.where(n_tot > 0, ns / n_tot, np.nan)
-        used = fewest >= MIN_FIT_BOXES
-        out.append(fit_power_law(scale[used], mean[used]).exponent)
-    return out
+        p = pooled_spatial_scaling(curves)
+        months.append({"box_size_m": list(curves[0]["box_size_m"])[:p.scale_m.size], "scale_m": p.scale_m,
+                       "mean_total_s": p.mean_total_s, "n_boxes": p.n_boxes, "fewest_boxes": p.fewest_boxes})
+    return [pooled_spatial_scaling([months[i] for i in row]).fit.exponent for row in picks]
 
 
 #: resamples of the months in :func:`pooled_windows`' interval, and its seed

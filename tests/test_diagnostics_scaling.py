@@ -351,3 +351,31 @@ def test_pooled_spatial_scaling_refuses_curves_that_do_not_match(mesh):
     for bad in (0, 2.5, True):
         with pytest.raises(ConfigError, match="min_boxes"):
             pooled_spatial_scaling([c], min_boxes=bad)
+
+
+def test_pooling_pools_gives_pooling_every_curve():
+    """pooled_spatial_scaling of curves that are themselves pools (their PooledScaling as a curve, with
+    ``fewest_boxes``) gives the curve and β of pooling all their curves at once, including which widths a
+    thinly counted curve leaves out of the fit; without ``fewest_boxes`` the pooled counts would keep them."""
+    rng = np.random.default_rng(2)
+    widths = [10e3, 20e3, 40e3, 80e3]
+
+    def curve():
+        return {"box_size_m": widths, "scale_m": widths, "mean_total_s": list(rng.lognormal(-14, 1.0, 4)),
+                "n_boxes": [int(rng.integers(9, 60)) for _ in widths]}
+
+    groups = [[curve() for _ in range(5)] for _ in range(3)]
+    groups[1][2]["n_boxes"][3] = 4   # one curve counts 4 boxes at 80 km: that width leaves the fit
+    whole = pooled_spatial_scaling([c for g in groups for c in g])
+    pools = []
+    for g in groups:
+        p = pooled_spatial_scaling(g)
+        pools.append({"box_size_m": widths, "scale_m": p.scale_m, "mean_total_s": p.mean_total_s,
+                      "n_boxes": p.n_boxes, "fewest_boxes": p.fewest_boxes})
+    again = pooled_spatial_scaling(pools)
+    assert np.allclose(again.mean_total_s, whole.mean_total_s, rtol=1e-13)
+    assert np.array_equal(again.fewest_boxes, whole.fewest_boxes) and whole.fewest_boxes[3] == 4
+    assert again.fit.exponent == pytest.approx(whole.fit.exponent, rel=1e-12)
+    assert whole.fit.n_points == 3
+    plain = pooled_spatial_scaling([{k: v for k, v in p.items() if k != "fewest_boxes"} for p in pools])
+    assert plain.fit.n_points == 4

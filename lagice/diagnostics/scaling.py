@@ -465,6 +465,9 @@ def pooled_spatial_scaling(curves, min_boxes=MIN_FIT_BOXES, fit_range_m=None, wi
         in order (the k-th box width of every curve) over the widths every curve holds; they
         must agree within ``width_tolerance`` (relative), so curves of different meshes are
         refused. Either every curve starts with the element scale (``box_size_m`` None) or none.
+        A curve that is itself a pool of curves may carry ``fewest_boxes`` (the fewest boxes any
+        of its curves counts, :attr:`PooledScaling.fewest_boxes`), so that pooling pools gives
+        what pooling all their curves gives.
     min_boxes : int
         A width enters the fit only if every curve counts at least this many boxes at it (the
         rule of each window's own fit, default :data:`MIN_FIT_BOXES`).
@@ -498,7 +501,10 @@ def pooled_spatial_scaling(curves, min_boxes=MIN_FIT_BOXES, fit_range_m=None, wi
         if not (len(w) == sc.size == m.size == n.size):
             raise ConfigError(f"pooled_spatial_scaling: curve {i} has lists of lengths {len(w)}, {sc.size}, "
                               f"{m.size}, {n.size}; expected one entry per scale in each")
-        rows.append((w, sc, m, n))
+        few = np.asarray(c.get("fewest_boxes", n), dtype=np.float64)
+        if few.size != n.size:
+            raise ConfigError(f"pooled_spatial_scaling: curve {i} has {few.size} fewest_boxes for {n.size} scales")
+        rows.append((w, sc, m, n, few))
     has_el = [bool(r[0]) and r[0][0] is None for r in rows]
     if any(has_el) != all(has_el):
         raise ConfigError(f"pooled_spatial_scaling: {sum(has_el)} of {len(rows)} curves start with the element "
@@ -515,11 +521,12 @@ def pooled_spatial_scaling(curves, min_boxes=MIN_FIT_BOXES, fit_range_m=None, wi
     sc = np.array([r[1][:n_rows] for r in rows]).reshape(len(rows), n_rows)
     m = np.array([r[2][:n_rows] for r in rows]).reshape(len(rows), n_rows)
     n = np.array([r[3][:n_rows] for r in rows]).reshape(len(rows), n_rows)
+    few = np.array([r[4][:n_rows] for r in rows]).reshape(len(rows), n_rows)
     n_tot = n.sum(axis=0)
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = np.where(n_tot > 0, (n * np.where(n > 0, m, 0.0)).sum(axis=0) / n_tot, np.nan)
         scale = np.where(n_tot > 0, (n * np.where(n > 0, sc, 0.0)).sum(axis=0) / n_tot, np.nan)
-    fewest = n.min(axis=0)
+    fewest = few.min(axis=0)
     used = fewest >= min_boxes
     fit = fit_power_law(scale[used], mean[used], fit_range_m)
     return PooledScaling(scale, mean, n_tot.astype(np.int64), fewest.astype(np.int64), len(rows), fit)
