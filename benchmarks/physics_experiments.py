@@ -229,19 +229,14 @@ BASIN_SCENE_FILES = ("winter_basin_pack.toml", "winter_basin_pack_strait.toml", 
 
 
 def write_scenes(commit: str, folder: Path) -> None:
-    """The basin scene files of ``commit`` (:data:`BASIN_SCENE_FILES`, from git) into ``folder``, where
-    missing. Their relative paths (coast, spin-up state) are read from the checkout's root, as lagice
-    reads them from the working folder or the repository."""
-    for f in BASIN_SCENE_FILES:
-        target = folder / f
-        if target.exists():
-            continue
-        blob = subprocess.run(["git", "show", f"{commit}:examples/{f}"], cwd=ROOT, capture_output=True, check=False)
-        if blob.returncode != 0:
-            raise SystemExit(f"physics: cannot read examples/{f} of commit {commit} from git "
-                             f"({blob.stderr.decode().strip()}); the experiments defined before it need a git checkout")
-        folder.mkdir(parents=True, exist_ok=True)
-        target.write_bytes(blob.stdout)
+    """The scene files of ``commit`` (``examples/*.toml``, from git: :func:`rerun_check.scene_files_of`) into
+    ``folder``, unless the basin scenes (:data:`BASIN_SCENE_FILES`) are there already. Their relative paths
+    (coast, spin-up state) are read from the checkout's root, as lagice reads them from the working folder
+    or the repository."""
+    from rerun_check import scene_files_of
+
+    if not all((folder / f).exists() for f in BASIN_SCENE_FILES):
+        scene_files_of(commit, folder)
 
 
 def resolved_settings(cmd: list) -> dict:
