@@ -1,0 +1,256 @@
+"""β against the element size on a test bed a hundred times cheaper than the basin (issue 12).
+
+In the basin, the families whose floes are held by a sparse network of weak bands lose 0.02–0.07 of β
+from 20 to 10 km, at the neXtSIM strength law and at the same cohesion in pascals alike, and the cause
+is not found (docs/physics.md §5). A basin month at 10 km costs 6–7 minutes and its β moves by about
+0.03 with the weather and the box grid, so every test of a cause has cost hours. This script asks the
+same question of one cyclone over a closed disk 500 km in radius (``examples/imprint_cyclone_disk.toml``
+on ``data_stubs/disk_500km.geojson``): pristine 1 m ice, no healing, no thermodynamics, no remeshing, no
+spin-up, 3 days. A run takes 10 s at 20 km and about 3 min at 5 km on one core.
+
+Families (``--family``): ``lead``, the strong-floe lead of the basin (the effective envelope, damage cap
+0.97, C_lab 22.4 MPa: docs/physics.md §4, "Strong floes in a weak network"); ``shipped``, the flagship's
+nominal envelope at neXtSIM's strength (C_lab 2.80 MPa in lagice's form). Strength (``--law``):
+``same_pa``, the lab cohesion times √(Δx/20 km), so that every mesh has the 20 km mesh's cohesion in
+pascals; ``scaled``, neXtSIM's law as shipped (a mesh √2 finer is √2 stronger).
+
+Statistic: one Lagrangian window over the cyclone's passage, days 1–3 (the ice does not move before
+day 1), on the elements at least 100 km from the coast, with the validation's estimator
+(:func:`lagice.diagnostics.windows.window_summary`). β is fitted on the box widths every mesh resolves,
+25–220 km (``COMMON_FIT_M``; widths with at least 10 boxes, in practice 26–150 km: two to three
+widths per mesh), and also on each mesh's own widths.
+
+Rule RD (written at 21:57 UTC on 2026-11-30, before the runs of this script; a preview of three seeds on
+the 300 km disk was seen first: per-day β on each mesh's own widths 0.17–0.39 at 20 km, 0.06–0.15 at
+10 km, 0.07–0.17 at 5 km). Family ``lead``, law ``same_pa``, meshes 20, 14, 10, 7 and 5 km, seeds 12–17.
+  (R1) The disk reproduces the basin's fall if the median β (common widths) at 10 km is at least 0.02
+       below the median at 20 km.
+  (R2) β has converged by 10 km if the medians at 7 and 5 km both lie within 0.02 of the 10 km median;
+       it keeps falling if the 5 km median is at least 0.02 below the 10 km one.
+  Predicted: R1 holds, by 0.05–0.15; R2 says converged. If so, the basin's fall would be the 20 km
+  mesh's coarseness in this family, and its 10 km statistics the converged model's.
+
+    python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
+    python benchmarks/disk_convergence.py report --family lead --law same_pa
+
+Runs go to ``benchmarks/out/disk_convergence/FAMILY-LAW-KMkm-sSEED`` (``lagice run`` subprocesses, one
+numba thread each); ``report`` writes ``docs/figures/disk_convergence.json`` (every family and law run so
+far) and ``docs/figures/disk_convergence_FAMILY_LAW.png``.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "benchmarks" / "out" / "disk_convergence"
+JSON = ROOT / "docs" / "figures" / "disk_convergence.json"
+SCENE = ROOT / "examples" / "imprint_cyclone_disk.toml"
+DISK = "data_stubs/disk_500km.geojson"
+DAY_S = 86400.0
+
+KM = (20, 14, 10, 7, 5)
+SEEDS = tuple(range(12, 18))
+#: (scene overrides, C_lab [Pa] in lagice's form at the reference size)
+FAMILIES = {
+    "lead": (["rheology.failure_stress=effective", "rheology.max_damage=0.97"], 22.4e6),
+    "shipped": ([], 2.80e6),
+}
+LAWS = ("same_pa", "scaled")
+REFERENCE_KM = 20.0
+#: the window: the cyclone's passage
+WINDOW_DAYS = (1.0, 3.0)
+COAST_BUFFER_M = 100e3
+#: box widths every mesh resolves [m] (L of the estimator; inclusive)
+COMMON_FIT_M = (25e3, 220e3)
+MIN_BOXES = 10
+
+
+def lab_cohesion_pa(family: str, law: str, km: float) -> float:
+    """C_lab [Pa] for a mesh of ``km``: the family's value (``scaled``), or that value times
+    √(Δx/20 km) so that the cohesion in pascals is the 20 km mesh's (``same_pa``)."""
+    base = FAMILIES[family][1]
+    return base * (np.sqrt(km / REFERENCE_KM) if law == "same_pa" else 1.0)
+
+
+def run_name(family: str, law: str, km: float, seed: int) -> str:
+    return f"{family}-{law}-{km:g}km-s{seed}"
+
+
+def command(family: str, law: str, km: float, seed: int) -> list:
+    sets = [f"domain.file={DISK}", f"domain.resolution_m={km * 1e3:g}", f"run.seed={seed}",
+            f"rheology.strength_lab_pa={lab_cohesion_pa(family, law, km):.6g}", "output.every=6h",
+            *FAMILIES[family][0]]
+    cmd = [sys.executable, "-m", "lagice", "run", str(SCENE), "--out", str(OUT / run_name(family, law, km, seed))]
+    for s in sets:
+        cmd += ["--set", s]
+    return cmd
+
+
+def run_one(family, law, km, seed) -> str:
+    name = run_name(family, law, km, seed)
+    out = OUT / name
+    if (out / "snapshots" / "index.json").exists():
+        return f"{name}: done before"
+    OUT.mkdir(parents=True, exist_ok=True)
+    env = {**os.environ, "NUMBA_NUM_THREADS": os.environ.get("NUMBA_NUM_THREADS", "1")}
+    with open(OUT / f"{name}.log", "w") as log:
+        subprocess.run(command(family, law, km, seed), check=True, stdout=log, stderr=subprocess.STDOUT,
+                       cwd=ROOT, env=env)
+    return f"{name}: made"
+
+
+def common_beta(curve: dict) -> float:
+    """β on the widths in :data:`COMMON_FIT_M` with at least :data:`MIN_BOXES` boxes (NaN if fewer
+    than 2 such widths)."""
+    from lagice.diagnostics.scaling import fit_power_law
+
+    L = np.array(curve["scale_m"], float)
+    r = np.array(curve["mean_total_s"], float)
+    n = np.array(curve["n_boxes"], float)
+    box = np.array([b is not None for b in curve["box_size_m"]])
+    ok = box & (n >= MIN_BOXES)
+    return float(fit_power_law(L[ok], r[ok], fit_range=COMMON_FIT_M).exponent)
+
+
+def analyse_run(path: Path) -> dict:
+    from lagice.diagnostics.windows import window_summary
+
+    start, end = WINDOW_DAYS
+    w = window_summary(path, start * DAY_S, (end - start) * DAY_S, COAST_BUFFER_M)
+    s = w["interior"]
+    return {"beta_common": common_beta(s["scaling_space"]), "beta_own": s["beta_space"],
+            "mean_total_per_day": s["mean_total_s"] * DAY_S,
+            "half_shear_area_fraction": s["localisation_half_shear_area_fraction"],
+            "element_scale_m": s["element_scale_m"], "n_elements_interior": int(s["scaling_space"]["n_boxes"][0]),
+            "curve": s["scaling_space"]}
+
+
+def summarise(runs: dict) -> dict:
+    """Per mesh: the medians over the seeds and a 90 % interval of the median (resampling seeds)."""
+    rng = np.random.default_rng(0)
+    out = {}
+    for km in sorted({r["km"] for r in runs.values()}, reverse=True):
+        rows = [r for r in runs.values() if r["km"] == km]
+        row = {"n_seeds": len(rows)}
+        for k in ("beta_common", "beta_own", "mean_total_per_day", "half_shear_area_fraction"):
+            v = np.array([r[k] for r in rows], float)
+            v = v[np.isfinite(v)]
+            boot = np.median(rng.choice(v, size=(2000, v.size)), axis=1) if v.size else np.array([np.nan])
+            row[k] = {"median": float(np.median(v)) if v.size else None,
+                      "interval90": [float(np.quantile(boot, 0.05)), float(np.quantile(boot, 0.95))],
+                      "values": [float(x) for x in v]}
+        out[f"{km:g}"] = row
+    return out
+
+
+def verdict(summary: dict) -> dict:
+    """Rule RD's two tests on the medians of β on the common widths."""
+    med = {float(k): v["beta_common"]["median"] for k, v in summary.items()}
+    if not all(k in med for k in (20.0, 10.0, 7.0, 5.0)):
+        return {"complete": False}
+    fall = med[20.0] - med[10.0]
+    d7, d5 = med[7.0] - med[10.0], med[5.0] - med[10.0]
+    return {"complete": True, "fall_20_to_10": fall, "R1_disk_reproduces_fall": bool(fall >= 0.02),
+            "change_7_vs_10": d7, "change_5_vs_10": d5,
+            "R2_converged_by_10km": bool(abs(d7) < 0.02 and abs(d5) < 0.02),
+            "R2_keeps_falling": bool(d5 <= -0.02)}
+
+
+def figure(family: str, law: str, summary: dict, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    keys = (("beta_common", "β, widths 25–220 km", (0.17, 0.20)),
+            ("mean_total_per_day", "⟨ε̇tot⟩ (day⁻¹)", (0.01, 0.05)),
+            ("half_shear_area_fraction", "area holding half the shear", (0.04, 0.08)))
+    fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
+    kms = sorted((float(k) for k in summary), reverse=True)
+    for ax, (k, label, band) in zip(axes, keys):
+        ax.axhspan(*band, color="0.85", label="observed (basin statistics)")
+        for km in kms:
+            v = summary[f"{km:g}"][k]["values"]
+            ax.plot([km] * len(v), v, "o", color="tab:blue", alpha=0.5, ms=4)
+        med = [summary[f"{km:g}"][k]["median"] for km in kms]
+        ax.plot(kms, med, "k-s", label="median over seeds")
+        ax.set_xscale("log")
+        ax.set_xticks(kms)
+        ax.set_xticklabels([f"{km:g}" for km in kms])
+        ax.invert_xaxis()
+        ax.set_xlabel("element size (km)")
+        ax.set_title(label, fontsize=10)
+        if k != "beta_common":
+            ax.set_yscale("log")
+    axes[0].legend(fontsize=7)
+    fig.suptitle(f"one cyclone over a 500 km disk, days 1–3: family {family}, strength {law}", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def report(family: str, law: str) -> dict:
+    runs = {}
+    for path in sorted(OUT.glob(f"{family}-{law}-*km-s*")):
+        if not (path / "snapshots" / "index.json").exists():
+            continue
+        km = float(path.name.split("-")[2][:-2])
+        seed = int(path.name.split("-s")[-1])
+        runs[path.name] = {"km": km, "seed": seed, **analyse_run(path)}
+        r = runs[path.name]
+        print(f"{path.name:28s} β common {r['beta_common']:.3f}  own {r['beta_own']:.3f}  "
+              f"rate {r['mean_total_per_day']:.4f}/day  half-shear area {100 * r['half_shear_area_fraction']:.1f} %")
+    if not runs:
+        raise SystemExit(f"no finished runs of {family}-{law} in {OUT}")
+    summary = summarise(runs)
+    print(f"\n{'mesh':>6} {'seeds':>5} {'β common (90 %)':>24} {'β own':>7} {'rate/day':>9} {'half-shear':>10}")
+    for km, row in summary.items():
+        b = row["beta_common"]
+        print(f"{km:>4}km {row['n_seeds']:>5} {b['median']:>8.3f} [{b['interval90'][0]:.3f}, {b['interval90'][1]:.3f}]"
+              f" {row['beta_own']['median']:>7.3f} {row['mean_total_per_day']['median']:>9.4f}"
+              f" {100 * row['half_shear_area_fraction']['median']:>9.1f}%")
+    v = verdict(summary)
+    print("\nrule RD:", json.dumps(v))
+    data = json.loads(JSON.read_text()) if JSON.exists() else {}
+    commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+    data[f"{family}-{law}"] = {"git_commit": commit, "window_days": list(WINDOW_DAYS),
+                               "coast_buffer_m": COAST_BUFFER_M, "common_fit_m": list(COMMON_FIT_M),
+                               "summary": summary, "verdict": v,
+                               "runs": {k: {kk: vv for kk, vv in r.items() if kk != "curve"} for k, r in runs.items()}}
+    JSON.write_text(json.dumps(data, indent=1) + "\n")
+    fig = ROOT / "docs" / "figures" / f"disk_convergence_{family}_{law}.png"
+    figure(family, law, summary, fig)
+    print(f"wrote {JSON.relative_to(ROOT)} and {fig.relative_to(ROOT)}")
+    return data
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("what", choices=("run", "report"))
+    ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
+    ap.add_argument("--law", choices=LAWS, default="same_pa")
+    ap.add_argument("--km", type=float, nargs="+", default=list(KM))
+    ap.add_argument("--seeds", type=int, nargs="+", default=list(SEEDS))
+    ap.add_argument("--jobs", type=int, default=1)
+    a = ap.parse_args(argv)
+    if a.what == "run":
+        # the finest meshes first, so that two jobs finish together
+        todo = [(a.family, a.law, km, s) for km in sorted(a.km) for s in a.seeds]
+        with ThreadPoolExecutor(a.jobs) as ex:
+            for msg in ex.map(lambda t: run_one(*t), todo):
+                print(msg, flush=True)
+        return 0
+    report(a.family, a.law)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
