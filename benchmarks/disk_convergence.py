@@ -30,7 +30,25 @@ the 300 km disk was seen first: per-day β on each mesh's own widths 0.17–0.39
   Predicted: R1 holds, by 0.05–0.15; R2 says converged. If so, the basin's fall would be the 20 km
   mesh's coarseness in this family, and its 10 km statistics the converged model's.
 
+  Result (22:09 UTC): R1 holds, by 0.043 (20 km 0.185, 10 km 0.142); R2 is neither: 7 km 0.137 and 5 km
+  0.187, back at the 20 km value, with 90 % intervals of the medians 0.05–0.16 wide. One 20 km run (seed 12)
+  had been made as a test of this script a minute before the rule was written. On each mesh's own widths
+  the medians fall 0.166, 0.145, 0.121, 0.103, 0.103: the finest octave is flat on every mesh.
+
+Rule RD2 (written at 22:12 UTC, before its runs; the pooled figures of the first six seeds were first
+printed when the report code was tested, after the text of the rule). Six more seeds (18–23) for ``lead same_pa``, and the
+control ``shipped same_pa`` (seeds 12–23). The report adds the pooled curve per mesh (every box of every
+seed, :func:`lagice.diagnostics.scaling.pooled_spatial_scaling`), its β on the common widths, and its slope
+per octave.
+  (a) Over 12 seeds the lead's common-width β has no trend with the element if the pooled β at 20, 10 and
+      5 km lie within 0.03 of each other; it falls if the 5 km pooled β is at least 0.03 below 20 km's.
+  (b) The first octave (Δx to 2Δx) of the pooled curve is flatter than the octave from 4Δx to 8Δx on
+      every mesh, in both families (the element scale's own flattening).
+  Predicted: (a) no trend; (b) holds; the shipped family's β is 0.03–0.09 on every mesh, as in the basin.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
+    python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
+    python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
     python benchmarks/disk_convergence.py report --family lead --law same_pa
 
 Runs go to ``benchmarks/out/disk_convergence/FAMILY-LAW-KMkm-sSEED`` (``lagice run`` subprocesses, one
@@ -58,6 +76,8 @@ DAY_S = 86400.0
 
 KM = (20, 14, 10, 7, 5)
 SEEDS = tuple(range(12, 18))
+#: rule RD2's seeds (12 in all)
+MORE_SEEDS = tuple(range(18, 24))
 #: (scene overrides, C_lab [Pa] in lagice's form at the reference size)
 FAMILIES = {
     "lead": (["rheology.failure_stress=effective", "rheology.max_damage=0.97"], 22.4e6),
@@ -151,6 +171,44 @@ def summarise(runs: dict) -> dict:
     return out
 
 
+def pooled(runs: dict) -> dict:
+    """Per mesh: the curve pooled over every box of every seed, its β on the common widths and on
+    its own widths, and its slope per octave (rule RD2)."""
+    from lagice.diagnostics.scaling import pooled_spatial_scaling
+
+    out = {}
+    for km in sorted({r["km"] for r in runs.values()}, reverse=True):
+        curves = [r["curve"] for r in runs.values() if r["km"] == km]
+        k = min(len(c["scale_m"]) for c in curves)
+        curves = [{key: list(c[key][:k]) for key in ("box_size_m", "scale_m", "mean_total_s", "n_boxes")}
+                  for c in curves]
+        common = pooled_spatial_scaling(curves, min_boxes=MIN_BOXES, fit_range_m=COMMON_FIT_M)
+        own = pooled_spatial_scaling(curves, min_boxes=MIN_BOXES)
+        L, m = common.scale_m, common.mean_total_s
+        slopes = -np.diff(np.log(m)) / np.diff(np.log(L))
+        out[f"{km:g}"] = {"n_seeds": len(curves), "beta_common": float(common.fit.exponent),
+                          "beta_own": float(own.fit.exponent), "scale_m": [float(x) for x in L],
+                          "mean_total_per_day": [float(x * DAY_S) for x in m],
+                          "fewest_boxes": [int(x) for x in common.fewest_boxes],
+                          "slope_per_octave": [float(x) for x in slopes]}
+    return out
+
+
+def verdict_pooled(pool: dict) -> dict:
+    """Rule RD2 (a) on the pooled β (common widths), (b) on the first and third octaves."""
+    b = {float(k): v["beta_common"] for k, v in pool.items()}
+    out = {}
+    if all(k in b for k in (20.0, 10.0, 5.0)):
+        spread = max(b[20.0], b[10.0], b[5.0]) - min(b[20.0], b[10.0], b[5.0])
+        out.update({"pooled_spread_20_10_5": spread, "a_no_trend": bool(spread < 0.03),
+                    "a_falls": bool(b[5.0] <= b[20.0] - 0.03)})
+    flat = {k: (v["slope_per_octave"][0] < v["slope_per_octave"][2]) for k, v in pool.items()
+            if len(v["slope_per_octave"]) >= 3 and v["fewest_boxes"][3] >= MIN_BOXES}
+    out["b_first_octave_flatter"] = flat
+    out["b_holds"] = bool(flat) and all(flat.values())
+    return out
+
+
 def verdict(summary: dict) -> dict:
     """Rule RD's two tests on the medians of β on the common widths."""
     med = {float(k): v["beta_common"]["median"] for k, v in summary.items()}
@@ -219,11 +277,19 @@ def report(family: str, law: str) -> dict:
               f" {100 * row['half_shear_area_fraction']['median']:>9.1f}%")
     v = verdict(summary)
     print("\nrule RD:", json.dumps(v))
+    pool = pooled(runs)
+    print(f"\npooled over the seeds: {'mesh':>6} {'β common':>9} {'β own':>7}  slope per octave (L in km)")
+    for km, row in pool.items():
+        octs = "  ".join(f"{row['scale_m'][i] / 1e3:.0f}-{row['scale_m'][i + 1] / 1e3:.0f}:{x:.3f}"
+                         for i, x in enumerate(row["slope_per_octave"]) if row["fewest_boxes"][i + 1] >= MIN_BOXES)
+        print(f"{'':22}{km:>4}km {row['beta_common']:>9.3f} {row['beta_own']:>7.3f}  {octs}")
+    vp = verdict_pooled(pool)
+    print("rule RD2:", json.dumps(vp))
     data = json.loads(JSON.read_text()) if JSON.exists() else {}
     commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
     data[f"{family}-{law}"] = {"git_commit": commit, "window_days": list(WINDOW_DAYS),
                                "coast_buffer_m": COAST_BUFFER_M, "common_fit_m": list(COMMON_FIT_M),
-                               "summary": summary, "verdict": v,
+                               "summary": summary, "verdict": v, "pooled": pool, "verdict_pooled": vp,
                                "runs": {k: {kk: vv for kk, vv in r.items() if kk != "curve"} for k, r in runs.items()}}
     JSON.write_text(json.dumps(data, indent=1) + "\n")
     fig = ROOT / "docs" / "figures" / f"disk_convergence_{family}_{law}.png"
@@ -239,11 +305,13 @@ def main(argv=None) -> int:
     ap.add_argument("--law", choices=LAWS, default="same_pa")
     ap.add_argument("--km", type=float, nargs="+", default=list(KM))
     ap.add_argument("--seeds", type=int, nargs="+", default=list(SEEDS))
+    ap.add_argument("--more-seeds", action="store_true", help="add rule RD2's seeds 18-23")
     ap.add_argument("--jobs", type=int, default=1)
     a = ap.parse_args(argv)
     if a.what == "run":
         # the finest meshes first, so that two jobs finish together
-        todo = [(a.family, a.law, km, s) for km in sorted(a.km) for s in a.seeds]
+        seeds = list(a.seeds) + (list(MORE_SEEDS) if a.more_seeds else [])
+        todo = [(a.family, a.law, km, s) for km in sorted(a.km) for s in seeds]
         with ThreadPoolExecutor(a.jobs) as ex:
             for msg in ex.map(lambda t: run_one(*t), todo):
                 print(msg, flush=True)
