@@ -36,8 +36,8 @@ the 300 km disk was seen first: per-day β on each mesh's own widths 0.17–0.39
   the medians fall 0.166, 0.145, 0.121, 0.103, 0.103: the finest octave is flat on every mesh.
 
 Rule RD2 (written at 22:12 UTC, before its runs; the pooled figures of the first six seeds were first
-printed when the report code was tested, after the text of the rule). Six more seeds (18–23) for ``lead same_pa``, and the
-control ``shipped same_pa`` (seeds 12–23). The report adds the pooled curve per mesh (every box of every
+printed when the report code was tested, after the text of the rule). Six more seeds (18–23) for
+``lead same_pa``, and the control ``shipped same_pa`` (seeds 12–23). The report adds the pooled curve per mesh (every box of every
 seed, :func:`lagice.diagnostics.scaling.pooled_spatial_scaling`), its β on the common widths, and its slope
 per octave.
   (a) Over 12 seeds the lead's common-width β has no trend with the element if the pooled β at 20, 10 and

@@ -1404,3 +1404,59 @@ def test_a_clean_reproduction_names_the_code_of_a_run_made_from_a_modified_tree(
     (run / "reproduced.json").write_text(json.dumps({"max_abs_difference": 1e-9, "reproduced_by": head,
                                                      "modified_files": []}))
     assert reuse_notice(run)["made_by"] == head + "-dirty"   # not the same run: not a reproduction
+
+
+def test_disk_convergence_same_pa_gives_every_mesh_the_20km_cohesion():
+    """benchmarks/disk_convergence.py (rule RD): under ``same_pa`` every mesh gets the cohesion in
+    pascals of the 20 km mesh; under ``scaled`` (neXtSIM's law) a mesh √2 finer is √2 stronger."""
+    from disk_convergence import FAMILIES, KM, lab_cohesion_pa
+
+    from lagice.strength import StrengthLaw
+
+    for family in FAMILIES:
+        c = {km: lab_cohesion_pa(family, "same_pa", km) * StrengthLaw().scale_factor(km * 1e3) for km in KM}
+        assert np.allclose(list(c.values()), c[20], rtol=1e-12), family
+        s = {km: lab_cohesion_pa(family, "scaled", km) * StrengthLaw().scale_factor(km * 1e3) for km in (20, 10, 5)}
+        assert s[10] / s[20] == pytest.approx(np.sqrt(2)) and s[5] / s[10] == pytest.approx(np.sqrt(2))
+
+
+def _curve(dx_m, beta, n_widths, first_flat=True, boxes0=20000):
+    """A scaling curve on a mesh of element scale ``dx_m``: ⟨ε̇tot⟩ ∝ L^−β from 2Δx on, the first
+    octave flat when ``first_flat``; box counts fall 4× per octave."""
+    L = dx_m * 2.0 ** np.arange(n_widths)
+    m = 1e-7 * (L / 1e4) ** (-beta)
+    if first_flat:
+        m[0] = m[1]
+    n = (boxes0 / 4.0 ** np.arange(n_widths)).astype(int)
+    return {"box_size_m": [None] + [float(x) for x in L[1:]], "scale_m": list(L), "mean_total_s": list(m),
+            "n_boxes": [int(x) for x in n]}
+
+
+def test_disk_convergence_fits_the_common_widths_and_finds_the_flat_first_octave():
+    """β on the widths every mesh resolves is the curve's exponent there, whatever the mesh adds
+    below (a flat first octave) or above (a width with fewer than 10 boxes, left out); the pooled
+    slopes per octave show the flat first octave (rule RD2 (b)) and the verdicts read them."""
+    import disk_convergence as dc
+
+    # 20 km, 10 km and 5 km meshes, β 0.2 above 2Δx, first octave flat; a wild last width with 5 boxes
+    runs = {}
+    for km, n in ((20, 6), (10, 7), (5, 8)):
+        for seed in (1, 2):
+            c = _curve(km * 658.0, 0.2, n, boxes0=int(20000 * (20 / km) ** 2))
+            c["n_boxes"][-1] = 5
+            c["mean_total_s"][-1] *= 50.0
+            assert dc.common_beta(c) == pytest.approx(0.2, abs=1e-12)
+            runs[f"{km}-{seed}"] = {"km": float(km), "curve": c}
+    pool = dc.pooled(runs)
+    for row in pool.values():
+        assert row["beta_common"] == pytest.approx(0.2, abs=1e-12)
+        assert row["slope_per_octave"][0] == pytest.approx(0.0, abs=1e-12)
+        assert row["slope_per_octave"][2] == pytest.approx(0.2, abs=1e-12)
+        assert row["beta_own"] < 0.2  # the flat octave enters each mesh's own fit
+    v = dc.verdict_pooled(pool)
+    assert v["a_no_trend"] and not v["a_falls"] and v["b_holds"]
+    # a curve whose first octave is steeper than the rest fails (b)
+    steep = _curve(5 * 658.0, 0.2, 8, first_flat=False, boxes0=320000)
+    steep["mean_total_s"][0] *= 1.5
+    runs["5-1"]["curve"] = runs["5-2"]["curve"] = steep
+    assert dc.verdict_pooled(dc.pooled(runs))["b_first_octave_flatter"]["5"] is False
