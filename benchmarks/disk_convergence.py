@@ -37,9 +37,9 @@ the 300 km disk was seen first: per-day β on each mesh's own widths 0.17–0.39
 
 Rule RD2 (written at 22:12 UTC, before its runs; the pooled figures of the first six seeds were first
 printed when the report code was tested, after the text of the rule). Six more seeds (18–23) for
-``lead same_pa``, and the control ``shipped same_pa`` (seeds 12–23). The report adds the pooled curve per mesh (every box of every
-seed, :func:`lagice.diagnostics.scaling.pooled_spatial_scaling`), its β on the common widths, and its slope
-per octave.
+``lead same_pa``, and the control ``shipped same_pa`` (seeds 12–23). The report adds the pooled curve per
+mesh (every box of every seed, :func:`lagice.diagnostics.scaling.pooled_spatial_scaling`), its β on the
+common widths, and its slope per octave.
   (a) Over 12 seeds the lead's common-width β has no trend with the element if the pooled β at 20, 10 and
       5 km lie within 0.03 of each other; it falls if the 5 km pooled β is at least 0.03 below 20 km's.
   (b) The first octave (Δx to 2Δx) of the pooled curve is flatter than the octave from 4Δx to 8Δx on
