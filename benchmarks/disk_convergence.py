@@ -46,10 +46,23 @@ common widths, and its slope per octave.
       every mesh, in both families (the element scale's own flattening).
   Predicted: (a) no trend; (b) holds; the shipped family's β is 0.03–0.09 on every mesh, as in the basin.
 
+Rule RD3 (written at 22:41 UTC, before the 20 km runs were made again; the 10 km curve below had been
+computed): the same question in the basin, for the lead over its eight months of weather at 20 km and
+10 km (neXtSIM's scaled strength, as in rule R10; ``physics_experiments.py`` runs
+``B20-hthick-eff-C8-cap97-m20[-wSEED]`` and ``F10-hthick-eff-C8-cap97[-wSEED]``). ``basin`` pools every
+3-day window of a group (from day 1, 100 km from the coast) and fits β on the widths both meshes resolve,
+20–120 km (``BASIN_COMMON_FIT_M``; three widths on each mesh). The 10 km pooled curve (72 windows) was
+seen first: slopes 0.185, 0.144, 0.139 and 0.129 per octave from 6 to 93 km, not flat at the element.
+  (c) The basin's fall survives on the common widths if the 20 km pooled β there exceeds the 10 km one
+      by at least 0.02.
+  Predicted: (c) holds (20 km 0.16–0.19, 10 km 0.13–0.14): unlike one storm on a pristine disk, the
+  basin's fall is not the estimator's reach into the element's octave.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
     python benchmarks/disk_convergence.py report --family lead --law same_pa
+    python benchmarks/disk_convergence.py basin lead20=B20-hthick-eff-C8-cap97-m20,... lead10=...   # RD3
 
 Runs go to ``benchmarks/out/disk_convergence/FAMILY-LAW-KMkm-sSEED`` (``lagice run`` subprocesses, one
 numba thread each); ``report`` writes ``docs/figures/disk_convergence.json`` (every family and law run so
@@ -209,6 +222,51 @@ def verdict_pooled(pool: dict) -> dict:
     return out
 
 
+#: the basin's widths both a 20 km and a 10 km mesh resolve [m] (rule RD3)
+BASIN_COMMON_FIT_M = (20e3, 120e3)
+PHYSICS_OUT = ROOT / "benchmarks" / "out" / "physics"
+
+
+def basin(groups: dict) -> dict:
+    """Per group of basin runs (``{name: [run, ...]}`` in ``benchmarks/out/physics``): the curve pooled over
+    every published 3-day window (from day 1, 100 km from the coast), its β on its own widths, from the
+    first box width (2Δx) on, and on :data:`BASIN_COMMON_FIT_M`, and its slope per octave (rule RD3)."""
+    from lagice.diagnostics.scaling import pooled_spatial_scaling
+    from lagice.diagnostics.windows import window_starts_days, window_summary
+
+    out = {}
+    for name, runs in groups.items():
+        curves = []
+        for run in runs:
+            path = PHYSICS_OUT / run
+            for start in window_starts_days(path, 3.0, start_day=1.0):
+                w = window_summary(path, start * DAY_S, 3 * DAY_S, COAST_BUFFER_M)
+                curves.append(w["interior"]["scaling_space"])
+        k = min(len(c["scale_m"]) for c in curves)
+        curves = [{key: list(c[key][:k]) for key in ("box_size_m", "scale_m", "mean_total_s", "n_boxes")}
+                  for c in curves]
+        own = pooled_spatial_scaling(curves, min_boxes=MIN_BOXES)
+        L, m = own.scale_m, own.mean_total_s
+        from2 = pooled_spatial_scaling(curves, min_boxes=MIN_BOXES, fit_range_m=(L[1] * 0.99, 1e9))
+        common = pooled_spatial_scaling(curves, min_boxes=MIN_BOXES, fit_range_m=BASIN_COMMON_FIT_M)
+        slopes = -np.diff(np.log(m)) / np.diff(np.log(L))
+        out[name] = {"runs": list(runs), "n_windows": len(curves), "beta_own": float(own.fit.exponent),
+                     "beta_from_2dx": float(from2.fit.exponent), "beta_common": float(common.fit.exponent),
+                     "scale_m": [float(x) for x in L], "fewest_boxes": [int(x) for x in own.fewest_boxes],
+                     "slope_per_octave": [float(x) for x in slopes]}
+        r = out[name]
+        octs = "  ".join(f"{L[i] / 1e3:.0f}-{L[i + 1] / 1e3:.0f}:{x:.3f}" for i, x in enumerate(slopes)
+                         if r["fewest_boxes"][i + 1] >= MIN_BOXES)
+        print(f"{name}: {len(curves)} windows, β own {r['beta_own']:.3f}, from 2Δx {r['beta_from_2dx']:.3f}, "
+              f"on {BASIN_COMMON_FIT_M[0] / 1e3:g}-{BASIN_COMMON_FIT_M[1] / 1e3:g} km {r['beta_common']:.3f}; "
+              f"slope per octave {octs}")
+    data = json.loads(JSON.read_text()) if JSON.exists() else {}
+    data.setdefault("basin", {}).update(out)
+    data["basin"]["common_fit_m"] = list(BASIN_COMMON_FIT_M)
+    JSON.write_text(json.dumps(data, indent=1) + "\n")
+    return out
+
+
 def verdict(summary: dict) -> dict:
     """Rule RD's two tests on the medians of β on the common widths."""
     med = {float(k): v["beta_common"]["median"] for k, v in summary.items()}
@@ -227,6 +285,7 @@ def figure(family: str, law: str, summary: dict, path: Path) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     keys = (("beta_common", "β, widths 25–220 km", (0.17, 0.20)),
             ("mean_total_per_day", "⟨ε̇tot⟩ (day⁻¹)", (0.01, 0.05)),
@@ -234,13 +293,17 @@ def figure(family: str, law: str, summary: dict, path: Path) -> None:
     fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
     kms = sorted((float(k) for k in summary), reverse=True)
     for ax, (k, label, band) in zip(axes, keys):
-        ax.axhspan(*band, color="0.85", label="observed (basin statistics)")
+        ax.axhspan(*band, color="0.85", label="observed band (RGPS, Arctic; for scale)")
         for km in kms:
             v = summary[f"{km:g}"][k]["values"]
             ax.plot([km] * len(v), v, "o", color="tab:blue", alpha=0.5, ms=4)
         med = [summary[f"{km:g}"][k]["median"] for km in kms]
         ax.plot(kms, med, "k-s", label="median over seeds")
+        if k == "beta_common":
+            own = [summary[f"{km:g}"]["beta_own"]["median"] for km in kms]
+            ax.plot(kms, own, "--^", color="tab:red", label="β on each mesh's own widths (median)")
         ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set_xticks(kms)
         ax.set_xticklabels([f"{km:g}" for km in kms])
         ax.invert_xaxis()
@@ -300,7 +363,8 @@ def report(family: str, law: str) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=("run", "report"))
+    ap.add_argument("what", choices=("run", "report", "basin"))
+    ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
     ap.add_argument("--km", type=float, nargs="+", default=list(KM))
@@ -315,6 +379,9 @@ def main(argv=None) -> int:
         with ThreadPoolExecutor(a.jobs) as ex:
             for msg in ex.map(lambda t: run_one(*t), todo):
                 print(msg, flush=True)
+        return 0
+    if a.what == "basin":
+        basin({g.split("=")[0]: g.split("=")[1].split(",") for g in a.groups})
         return 0
     report(a.family, a.law)
     return 0
