@@ -58,9 +58,22 @@ seen first: slopes 0.185, 0.144, 0.139 and 0.129 per octave from 6 to 93 km, not
   Predicted: (c) holds (20 km 0.16–0.19, 10 km 0.13–0.14): unlike one storm on a pristine disk, the
   basin's fall is not the estimator's reach into the element's octave.
 
+  Result (23:00 UTC): (c) holds, as predicted. On 24–93 km (the two meshes' box widths coincide) the pooled
+  β is 0.172 at 20 km and 0.134 at 10 km; month by month it is lower at 10 km in 6 of 8 months (median
+  −0.039). By octave: 24–47 km 0.135 and 0.139, 47–93 km 0.207 and 0.129.
+
+Rule RD4 (written at 22:59 UTC, before its runs). The basin's months use neXtSIM's scaled strength (a mesh √2
+finer is √2 stronger), the disk's runs above the same cohesion in pascals. ``lead scaled`` on the disk,
+seeds 12–23, 20 to 5 km.
+  (d) The strength law alone makes a fall on the disk if the pooled β on the common widths at 5 km is at
+      least 0.03 below the 20 km one.
+  Predicted: the disk breaks less on finer meshes (the rate falls by ×0.5 or more from 20 to 5 km), and
+  (d) holds.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
+    python benchmarks/disk_convergence.py run --family lead --law scaled --more-seeds --jobs 2       # RD4
     python benchmarks/disk_convergence.py report --family lead --law same_pa
     python benchmarks/disk_convergence.py basin lead20=B20-hthick-eff-C8-cap97-m20,... lead10=...   # RD3
 
@@ -236,12 +249,19 @@ def basin(groups: dict) -> dict:
 
     out = {}
     for name, runs in groups.items():
-        curves = []
+        curves, per_run = [], {}
         for run in runs:
             path = PHYSICS_OUT / run
+            mine = []
             for start in window_starts_days(path, 3.0, start_day=1.0):
                 w = window_summary(path, start * DAY_S, 3 * DAY_S, COAST_BUFFER_M)
-                curves.append(w["interior"]["scaling_space"])
+                mine.append(w["interior"]["scaling_space"])
+            km = min(len(c["scale_m"]) for c in mine)
+            mine = [{key: list(c[key][:km]) for key in ("box_size_m", "scale_m", "mean_total_s", "n_boxes")}
+                    for c in mine]
+            per_run[run] = float(pooled_spatial_scaling(mine, min_boxes=MIN_BOXES,
+                                                        fit_range_m=BASIN_COMMON_FIT_M).fit.exponent)
+            curves += mine
         k = min(len(c["scale_m"]) for c in curves)
         curves = [{key: list(c[key][:k]) for key in ("box_size_m", "scale_m", "mean_total_s", "n_boxes")}
                   for c in curves]
@@ -253,13 +273,14 @@ def basin(groups: dict) -> dict:
         out[name] = {"runs": list(runs), "n_windows": len(curves), "beta_own": float(own.fit.exponent),
                      "beta_from_2dx": float(from2.fit.exponent), "beta_common": float(common.fit.exponent),
                      "scale_m": [float(x) for x in L], "fewest_boxes": [int(x) for x in own.fewest_boxes],
-                     "slope_per_octave": [float(x) for x in slopes]}
+                     "slope_per_octave": [float(x) for x in slopes], "beta_common_per_run": per_run}
         r = out[name]
         octs = "  ".join(f"{L[i] / 1e3:.0f}-{L[i + 1] / 1e3:.0f}:{x:.3f}" for i, x in enumerate(slopes)
                          if r["fewest_boxes"][i + 1] >= MIN_BOXES)
         print(f"{name}: {len(curves)} windows, β own {r['beta_own']:.3f}, from 2Δx {r['beta_from_2dx']:.3f}, "
               f"on {BASIN_COMMON_FIT_M[0] / 1e3:g}-{BASIN_COMMON_FIT_M[1] / 1e3:g} km {r['beta_common']:.3f}; "
               f"slope per octave {octs}")
+        print("   β on the common widths, run by run:", " ".join(f"{v:.3f}" for v in per_run.values()))
     data = json.loads(JSON.read_text()) if JSON.exists() else {}
     data.setdefault("basin", {}).update(out)
     data["basin"]["common_fit_m"] = list(BASIN_COMMON_FIT_M)
