@@ -58,7 +58,7 @@ seen first: slopes 0.185, 0.144, 0.139 and 0.129 per octave from 6 to 93 km, not
   Predicted: (c) holds (20 km 0.16–0.19, 10 km 0.13–0.14): unlike one storm on a pristine disk, the
   basin's fall is not the estimator's reach into the element's octave.
 
-  Result (23:00 UTC): (c) holds, as predicted. On 24–93 km (the two meshes' box widths coincide) the pooled
+  Result (22:57 UTC): (c) holds, as predicted. On 24–93 km (the two meshes' box widths coincide) the pooled
   β is 0.172 at 20 km and 0.134 at 10 km; month by month it is lower at 10 km in 6 of 8 months (median
   −0.039). By octave: 24–47 km 0.135 and 0.139, 47–93 km 0.207 and 0.129.
 
