@@ -293,7 +293,8 @@ def basin(groups: dict) -> dict:
 
 
 def verdict(summary: dict) -> dict:
-    """Rule RD's two tests on the medians of β on the common widths."""
+    """Rule RD's two tests on the medians of β on the common widths, over the runs present (RD was stated
+    for seeds 12–17; once RD2's seeds are made, ``report`` judges the twelve)."""
     med = {float(k): v["beta_common"]["median"] for k, v in summary.items()}
     if not all(k in med for k in (20.0, 10.0, 7.0, 5.0)):
         return {"complete": False}
