@@ -159,15 +159,33 @@ def run_one(family, law, km, seed) -> str:
 
 def common_beta(curve: dict) -> float:
     """β on the widths in :data:`COMMON_FIT_M` with at least :data:`MIN_BOXES` boxes (NaN if fewer
-    than 2 such widths)."""
-    from lagice.diagnostics.scaling import fit_power_law
+    than 2 such widths): the pool of one curve is the curve."""
+    return float(_pool([curve], COMMON_FIT_M)[0].fit.exponent)
 
-    L = np.array(curve["scale_m"], float)
-    r = np.array(curve["mean_total_s"], float)
-    n = np.array(curve["n_boxes"], float)
-    box = np.array([b is not None for b in curve["box_size_m"]])
-    ok = box & (n >= MIN_BOXES)
-    return float(fit_power_law(L[ok], r[ok], fit_range=COMMON_FIT_M).exponent)
+
+def _pool(curves, fit_range_m=None):
+    """(:func:`lagice.diagnostics.scaling.pooled_spatial_scaling` of ``curves`` cut to the widths every one
+    holds, with at least :data:`MIN_BOXES` boxes per fitted width; its slope per octave,
+    −Δlog⟨ε̇tot⟩/Δlog L between successive widths)."""
+    from lagice.diagnostics.scaling import pooled_spatial_scaling
+
+    k = min(len(c["scale_m"]) for c in curves)
+    cut = [{key: list(c[key][:k]) for key in ("box_size_m", "scale_m", "mean_total_s", "n_boxes")} for c in curves]
+    pool = pooled_spatial_scaling(cut, min_boxes=MIN_BOXES, fit_range_m=fit_range_m)
+    return pool, -np.diff(np.log(pool.mean_total_s)) / np.diff(np.log(pool.scale_m))
+
+
+def _octaves(scale_m, slopes, fewest_boxes) -> str:
+    """The slopes per octave as text, over the widths with at least :data:`MIN_BOXES` boxes."""
+    return "  ".join(f"{scale_m[i] / 1e3:.0f}-{scale_m[i + 1] / 1e3:.0f}:{x:.3f}" for i, x in enumerate(slopes)
+                     if fewest_boxes[i + 1] >= MIN_BOXES)
+
+
+def _write_json(key: str, value: dict) -> None:
+    """Set ``key`` of :data:`JSON` (other families, laws and the basin kept)."""
+    data = json.loads(JSON.read_text()) if JSON.exists() else {}
+    data[key] = value
+    JSON.write_text(json.dumps(data, indent=1) + "\n")
 
 
 def analyse_run(path: Path) -> dict:
@@ -204,21 +222,14 @@ def summarise(runs: dict) -> dict:
 def pooled(runs: dict) -> dict:
     """Per mesh: the curve pooled over every box of every seed, its β on the common widths and on
     its own widths, and its slope per octave (rule RD2)."""
-    from lagice.diagnostics.scaling import pooled_spatial_scaling
-
     out = {}
     for km in sorted({r["km"] for r in runs.values()}, reverse=True):
         curves = [r["curve"] for r in runs.values() if r["km"] == km]
-        k = min(len(c["scale_m"]) for c in curves)
-        curves = [{key: list(c[key][:k]) for key in ("box_size_m", "scale_m", "mean_total_s", "n_boxes")}
-                  for c in curves]
-        common = pooled_spatial_scaling(curves, min_boxes=MIN_BOXES, fit_range_m=COMMON_FIT_M)
-        own = pooled_spatial_scaling(curves, min_boxes=MIN_BOXES)
-        L, m = common.scale_m, common.mean_total_s
-        slopes = -np.diff(np.log(m)) / np.diff(np.log(L))
+        common, slopes = _pool(curves, COMMON_FIT_M)
+        own, _ = _pool(curves)
         out[f"{km:g}"] = {"n_seeds": len(curves), "beta_common": float(common.fit.exponent),
-                          "beta_own": float(own.fit.exponent), "scale_m": [float(x) for x in L],
-                          "mean_total_per_day": [float(x * DAY_S) for x in m],
+                          "beta_own": float(own.fit.exponent), "scale_m": [float(x) for x in common.scale_m],
+                          "mean_total_per_day": [float(x * DAY_S) for x in common.mean_total_s],
                           "fewest_boxes": [int(x) for x in common.fewest_boxes],
                           "slope_per_octave": [float(x) for x in slopes]}
     return out
@@ -248,47 +259,34 @@ def basin(groups: dict) -> dict:
     """Per group of basin runs (``{name: [run, ...]}`` in ``benchmarks/out/physics``): the curve pooled over
     every published 3-day window (from day 1, 100 km from the coast), its β on its own widths, from the
     first box width (2Δx) on, and on :data:`BASIN_COMMON_FIT_M`, and its slope per octave (rule RD3)."""
-    from lagice.diagnostics.scaling import pooled_spatial_scaling
     from lagice.diagnostics.windows import window_starts_days, window_summary
+    from lagice.io.cf import git_commit
 
     out = {}
     for name, runs in groups.items():
         curves, per_run = [], {}
         for run in runs:
             path = PHYSICS_OUT / run
-            mine = []
-            for start in window_starts_days(path, 3.0, start_day=1.0):
-                w = window_summary(path, start * DAY_S, 3 * DAY_S, COAST_BUFFER_M)
-                mine.append(w["interior"]["scaling_space"])
-            km = min(len(c["scale_m"]) for c in mine)
-            mine = [{key: list(c[key][:km]) for key in ("box_size_m", "scale_m", "mean_total_s", "n_boxes")}
-                    for c in mine]
-            per_run[run] = float(pooled_spatial_scaling(mine, min_boxes=MIN_BOXES,
-                                                        fit_range_m=BASIN_COMMON_FIT_M).fit.exponent)
+            mine = [window_summary(path, start * DAY_S, 3 * DAY_S, COAST_BUFFER_M)["interior"]["scaling_space"]
+                    for start in window_starts_days(path, 3.0, start_day=1.0)]
+            per_run[run] = float(_pool(mine, BASIN_COMMON_FIT_M)[0].fit.exponent)
             curves += mine
-        k = min(len(c["scale_m"]) for c in curves)
-        curves = [{key: list(c[key][:k]) for key in ("box_size_m", "scale_m", "mean_total_s", "n_boxes")}
-                  for c in curves]
-        own = pooled_spatial_scaling(curves, min_boxes=MIN_BOXES)
-        L, m = own.scale_m, own.mean_total_s
-        from2 = pooled_spatial_scaling(curves, min_boxes=MIN_BOXES, fit_range_m=(L[1] * 0.99, 1e9))
-        common = pooled_spatial_scaling(curves, min_boxes=MIN_BOXES, fit_range_m=BASIN_COMMON_FIT_M)
-        slopes = -np.diff(np.log(m)) / np.diff(np.log(L))
+        own, slopes = _pool(curves)
+        L = own.scale_m
+        from2, _ = _pool(curves, (L[1] * 0.99, 1e9))
+        common, _ = _pool(curves, BASIN_COMMON_FIT_M)
         out[name] = {"runs": list(runs), "n_windows": len(curves), "beta_own": float(own.fit.exponent),
                      "beta_from_2dx": float(from2.fit.exponent), "beta_common": float(common.fit.exponent),
                      "scale_m": [float(x) for x in L], "fewest_boxes": [int(x) for x in own.fewest_boxes],
                      "slope_per_octave": [float(x) for x in slopes], "beta_common_per_run": per_run}
         r = out[name]
-        octs = "  ".join(f"{L[i] / 1e3:.0f}-{L[i + 1] / 1e3:.0f}:{x:.3f}" for i, x in enumerate(slopes)
-                         if r["fewest_boxes"][i + 1] >= MIN_BOXES)
         print(f"{name}: {len(curves)} windows, β own {r['beta_own']:.3f}, from 2Δx {r['beta_from_2dx']:.3f}, "
               f"on {BASIN_COMMON_FIT_M[0] / 1e3:g}-{BASIN_COMMON_FIT_M[1] / 1e3:g} km {r['beta_common']:.3f}; "
-              f"slope per octave {octs}")
+              f"slope per octave {_octaves(L, slopes, r['fewest_boxes'])}")
         print("   β on the common widths, run by run:", " ".join(f"{v:.3f}" for v in per_run.values()))
     data = json.loads(JSON.read_text()) if JSON.exists() else {}
-    data.setdefault("basin", {}).update(out)
-    data["basin"]["common_fit_m"] = list(BASIN_COMMON_FIT_M)
-    JSON.write_text(json.dumps(data, indent=1) + "\n")
+    _write_json("basin", {**data.get("basin", {}), **out, "common_fit_m": list(BASIN_COMMON_FIT_M),
+                          "git_commit": git_commit()})
     return out
 
 
@@ -369,22 +367,21 @@ def report(family: str, law: str) -> dict:
     pool = pooled(runs)
     print(f"\npooled over the seeds: {'mesh':>6} {'β common':>9} {'β own':>7}  slope per octave (L in km)")
     for km, row in pool.items():
-        octs = "  ".join(f"{row['scale_m'][i] / 1e3:.0f}-{row['scale_m'][i + 1] / 1e3:.0f}:{x:.3f}"
-                         for i, x in enumerate(row["slope_per_octave"]) if row["fewest_boxes"][i + 1] >= MIN_BOXES)
+        octs = _octaves(row["scale_m"], row["slope_per_octave"], row["fewest_boxes"])
         print(f"{'':22}{km:>4}km {row['beta_common']:>9.3f} {row['beta_own']:>7.3f}  {octs}")
     vp = verdict_pooled(pool)
     print("rule RD2:", json.dumps(vp))
-    data = json.loads(JSON.read_text()) if JSON.exists() else {}
-    commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
-    data[f"{family}-{law}"] = {"git_commit": commit, "window_days": list(WINDOW_DAYS),
-                               "coast_buffer_m": COAST_BUFFER_M, "common_fit_m": list(COMMON_FIT_M),
-                               "summary": summary, "verdict": v, "pooled": pool, "verdict_pooled": vp,
-                               "runs": {k: {kk: vv for kk, vv in r.items() if kk != "curve"} for k, r in runs.items()}}
-    JSON.write_text(json.dumps(data, indent=1) + "\n")
+    from lagice.io.cf import git_commit
+
+    result = {"git_commit": git_commit(), "window_days": list(WINDOW_DAYS), "coast_buffer_m": COAST_BUFFER_M,
+              "common_fit_m": list(COMMON_FIT_M), "summary": summary, "verdict": v, "pooled": pool,
+              "verdict_pooled": vp,
+              "runs": {k: {kk: vv for kk, vv in r.items() if kk != "curve"} for k, r in runs.items()}}
+    _write_json(f"{family}-{law}", result)
     fig = ROOT / "docs" / "figures" / f"disk_convergence_{family}_{law}.png"
     figure(family, law, summary, fig)
     print(f"wrote {JSON.relative_to(ROOT)} and {fig.relative_to(ROOT)}")
-    return data
+    return result
 
 
 def main(argv=None) -> int:
