@@ -98,6 +98,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))  # validate.git_commit
 OUT = ROOT / "benchmarks" / "out" / "disk_convergence"
 JSON = ROOT / "docs" / "figures" / "disk_convergence.json"
 SCENE = ROOT / "examples" / "imprint_cyclone_disk.toml"
@@ -182,7 +183,11 @@ def _octaves(scale_m, slopes, fewest_boxes) -> str:
 
 
 def _write_json(key: str, value: dict) -> None:
-    """Set ``key`` of :data:`JSON` (other families, laws and the basin kept)."""
+    """Set ``key`` of :data:`JSON` (other families, laws and the basin kept), with the commit whose code
+    made it (``validate.git_commit``: HEAD, and whether files outside docs/ differ from it)."""
+    from validate import git_commit
+
+    value = {**value, "git_commit": git_commit()}
     data = json.loads(JSON.read_text()) if JSON.exists() else {}
     data[key] = value
     JSON.write_text(json.dumps(data, indent=1) + "\n")
@@ -260,7 +265,6 @@ def basin(groups: dict) -> dict:
     every published 3-day window (from day 1, 100 km from the coast), its β on its own widths, from the
     first box width (2Δx) on, and on :data:`BASIN_COMMON_FIT_M`, and its slope per octave (rule RD3)."""
     from lagice.diagnostics.windows import window_starts_days, window_summary
-    from lagice.io.cf import git_commit
 
     out = {}
     for name, runs in groups.items():
@@ -285,8 +289,7 @@ def basin(groups: dict) -> dict:
               f"slope per octave {_octaves(L, slopes, r['fewest_boxes'])}")
         print("   β on the common widths, run by run:", " ".join(f"{v:.3f}" for v in per_run.values()))
     data = json.loads(JSON.read_text()) if JSON.exists() else {}
-    _write_json("basin", {**data.get("basin", {}), **out, "common_fit_m": list(BASIN_COMMON_FIT_M),
-                          "git_commit": git_commit()})
+    _write_json("basin", {**data.get("basin", {}), **out, "common_fit_m": list(BASIN_COMMON_FIT_M)})
     return out
 
 
@@ -371,9 +374,8 @@ def report(family: str, law: str) -> dict:
         print(f"{'':22}{km:>4}km {row['beta_common']:>9.3f} {row['beta_own']:>7.3f}  {octs}")
     vp = verdict_pooled(pool)
     print("rule RD2:", json.dumps(vp))
-    from lagice.io.cf import git_commit
 
-    result = {"git_commit": git_commit(), "window_days": list(WINDOW_DAYS), "coast_buffer_m": COAST_BUFFER_M,
+    result = {"window_days": list(WINDOW_DAYS), "coast_buffer_m": COAST_BUFFER_M,
               "common_fit_m": list(COMMON_FIT_M), "summary": summary, "verdict": v, "pooled": pool,
               "verdict_pooled": vp,
               "runs": {k: {kk: vv for kk, vv in r.items() if kk != "curve"} for k, r in runs.items()}}
