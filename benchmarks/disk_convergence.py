@@ -74,12 +74,25 @@ seeds 12–23, 20 to 5 km.
   where the pack nearly locks (7, 5 km), lowest at 10 km, where the storm fails the pack diffusely in all
   twelve draws (half the shear in 5–18 % of the area).
 
+Rule RD5 (written at 23:58 UTC, before its runs; one 4-day run at 20 km was made first to time the scene, and
+none of its statistics was looked at). One storm on pristine ice lacks the basin's time-dependent pieces: weeks
+of weather with many storms, thermodynamics, neXtSIM's healing, mesh motion and remeshing. Stage ``month`` runs
+``examples/winter_disk.toml`` (all of them, over the same disk of uniform 1 m ice, from no spin-up; no island,
+no thick-and-thin pack) with the eight months' wind seeds (2026–2033), family ``lead``, law ``same_pa``, at 20
+and 10 km. ``report --stage month`` pools every 3-day window from day 1 (100 km from the coast), as ``basin``.
+  (e) The month's pieces make the fall if the pooled β on 20–120 km (``BASIN_COMMON_FIT_M``) at 10 km is at
+      least 0.02 below the 20 km one; (f) β on those widths is lower at 10 km in at least 6 of the 8 months.
+  Predicted: (e) and (f) hold, with a fall of 0.02–0.05 that sits in the widest octave, as in the basin. If
+  they fail, the fall needs the basin's geometry or its spun-up, thick-and-thin start.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law scaled --more-seeds --jobs 2       # RD4
     python benchmarks/disk_convergence.py report --family lead --law same_pa
     python benchmarks/disk_convergence.py basin lead20=B20-hthick-eff-C8-cap97-m20,... lead10=...   # RD3
+    python benchmarks/disk_convergence.py run --stage month --family lead --law same_pa --jobs 2      # RD5
+    python benchmarks/disk_convergence.py report --stage month --family lead --law same_pa
 
 Runs go to ``benchmarks/out/disk_convergence/FAMILY-LAW-KMkm-sSEED`` (``lagice run`` subprocesses, one
 numba thread each); ``report`` writes ``docs/figures/disk_convergence.json`` (every family and law run so
@@ -102,6 +115,8 @@ sys.path.insert(0, str(ROOT / "benchmarks"))  # validate.git_commit
 OUT = ROOT / "benchmarks" / "out" / "disk_convergence"
 JSON = ROOT / "docs" / "figures" / "disk_convergence.json"
 SCENE = ROOT / "examples" / "imprint_cyclone_disk.toml"
+#: stage ``month`` (rule RD5): the flagship's weather and time-dependent physics over the same disk
+MONTH_SCENE = ROOT / "examples" / "winter_disk.toml"
 DISK = "data_stubs/disk_500km.geojson"
 DAY_S = 86400.0
 
@@ -109,6 +124,10 @@ KM = (20, 14, 10, 7, 5)
 SEEDS = tuple(range(12, 18))
 #: rule RD2's seeds (12 in all)
 MORE_SEEDS = tuple(range(18, 24))
+#: stage ``month``: the wind seeds of the basin's eight months (physics_experiments.py: the validation
+#: month 2026, ENSEMBLE_SEEDS, MORE_SEEDS); the strength disorder is run.seed 2026's in every month
+MONTH_SEEDS = tuple(range(2026, 2034))
+MONTH_KM = (20, 10)
 #: (scene overrides, C_lab [Pa] in lagice's form at the reference size)
 FAMILIES = {
     "lead": (["rheology.failure_stress=effective", "rheology.max_damage=0.97"], 22.4e6),
@@ -131,29 +150,36 @@ def lab_cohesion_pa(family: str, law: str, km: float) -> float:
     return base * (np.sqrt(km / REFERENCE_KM) if law == "same_pa" else 1.0)
 
 
-def run_name(family: str, law: str, km: float, seed: int) -> str:
+def run_name(family: str, law: str, km: float, seed: int, stage: str = "storm") -> str:
+    """``FAMILY-LAW-KMkm-sSEED`` (one cyclone, disorder seed) or ``month-FAMILY-LAW-KMkm-wSEED`` (wind seed)."""
+    if stage == "month":
+        return f"month-{family}-{law}-{km:g}km-w{seed}"
     return f"{family}-{law}-{km:g}km-s{seed}"
 
 
-def command(family: str, law: str, km: float, seed: int) -> list:
-    sets = [f"domain.file={DISK}", f"domain.resolution_m={km * 1e3:g}", f"run.seed={seed}",
-            f"rheology.strength_lab_pa={lab_cohesion_pa(family, law, km):.6g}", "output.every=6h",
+def command(family: str, law: str, km: float, seed: int, stage: str = "storm") -> list:
+    sets = [f"domain.resolution_m={km * 1e3:g}", f"rheology.strength_lab_pa={lab_cohesion_pa(family, law, km):.6g}",
             *FAMILIES[family][0]]
-    cmd = [sys.executable, "-m", "lagice", "run", str(SCENE), "--out", str(OUT / run_name(family, law, km, seed))]
+    if stage == "month":
+        scene, sets = MONTH_SCENE, [f"forcing.wind.seed={seed}", *sets]
+    else:
+        scene, sets = SCENE, [f"domain.file={DISK}", f"run.seed={seed}", "output.every=6h", *sets]
+    cmd = [sys.executable, "-m", "lagice", "run", str(scene), "--out",
+           str(OUT / run_name(family, law, km, seed, stage))]
     for s in sets:
         cmd += ["--set", s]
     return cmd
 
 
-def run_one(family, law, km, seed) -> str:
-    name = run_name(family, law, km, seed)
+def run_one(family, law, km, seed, stage="storm") -> str:
+    name = run_name(family, law, km, seed, stage)
     out = OUT / name
     if (out / "snapshots" / "index.json").exists():
         return f"{name}: done before"
     OUT.mkdir(parents=True, exist_ok=True)
     env = {**os.environ, "NUMBA_NUM_THREADS": os.environ.get("NUMBA_NUM_THREADS", "1")}
     with open(OUT / f"{name}.log", "w") as log:
-        subprocess.run(command(family, law, km, seed), check=True, stdout=log, stderr=subprocess.STDOUT,
+        subprocess.run(command(family, law, km, seed, stage), check=True, stdout=log, stderr=subprocess.STDOUT,
                        cwd=ROOT, env=env)
     return f"{name}: made"
 
@@ -260,37 +286,76 @@ BASIN_COMMON_FIT_M = (20e3, 120e3)
 PHYSICS_OUT = ROOT / "benchmarks" / "out" / "physics"
 
 
-def basin(groups: dict) -> dict:
-    """Per group of basin runs (``{name: [run, ...]}`` in ``benchmarks/out/physics``): the curve pooled over
-    every published 3-day window (from day 1, 100 km from the coast), its β on its own widths, from the
-    first box width (2Δx) on, and on :data:`BASIN_COMMON_FIT_M`, and its slope per octave (rule RD3)."""
+def pool_windows(groups: dict) -> dict:
+    """Per group of runs (``{name: [run folder, ...]}``): the curve pooled over every 3-day window (from
+    day 1, 100 km from the coast), its β on its own widths, from the first box width (2Δx) on, and on
+    :data:`BASIN_COMMON_FIT_M`, its slope per octave, and β on the common widths run by run (rules RD3,
+    RD5)."""
     from lagice.diagnostics.windows import window_starts_days, window_summary
 
     out = {}
-    for name, runs in groups.items():
+    for name, paths in groups.items():
         curves, per_run = [], {}
-        for run in runs:
-            path = PHYSICS_OUT / run
+        for path in paths:
             mine = [window_summary(path, start * DAY_S, 3 * DAY_S, COAST_BUFFER_M)["interior"]["scaling_space"]
                     for start in window_starts_days(path, 3.0, start_day=1.0)]
-            per_run[run] = float(_pool(mine, BASIN_COMMON_FIT_M)[0].fit.exponent)
+            per_run[Path(path).name] = float(_pool(mine, BASIN_COMMON_FIT_M)[0].fit.exponent)
             curves += mine
         own, slopes = _pool(curves)
         L = own.scale_m
         from2, _ = _pool(curves, (L[1] * 0.99, 1e9))
         common, _ = _pool(curves, BASIN_COMMON_FIT_M)
-        out[name] = {"runs": list(runs), "n_windows": len(curves), "beta_own": float(own.fit.exponent),
-                     "beta_from_2dx": float(from2.fit.exponent), "beta_common": float(common.fit.exponent),
-                     "scale_m": [float(x) for x in L], "fewest_boxes": [int(x) for x in own.fewest_boxes],
+        out[name] = {"runs": [Path(x).name for x in paths], "n_windows": len(curves),
+                     "beta_own": float(own.fit.exponent), "beta_from_2dx": float(from2.fit.exponent),
+                     "beta_common": float(common.fit.exponent), "scale_m": [float(x) for x in L],
+                     "mean_total_per_day": [float(x * DAY_S) for x in own.mean_total_s],
+                     "fewest_boxes": [int(x) for x in own.fewest_boxes],
                      "slope_per_octave": [float(x) for x in slopes], "beta_common_per_run": per_run}
         r = out[name]
         print(f"{name}: {len(curves)} windows, β own {r['beta_own']:.3f}, from 2Δx {r['beta_from_2dx']:.3f}, "
               f"on {BASIN_COMMON_FIT_M[0] / 1e3:g}-{BASIN_COMMON_FIT_M[1] / 1e3:g} km {r['beta_common']:.3f}; "
               f"slope per octave {_octaves(L, slopes, r['fewest_boxes'])}")
         print("   β on the common widths, run by run:", " ".join(f"{v:.3f}" for v in per_run.values()))
+    return out
+
+
+def basin(groups: dict) -> dict:
+    """:func:`pool_windows` of groups of basin runs (``{name: [run, ...]}`` in ``benchmarks/out/physics``)."""
+    out = pool_windows({name: [PHYSICS_OUT / run for run in runs] for name, runs in groups.items()})
     data = json.loads(JSON.read_text()) if JSON.exists() else {}
     _write_json("basin", {**data.get("basin", {}), **out, "common_fit_m": list(BASIN_COMMON_FIT_M)})
     return out
+
+
+def verdict_month(coarse: dict, fine: dict) -> dict:
+    """Rule RD5 on two :func:`pool_windows` groups (20 km, 10 km): (e) the pooled β on the common widths
+    falls by at least 0.02; (f) it is lower at 10 km in at least 6 of the months both meshes ran."""
+    pairs = [(coarse["beta_common_per_run"][k], fine["beta_common_per_run"][k.replace("-20km-", "-10km-")])
+             for k in coarse["beta_common_per_run"] if k.replace("-20km-", "-10km-") in fine["beta_common_per_run"]]
+    fall = coarse["beta_common"] - fine["beta_common"]
+    lower = sum(f < c for c, f in pairs)
+    return {"fall_pooled_common": fall, "e_falls": bool(fall >= 0.02), "months_paired": len(pairs),
+            "months_lower_at_10km": lower, "f_lower_in_6_of_8": bool(lower >= 6),
+            "median_paired_change": float(np.median([f - c for c, f in pairs])) if pairs else None}
+
+
+def report_month(family: str, law: str) -> dict:
+    """Stage ``month`` (rule RD5): pool the 3-day windows of the months on each mesh, as ``basin`` does for
+    the basin's months, and judge the fall from 20 to 10 km."""
+    groups = {}
+    for km in MONTH_KM:
+        paths = [p for p in sorted(OUT.glob(f"month-{family}-{law}-{km:g}km-w*"))
+                 if (p / "snapshots" / "index.json").exists()]
+        if paths:
+            groups[f"{km:g}"] = paths
+    if len(groups) < 2:
+        raise SystemExit(f"stage month: need finished runs of {family}-{law} at 20 and 10 km in {OUT}")
+    out = pool_windows(groups)
+    v = verdict_month(out["20"], out["10"])
+    print("rule RD5:", json.dumps(v))
+    _write_json(f"month-{family}-{law}", {"scene": str(MONTH_SCENE.relative_to(ROOT)), "meshes": out,
+                                           "common_fit_m": list(BASIN_COMMON_FIT_M), "verdict": v})
+    return {"meshes": out, "verdict": v}
 
 
 def verdict(summary: dict) -> dict:
@@ -396,11 +461,20 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", type=int, nargs="+", default=list(SEEDS))
     ap.add_argument("--more-seeds", action="store_true", help="add rule RD2's seeds 18-23")
     ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--stage", choices=("storm", "month"), default="storm",
+                    help="storm: one cyclone, 3 days (default); month: examples/winter_disk.toml, 28 days (RD5)")
     a = ap.parse_args(argv)
+    if a.stage == "month" and a.what == "report":
+        report_month(a.family, a.law)
+        return 0
     if a.what == "run":
         # the finest meshes first, so that two jobs finish together
-        seeds = list(a.seeds) + (list(MORE_SEEDS) if a.more_seeds else [])
-        todo = [(a.family, a.law, km, s) for km in sorted(a.km) for s in seeds]
+        if a.stage == "month":
+            kms = a.km if a.km != list(KM) else list(MONTH_KM)
+            seeds = a.seeds if a.seeds != list(SEEDS) else list(MONTH_SEEDS)
+        else:
+            kms, seeds = a.km, list(a.seeds) + (list(MORE_SEEDS) if a.more_seeds else [])
+        todo = [(a.family, a.law, km, s, a.stage) for km in sorted(kms) for s in seeds]
         with ThreadPoolExecutor(a.jobs) as ex:
             for msg in ex.map(lambda t: run_one(*t), todo):
                 print(msg, flush=True)
