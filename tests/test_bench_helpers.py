@@ -1460,3 +1460,23 @@ def test_disk_convergence_fits_the_common_widths_and_finds_the_flat_first_octave
     steep["mean_total_s"][0] *= 1.5
     runs["5-1"]["curve"] = runs["5-2"]["curve"] = steep
     assert dc.verdict_pooled(dc.pooled(runs))["b_first_octave_flatter"]["5"] is False
+
+
+def test_disk_convergence_month_verdict_pairs_the_months_by_wind_seed():
+    """Rule RD5: the fall is the 20 km pooled β on the common widths less the 10 km one, and the months
+    are paired by wind seed (a month run on one mesh only is left out of the count)."""
+    import disk_convergence as dc
+
+    assert dc.run_name("lead", "same_pa", 10, 2027, "month") == "month-lead-same_pa-10km-w2027"
+    assert dc.run_name("lead", "same_pa", 10, 17) == "lead-same_pa-10km-s17"
+    cmd = dc.command("lead", "same_pa", 10, 2027, "month")
+    assert str(dc.MONTH_SCENE) in cmd and "forcing.wind.seed=2027" in cmd and "run.seed=2027" not in cmd
+    coarse = {"beta_common": 0.18, "beta_common_per_run": {f"month-lead-same_pa-20km-w{s}": 0.18 for s in range(8)}}
+    fine = {"beta_common": 0.15, "beta_common_per_run": {f"month-lead-same_pa-10km-w{s}": 0.15 + 0.04 * (s < 3)
+                                                          for s in range(7)}}
+    v = dc.verdict_month(coarse, fine)
+    assert v["fall_pooled_common"] == pytest.approx(0.03) and v["e_falls"]
+    assert v["months_paired"] == 7 and v["months_lower_at_10km"] == 4 and not v["f_lower_in_6_of_8"]
+    assert v["median_paired_change"] == pytest.approx(-0.03)
+    fine["beta_common"] = 0.165
+    assert not dc.verdict_month(coarse, fine)["e_falls"]
