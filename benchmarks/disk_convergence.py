@@ -85,6 +85,30 @@ and 10 km. ``report --stage month`` pools every 3-day window from day 1 (100 km 
   Predicted: (e) and (f) hold, with a fall of 0.02–0.05 that sits in the widest octave, as in the basin. If
   they fail, the fall needs the basin's geometry or its spun-up, thick-and-thin start.
 
+  Result (00:25 UTC): (e) fails, by 0.0015: the pooled β on 20–120 km is 0.145 at 20 km and 0.126 at 10 km (a
+  fall of 0.018); (f) holds: β is lower at 10 km in 7 of 8 months (median −0.015). By octave the fall sits in
+  the widest one (52–104 km: 0.143 against 0.104), as in the basin. Looked at after the rule was judged (no
+  rule): in the first window (days 1–4) β is higher at 10 km (0.149 against 0.138), in the later ones lower
+  (0.124 against 0.144), and at 10 km it falls through the month (0.149 in days 1–4, 0.099 in days 25–28).
+  Maps show the bands cutting the pack into smaller floes at 10 km. The band length per area (elements with
+  damage > 0.9, 100 km from the coast, each as long as √area; median over the months) is 0.0142 and 0.0186
+  km⁻¹ on day 4, 0.0289 and 0.0478 on day 28 (20 and 10 km): ×1.3 growing to ×1.65; at 20 km it stops
+  growing after day 16, at 10 km it does not.
+
+Rule RD6 (written at 00:27 UTC, before its runs). A reading of RD5: at the same cohesion in pascals a band one
+element wide costs an energy proportional to Δx (the elastic energy density released at failure, ∝ σc²/E,
+times the band's width), so the same weather buys more band length on a finer mesh, and over weeks of breaking
+and healing the finer mesh cuts the pack into smaller floes (the crack band argument of Bažant and Oh 1983).
+neXtSIM's law σc ∝ Δx^(−1/2) keeps that energy per band length the same on every mesh. Stage ``month`` with
+law ``scaled`` (family ``lead``, the same eight wind seeds, 20 and 10 km; at 20 km the cohesion is the same as
+``same_pa``'s, so those runs must repeat RD5's bit for bit).
+  (g) The band length per area on day 28 at 10 km lies within ×0.8–1.25 of the 20 km one (RD5: ×1.65).
+  (h) The pooled β on 20–120 km falls from 20 to 10 km by less than 0.02, and is lower at 10 km in at most 5
+      of the 8 months.
+  Predicted: (g) and (h) hold. Then the basin's fall under the same law (RD3: 0.038) would need the basin's
+  geometry or its spun-up, thick-and-thin start; if (g) holds and (h) fails, band length is not what sets
+  β's fall.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -93,6 +117,7 @@ and 10 km. ``report --stage month`` pools every 3-day window from day 1 (100 km 
     python benchmarks/disk_convergence.py basin lead20=B20-hthick-eff-C8-cap97-m20,... lead10=...   # RD3
     python benchmarks/disk_convergence.py run --stage month --family lead --law same_pa --jobs 2      # RD5
     python benchmarks/disk_convergence.py report --stage month --family lead --law same_pa
+    python benchmarks/disk_convergence.py run --stage month --family lead --law scaled --jobs 2        # RD6
 
 Runs go to ``benchmarks/out/disk_convergence/FAMILY-LAW-KMkm-sSEED`` (``lagice run`` subprocesses, one
 numba thread each); ``report`` writes ``docs/figures/disk_convergence.json`` (every family and law run so
@@ -339,6 +364,38 @@ def verdict_month(coarse: dict, fine: dict) -> dict:
             "median_paired_change": float(np.median([f - c for c, f in pairs])) if pairs else None}
 
 
+#: band length per area (rule RD6): the days at which it is read, and the damage of a band element
+BAND_DAYS = (4, 10, 16, 22, 28)
+BAND_DAMAGE = 0.9
+DISK_RADIUS_M = 500e3
+
+
+def band_length_per_km(path, days=BAND_DAYS) -> list:
+    """Length of broken bands per interior area [km⁻¹] in the snapshots of ``days`` (rule RD6): the
+    elements with damage above :data:`BAND_DAMAGE` at least 100 km from the disk's coast, each counted as
+    a band as long as its size √area, over the interior's area. A network of bands one element wide whose
+    floes are D across has about 2/D of it, whatever the mesh."""
+    import xarray as xr
+
+    from lagice.io.snapshots import read_index
+
+    path = Path(path)
+    idx = read_index(path)
+    by_day = {round(e["time_s"] / DAY_S): e["file"] for e in idx}
+    out = []
+    for day in days:
+        with xr.open_dataset(path / "snapshots" / by_day[day], decode_times=False) as ds:
+            x, y = ds["mesh_node_x"].values, ds["mesh_node_y"].values
+            t = ds["mesh_face_nodes"].values.astype(np.int64)
+            damage = ds["damage"].values[0]
+        area = 0.5 * np.abs((x[t[:, 1]] - x[t[:, 0]]) * (y[t[:, 2]] - y[t[:, 0]])
+                            - (x[t[:, 2]] - x[t[:, 0]]) * (y[t[:, 1]] - y[t[:, 0]]))
+        inside = np.hypot(x[t].mean(axis=1), y[t].mean(axis=1)) < DISK_RADIUS_M - COAST_BUFFER_M
+        band = inside & (damage > BAND_DAMAGE)
+        out.append(float(np.sqrt(area[band]).sum() / area[inside].sum() * 1e3))
+    return out
+
+
 def report_month(family: str, law: str) -> dict:
     """Stage ``month`` (rule RD5): pool the 3-day windows of the months on each mesh, as ``basin`` does for
     the basin's months, and judge the fall from 20 to 10 km."""
@@ -351,8 +408,16 @@ def report_month(family: str, law: str) -> dict:
     if len(groups) < 2:
         raise SystemExit(f"stage month: need finished runs of {family}-{law} at 20 and 10 km in {OUT}")
     out = pool_windows(groups)
+    for km, paths in groups.items():
+        bands = np.array([band_length_per_km(p) for p in paths])
+        out[km]["band_length_per_km"] = {"days": list(BAND_DAYS), "median": [float(x) for x in np.median(bands, 0)],
+                                         "per_run": {Path(p).name: [float(x) for x in b] for p, b in zip(paths, bands)}}
+        print(f"{km} km: band length per area (km⁻¹, median over months) on days {BAND_DAYS}:",
+              " ".join(f"{x:.4f}" for x in out[km]["band_length_per_km"]["median"]))
     v = verdict_month(out["20"], out["10"])
-    print("rule RD5:", json.dumps(v))
+    ratio = out["10"]["band_length_per_km"]["median"][-1] / out["20"]["band_length_per_km"]["median"][-1]
+    v.update({"band_length_ratio_10_to_20_last_day": ratio, "g_same_band_length": bool(0.8 <= ratio <= 1.25)})
+    print("rules RD5 and RD6:", json.dumps(v))
     _write_json(f"month-{family}-{law}", {"scene": str(MONTH_SCENE.relative_to(ROOT)), "meshes": out,
                                            "common_fit_m": list(BASIN_COMMON_FIT_M), "verdict": v})
     return {"meshes": out, "verdict": v}
