@@ -373,8 +373,9 @@ DISK_RADIUS_M = 500e3
 def band_length_per_km(path, days=BAND_DAYS) -> list:
     """Length of broken bands per interior area [km⁻¹] in the snapshots of ``days`` (rule RD6): the
     elements with damage above :data:`BAND_DAMAGE` at least 100 km from the disk's coast, each counted as
-    a band as long as its size √area, over the interior's area. A network of bands one element wide whose
-    floes are D across has about 2/D of it, whatever the mesh."""
+    a band as long as its size √area, over the interior's area. The same network of bands one element wide
+    gives the same value on every mesh of the same element shape (a band of equilateral triangles is
+    counted 1.3 times its length, one of right triangles from squares √2 times)."""
     import xarray as xr
 
     from lagice.io.snapshots import read_index

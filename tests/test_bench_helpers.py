@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 import re
 import sys
 from pathlib import Path
@@ -1480,3 +1481,43 @@ def test_disk_convergence_month_verdict_pairs_the_months_by_wind_seed():
     assert v["median_paired_change"] == pytest.approx(-0.03)
     fine["beta_common"] = 0.165
     assert not dc.verdict_month(coarse, fine)["e_falls"]
+
+
+def _square_mesh_snapshot(run_dir, h_m, band_damage, time_s):
+    """A run folder with one snapshot: squares of side ``h_m`` cut into two triangles over ±450 km, the
+    column of squares with 0 ≤ x ≤ h carrying ``band_damage`` and every other element 0.3."""
+    import xarray as xr
+
+    n = int(round(900e3 / h_m))
+    xs = -450e3 + h_m * np.arange(n + 1)
+    X, Y = np.meshgrid(xs, xs, indexing="ij")
+    nid = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)
+    a, b, c, d = nid[:-1, :-1].ravel(), nid[1:, :-1].ravel(), nid[1:, 1:].ravel(), nid[:-1, 1:].ravel()
+    tri = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    cx = X.ravel()[tri].mean(axis=1)
+    damage = np.where((cx > 0) & (cx < h_m), band_damage, 0.3)
+    snap = Path(run_dir) / "snapshots"
+    snap.mkdir(parents=True)
+    xr.Dataset({"mesh_node_x": ("mesh_node", X.ravel()), "mesh_node_y": ("mesh_node", Y.ravel()),
+                "mesh_face_nodes": (("mesh_face", "mesh_nmax_face"), tri),
+                "damage": (("time", "mesh_face"), damage[None, :])}).to_netcdf(snap / "snapshot_00000001.nc")
+    (snap / "index.json").write_text(json.dumps([{"file": "snapshot_00000001.nc", "time_s": time_s, "step": 1,
+                                                  "mesh_epoch": 0}]))
+
+
+def test_disk_convergence_band_length_is_the_same_band_on_two_meshes(tmp_path):
+    """Rule RD6's band length per area: one straight band across the disk's interior (radius 400 km) gives
+    √2 × its length over the interior's area on a mesh of right triangles, whatever the element size, and
+    elements at or below the band damage are not counted."""
+    import disk_convergence as dc
+
+    day = 28
+    for h in (10e3, 5e3):
+        _square_mesh_snapshot(tmp_path / f"h{h:g}", h, 0.95, day * dc.DAY_S)
+        _square_mesh_snapshot(tmp_path / f"h{h:g}-weak", h, dc.BAND_DAMAGE, day * dc.DAY_S)
+    r = 400.0  # km
+    expected = np.sqrt(2.0) * 2 * r / (np.pi * r ** 2)
+    got = {h: dc.band_length_per_km(tmp_path / f"h{h:g}", days=(day,))[0] for h in (10e3, 5e3)}
+    assert got[10e3] == pytest.approx(expected, rel=0.03) and got[5e3] == pytest.approx(expected, rel=0.03)
+    assert got[5e3] == pytest.approx(got[10e3], rel=0.02)
+    assert dc.band_length_per_km(tmp_path / "h5000-weak", days=(day,)) == [0.0]
