@@ -320,12 +320,15 @@ def pool_windows(groups: dict) -> dict:
 
     out = {}
     for name, paths in groups.items():
-        curves, per_run = [], {}
+        curves, per_run, by_start = [], {}, {}
         for path in paths:
+            starts = window_starts_days(path, 3.0, start_day=1.0)
             mine = [window_summary(path, start * DAY_S, 3 * DAY_S, COAST_BUFFER_M)["interior"]["scaling_space"]
-                    for start in window_starts_days(path, 3.0, start_day=1.0)]
+                    for start in starts]
             per_run[Path(path).name] = float(_pool(mine, BASIN_COMMON_FIT_M)[0].fit.exponent)
             curves += mine
+            for start, c in zip(starts, mine):
+                by_start.setdefault(float(start), []).append(c)
         own, slopes = _pool(curves)
         L = own.scale_m
         from2, _ = _pool(curves, (L[1] * 0.99, 1e9))
@@ -335,7 +338,9 @@ def pool_windows(groups: dict) -> dict:
                      "beta_common": float(common.fit.exponent), "scale_m": [float(x) for x in L],
                      "mean_total_per_day": [float(x * DAY_S) for x in own.mean_total_s],
                      "fewest_boxes": [int(x) for x in own.fewest_boxes],
-                     "slope_per_octave": [float(x) for x in slopes], "beta_common_per_run": per_run}
+                     "slope_per_octave": [float(x) for x in slopes], "beta_common_per_run": per_run,
+                     "beta_common_by_window_start_day": {f"{k:g}": float(_pool(v, BASIN_COMMON_FIT_M)[0].fit.exponent)
+                                                         for k, v in sorted(by_start.items())}}
         r = out[name]
         print(f"{name}: {len(curves)} windows, β own {r['beta_own']:.3f}, from 2Δx {r['beta_from_2dx']:.3f}, "
               f"on {BASIN_COMMON_FIT_M[0] / 1e3:g}-{BASIN_COMMON_FIT_M[1] / 1e3:g} km {r['beta_common']:.3f}; "
@@ -397,6 +402,66 @@ def band_length_per_km(path, days=BAND_DAYS) -> list:
     return out
 
 
+#: the month whose maps the figure shows (the validation month's weather) and the days shown
+MAP_SEED, MAP_DAYS = 2026, (7, 16, 27)
+
+
+def figure_month(family: str, law: str, groups: dict, pooled_windows: dict, path: Path) -> None:
+    """Stage ``month``: the total deformation rate of the month of wind seed :data:`MAP_SEED` on
+    :data:`MAP_DAYS` on each mesh, the band length per area against the day, and the pooled β on the common
+    widths window by window."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import xarray as xr
+    from matplotlib.colors import LogNorm
+
+    from lagice.io.snapshots import read_index
+
+    kms = sorted(groups, key=float, reverse=True)
+    fig, axes = plt.subplots(len(kms), len(MAP_DAYS) + 1, figsize=(4.2 * (len(MAP_DAYS) + 1), 4.0 * len(kms)))
+    colours = {"20": "tab:blue", "10": "tab:red"}
+    for row, km in enumerate(kms):
+        run = next(p for p in groups[km] if Path(p).name.endswith(f"-w{MAP_SEED}"))
+        by_day = {round(e["time_s"] / DAY_S): e["file"] for e in read_index(run)}
+        for col, day in enumerate(MAP_DAYS):
+            with xr.open_dataset(Path(run) / "snapshots" / by_day[day], decode_times=False) as ds:
+                x, y = ds["mesh_node_x"].values / 1e3, ds["mesh_node_y"].values / 1e3
+                rate = ds["total_deformation_rate"].values[0] * DAY_S
+                im = axes[row, col].tripcolor(x, y, ds["mesh_face_nodes"].values.astype(np.int64),
+                                              facecolors=np.maximum(rate, 1e-4), norm=LogNorm(1e-3, 1.0),
+                                              cmap="magma_r")
+            axes[row, col].set_aspect("equal")
+            axes[row, col].set_title(f"{km} km mesh, day {day}", fontsize=10)
+            axes[row, col].set_xlabel("x (km)")
+        fig.colorbar(im, ax=axes[row, len(MAP_DAYS) - 1], label="total deformation rate (day⁻¹)", shrink=0.8)
+    ax = axes[0, -1]
+    for km in kms:
+        b = pooled_windows[km]["band_length_per_km"]
+        for runs in b["per_run"].values():
+            ax.plot(b["days"], runs, color=colours.get(km, "k"), alpha=0.25, lw=0.8)
+        ax.plot(b["days"], b["median"], "-o", color=colours.get(km, "k"), label=f"{km} km (median of months)")
+    ax.set_xlabel("day")
+    ax.set_ylabel("band length per area (km⁻¹)")
+    ax.set_title(f"broken bands (damage > {BAND_DAMAGE:g}), 100 km from the coast", fontsize=10)
+    ax.legend(fontsize=8)
+    ax = axes[1, -1] if len(kms) > 1 else ax
+    for km in kms:
+        w = pooled_windows[km]["beta_common_by_window_start_day"]
+        ax.plot([float(k) + 1.5 for k in w], list(w.values()), "-s", color=colours.get(km, "k"), label=f"{km} km")
+    ax.axhspan(0.17, 0.20, color="0.85", label="observed band (RGPS; for scale)")
+    ax.set_xlabel("window centre (day)")
+    ax.set_ylabel(f"β on {BASIN_COMMON_FIT_M[0] / 1e3:g}–{BASIN_COMMON_FIT_M[1] / 1e3:g} km, pooled over months")
+    ax.set_title("β window by window", fontsize=10)
+    ax.legend(fontsize=8)
+    fig.suptitle(f"28 days of the winter climatology over a pristine 500 km disk: family {family}, strength {law}"
+                 f" (maps: wind seed {MAP_SEED})", fontsize=11)
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+
+
 def report_month(family: str, law: str) -> dict:
     """Stage ``month`` (rule RD5): pool the 3-day windows of the months on each mesh, as ``basin`` does for
     the basin's months, and judge the fall from 20 to 10 km."""
@@ -419,6 +484,9 @@ def report_month(family: str, law: str) -> dict:
     ratio = out["10"]["band_length_per_km"]["median"][-1] / out["20"]["band_length_per_km"]["median"][-1]
     v.update({"band_length_ratio_10_to_20_last_day": ratio, "g_same_band_length": bool(0.8 <= ratio <= 1.25)})
     print("rules RD5 and RD6:", json.dumps(v))
+    fig = ROOT / "docs" / "figures" / f"disk_month_{family}_{law}.png"
+    figure_month(family, law, groups, out, fig)
+    print(f"wrote {fig.relative_to(ROOT)}")
     _write_json(f"month-{family}-{law}", {"scene": str(MONTH_SCENE.relative_to(ROOT)), "meshes": out,
                                            "common_fit_m": list(BASIN_COMMON_FIT_M), "verdict": v})
     return {"meshes": out, "verdict": v}
