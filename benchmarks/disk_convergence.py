@@ -420,7 +420,8 @@ def figure_month(family: str, law: str, groups: dict, pooled_windows: dict, path
     from lagice.io.snapshots import read_index
 
     kms = sorted(groups, key=float, reverse=True)
-    fig, axes = plt.subplots(len(kms), len(MAP_DAYS) + 1, figsize=(4.2 * (len(MAP_DAYS) + 1), 4.0 * len(kms)))
+    fig, axes = plt.subplots(len(kms), len(MAP_DAYS) + 1, figsize=(4.2 * (len(MAP_DAYS) + 1), 4.0 * len(kms)),
+                             layout="constrained")
     colours = {"20": "tab:blue", "10": "tab:red"}
     for row, km in enumerate(kms):
         run = next(p for p in groups[km] if Path(p).name.endswith(f"-w{MAP_SEED}"))
@@ -435,7 +436,7 @@ def figure_month(family: str, law: str, groups: dict, pooled_windows: dict, path
             axes[row, col].set_aspect("equal")
             axes[row, col].set_title(f"{km} km mesh, day {day}", fontsize=10)
             axes[row, col].set_xlabel("x (km)")
-        fig.colorbar(im, ax=axes[row, len(MAP_DAYS) - 1], label="total deformation rate (day⁻¹)", shrink=0.8)
+    fig.colorbar(im, ax=list(axes[:, :len(MAP_DAYS)].ravel()), label="total deformation rate (day⁻¹)", shrink=0.6)
     ax = axes[0, -1]
     for km in kms:
         b = pooled_windows[km]["band_length_per_km"]
@@ -444,7 +445,7 @@ def figure_month(family: str, law: str, groups: dict, pooled_windows: dict, path
         ax.plot(b["days"], b["median"], "-o", color=colours.get(km, "k"), label=f"{km} km (median of months)")
     ax.set_xlabel("day")
     ax.set_ylabel("band length per area (km⁻¹)")
-    ax.set_title(f"broken bands (damage > {BAND_DAMAGE:g}), 100 km from the coast", fontsize=10)
+    ax.set_title(f"bands (damage > {BAND_DAMAGE:g}), ≥ 100 km from coast", fontsize=10)
     ax.legend(fontsize=8)
     ax = axes[1, -1] if len(kms) > 1 else ax
     for km in kms:
@@ -457,7 +458,6 @@ def figure_month(family: str, law: str, groups: dict, pooled_windows: dict, path
     ax.legend(fontsize=8)
     fig.suptitle(f"28 days of the winter climatology over a pristine 500 km disk: family {family}, strength {law}"
                  f" (maps: wind seed {MAP_SEED})", fontsize=11)
-    fig.tight_layout()
     fig.savefig(path, dpi=80)
     plt.close(fig)
 
