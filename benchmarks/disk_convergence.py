@@ -109,6 +109,30 @@ law ``scaled`` (family ``lead``, the same eight wind seeds, 20 and 10 km; at 20 
   geometry or its spun-up, thick-and-thin start; if (g) holds and (h) fails, band length is not what sets
   β's fall.
 
+  Result (00:52 UTC): both fail; both predictions were wrong. (g): the band length per area on day 28 is 1.35
+  times the 20 km one (0.0390 against 0.0289 km⁻¹; ×1.65 at the same cohesion). (h): the pooled β on 20–120 km
+  falls by 0.020 (0.145 → 0.124), lower at 10 km in 7 of 8 months (median −0.021), in the widest octave
+  (52–103 km: 0.095). The 20 km months repeat RD5's bit for bit (every field of the last snapshots of three
+  months compared). At 10 km the first window's β is again higher than 20 km's (0.173 against 0.138), and the
+  later ones lower. So on the disk the month's pieces make half the basin's fall under either law; the law
+  changes the extra band length (×1.65 → ×1.35) and not the fall of β.
+
+Rule RD7 (written at 00:55 UTC, before its analysis; no new runs). Is β set by how far the pack is cut into
+floes, with the mesh only changing how fast? Every window of RD5's and RD6's months (2 laws × 2 meshes × 8
+months × 9 windows) is labelled by the band length per area on its first day, and the windows of each mesh
+are pooled by bin of band length (below 0.02, 0.02–0.03, 0.03–0.04, 0.04 km⁻¹ and above), β on 20–120 km.
+  (k) Fragmentation sets β if, in every bin with at least 8 windows on both meshes, the 20 and 10 km β lie
+      within 0.02 of each other, and on each mesh β is at least 0.03 lower in its most cut bin than in its
+      least cut one (bins with at least 8 windows).
+  Predicted: (k) holds.
+
+Rule RD8 (written at 00:55 UTC, before its runs). Healing is the time-dependent piece whose cycle of mending
+and breaking again could cut the finer mesh further. Stage ``month``, variant ``noheal`` (``healing.law =
+none``), family ``lead``, law ``same_pa``, the eight wind seeds, 20 and 10 km.
+  (m) Healing is not needed for the fall if the pooled β on 20–120 km falls from 20 to 10 km by at least 0.02
+      and is lower at 10 km in at least 6 of 8 months (RD5's (e) and (f) on these runs).
+  Predicted: (m) holds; the band length per area on day 28 is at least 1.25 times the 20 km one.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -118,6 +142,8 @@ law ``scaled`` (family ``lead``, the same eight wind seeds, 20 and 10 km; at 20 
     python benchmarks/disk_convergence.py run --stage month --family lead --law same_pa --jobs 2      # RD5
     python benchmarks/disk_convergence.py report --stage month --family lead --law same_pa
     python benchmarks/disk_convergence.py run --stage month --family lead --law scaled --jobs 2        # RD6
+    python benchmarks/disk_convergence.py run --stage month --variant noheal --family lead --law same_pa --jobs 2  # RD8
+    python benchmarks/disk_convergence.py fragmentation                                               # RD7
 
 Runs go to ``benchmarks/out/disk_convergence/FAMILY-LAW-KMkm-sSEED`` (``lagice run`` subprocesses, one
 numba thread each); ``report`` writes ``docs/figures/disk_convergence.json`` (every family and law run so
@@ -153,6 +179,8 @@ MORE_SEEDS = tuple(range(18, 24))
 #: month 2026, ENSEMBLE_SEEDS, MORE_SEEDS); the strength disorder is run.seed 2026's in every month
 MONTH_SEEDS = tuple(range(2026, 2034))
 MONTH_KM = (20, 10)
+#: stage ``month``'s variants (``--variant``): scene overrides, the basin's pieces taken out one at a time
+MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"]}
 #: (scene overrides, C_lab [Pa] in lagice's form at the reference size)
 FAMILIES = {
     "lead": (["rheology.failure_stress=effective", "rheology.max_damage=0.97"], 22.4e6),
@@ -175,36 +203,41 @@ def lab_cohesion_pa(family: str, law: str, km: float) -> float:
     return base * (np.sqrt(km / REFERENCE_KM) if law == "same_pa" else 1.0)
 
 
-def run_name(family: str, law: str, km: float, seed: int, stage: str = "storm") -> str:
-    """``FAMILY-LAW-KMkm-sSEED`` (one cyclone, disorder seed) or ``month-FAMILY-LAW-KMkm-wSEED`` (wind seed)."""
+def _month_prefix(variant: str = "") -> str:
+    return f"month-{variant}-" if variant else "month-"
+
+
+def run_name(family: str, law: str, km: float, seed: int, stage: str = "storm", variant: str = "") -> str:
+    """``FAMILY-LAW-KMkm-sSEED`` (one cyclone, disorder seed) or ``month[-VARIANT]-FAMILY-LAW-KMkm-wSEED``
+    (wind seed)."""
     if stage == "month":
-        return f"month-{family}-{law}-{km:g}km-w{seed}"
+        return f"{_month_prefix(variant)}{family}-{law}-{km:g}km-w{seed}"
     return f"{family}-{law}-{km:g}km-s{seed}"
 
 
-def command(family: str, law: str, km: float, seed: int, stage: str = "storm") -> list:
+def command(family: str, law: str, km: float, seed: int, stage: str = "storm", variant: str = "") -> list:
     sets = [f"domain.resolution_m={km * 1e3:g}", f"rheology.strength_lab_pa={lab_cohesion_pa(family, law, km):.6g}",
             *FAMILIES[family][0]]
     if stage == "month":
-        scene, sets = MONTH_SCENE, [f"forcing.wind.seed={seed}", *sets]
+        scene, sets = MONTH_SCENE, [f"forcing.wind.seed={seed}", *sets, *MONTH_VARIANTS[variant]]
     else:
         scene, sets = SCENE, [f"domain.file={DISK}", f"run.seed={seed}", "output.every=6h", *sets]
     cmd = [sys.executable, "-m", "lagice", "run", str(scene), "--out",
-           str(OUT / run_name(family, law, km, seed, stage))]
+           str(OUT / run_name(family, law, km, seed, stage, variant))]
     for s in sets:
         cmd += ["--set", s]
     return cmd
 
 
-def run_one(family, law, km, seed, stage="storm") -> str:
-    name = run_name(family, law, km, seed, stage)
+def run_one(family, law, km, seed, stage="storm", variant="") -> str:
+    name = run_name(family, law, km, seed, stage, variant)
     out = OUT / name
     if (out / "snapshots" / "index.json").exists():
         return f"{name}: done before"
     OUT.mkdir(parents=True, exist_ok=True)
     env = {**os.environ, "NUMBA_NUM_THREADS": os.environ.get("NUMBA_NUM_THREADS", "1")}
     with open(OUT / f"{name}.log", "w") as log:
-        subprocess.run(command(family, law, km, seed, stage), check=True, stdout=log, stderr=subprocess.STDOUT,
+        subprocess.run(command(family, law, km, seed, stage, variant), check=True, stdout=log, stderr=subprocess.STDOUT,
                        cwd=ROOT, env=env)
     return f"{name}: made"
 
@@ -462,12 +495,12 @@ def figure_month(family: str, law: str, groups: dict, pooled_windows: dict, path
     plt.close(fig)
 
 
-def report_month(family: str, law: str) -> dict:
-    """Stage ``month`` (rule RD5): pool the 3-day windows of the months on each mesh, as ``basin`` does for
-    the basin's months, and judge the fall from 20 to 10 km."""
+def report_month(family: str, law: str, variant: str = "") -> dict:
+    """Stage ``month`` (rules RD5, RD6, RD8): pool the 3-day windows of the months on each mesh, as ``basin``
+    does for the basin's months, and judge the fall from 20 to 10 km."""
     groups = {}
     for km in MONTH_KM:
-        paths = [p for p in sorted(OUT.glob(f"month-{family}-{law}-{km:g}km-w*"))
+        paths = [p for p in sorted(OUT.glob(f"{_month_prefix(variant)}{family}-{law}-{km:g}km-w*"))
                  if (p / "snapshots" / "index.json").exists()]
         if paths:
             groups[f"{km:g}"] = paths
@@ -484,11 +517,12 @@ def report_month(family: str, law: str) -> dict:
     ratio = out["10"]["band_length_per_km"]["median"][-1] / out["20"]["band_length_per_km"]["median"][-1]
     v.update({"band_length_ratio_10_to_20_last_day": ratio, "g_same_band_length": bool(0.8 <= ratio <= 1.25)})
     print("rules RD5 and RD6:", json.dumps(v))
-    fig = ROOT / "docs" / "figures" / f"disk_month_{family}_{law}.png"
-    figure_month(family, law, groups, out, fig)
+    fig = ROOT / "docs" / "figures" / f"disk_month_{variant + '_' if variant else ''}{family}_{law}.png"
+    figure_month(f"{family}{', ' + variant if variant else ''}", law, groups, out, fig)
     print(f"wrote {fig.relative_to(ROOT)}")
-    _write_json(f"month-{family}-{law}", {"scene": str(MONTH_SCENE.relative_to(ROOT)), "meshes": out,
-                                           "common_fit_m": list(BASIN_COMMON_FIT_M), "verdict": v})
+    _write_json(f"{_month_prefix(variant)}{family}-{law}",
+                {"scene": str(MONTH_SCENE.relative_to(ROOT)), "overrides": MONTH_VARIANTS[variant], "meshes": out,
+                 "common_fit_m": list(BASIN_COMMON_FIT_M), "verdict": v})
     return {"meshes": out, "verdict": v}
 
 
@@ -597,9 +631,11 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--stage", choices=("storm", "month"), default="storm",
                     help="storm: one cyclone, 3 days (default); month: examples/winter_disk.toml, 28 days (RD5)")
+    ap.add_argument("--variant", choices=sorted(MONTH_VARIANTS), default="",
+                    help="stage month: a piece taken out (noheal: healing.law = none; rule RD8)")
     a = ap.parse_args(argv)
     if a.stage == "month" and a.what == "report":
-        report_month(a.family, a.law)
+        report_month(a.family, a.law, a.variant)
         return 0
     if a.what == "run":
         # the finest meshes first, so that two jobs finish together
@@ -608,7 +644,7 @@ def main(argv=None) -> int:
             seeds = a.seeds if a.seeds != list(SEEDS) else list(MONTH_SEEDS)
         else:
             kms, seeds = a.km, list(a.seeds) + (list(MORE_SEEDS) if a.more_seeds else [])
-        todo = [(a.family, a.law, km, s, a.stage) for km in sorted(kms) for s in seeds]
+        todo = [(a.family, a.law, km, s, a.stage, a.variant) for km in sorted(kms) for s in seeds]
         with ThreadPoolExecutor(a.jobs) as ex:
             for msg in ex.map(lambda t: run_one(*t), todo):
                 print(msg, flush=True)
