@@ -619,9 +619,68 @@ def report(family: str, law: str) -> dict:
     return result
 
 
+#: rule RD7's bins of band length per area [km⁻¹] and the fewest windows a bin needs
+FRAGMENTATION_BINS = (0.0, 0.02, 0.03, 0.04, np.inf)
+FRAGMENTATION_MIN_WINDOWS = 8
+
+
+def fragmentation(family: str = "lead", laws=("same_pa", "scaled")) -> dict:
+    """Rule RD7: every 3-day window of the ``month`` runs of ``laws`` labelled by the band length per area on
+    its first day; per mesh and bin of :data:`FRAGMENTATION_BINS`, the pooled β on
+    :data:`BASIN_COMMON_FIT_M`. The 20 km runs of ``same_pa`` and ``scaled`` have the same cohesion (the same
+    runs, bit for bit), so at 20 km only the first law's are taken."""
+    from lagice.diagnostics.windows import window_starts_days, window_summary
+
+    out = {}
+    for km in MONTH_KM:
+        bins = [[] for _ in FRAGMENTATION_BINS[:-1]]
+        for law in (laws[:1] if float(km) == REFERENCE_KM else laws):
+            for path in sorted(OUT.glob(f"month-{family}-{law}-{km:g}km-w*")):
+                if not (path / "snapshots" / "index.json").exists():
+                    continue
+                starts = window_starts_days(path, 3.0, start_day=1.0)
+                lengths = band_length_per_km(path, days=[round(x) for x in starts])
+                for start, length in zip(starts, lengths):
+                    c = window_summary(path, start * DAY_S, 3 * DAY_S, COAST_BUFFER_M)["interior"]["scaling_space"]
+                    bins[int(np.searchsorted(FRAGMENTATION_BINS, length, side="right")) - 1].append(c)
+        row = []
+        for i, curves in enumerate(bins):
+            lo, hi = FRAGMENTATION_BINS[i], FRAGMENTATION_BINS[i + 1]
+            beta = float(_pool(curves, BASIN_COMMON_FIT_M)[0].fit.exponent) if curves else None
+            row.append({"band_length_per_km": [lo, None if np.isinf(hi) else hi], "n_windows": len(curves),
+                        "beta_common": beta})
+            print(f"{km} km, band length {lo:.2f}-{hi:.2f} km⁻¹: {len(curves):3d} windows, β on 20-120 km "
+                  + (f"{beta:.3f}" if beta is not None else "-"))
+        out[f"{km:g}"] = row
+    v = verdict_fragmentation(out)
+    print("rule RD7:", json.dumps(v))
+    _write_json("fragmentation", {"family": family, "laws": list(laws), "bins": out, "verdict": v,
+                                  "min_windows": FRAGMENTATION_MIN_WINDOWS})
+    return {"bins": out, "verdict": v}
+
+
+def verdict_fragmentation(bins: dict) -> dict:
+    """Rule RD7 (k) on :func:`fragmentation`'s bins: the two meshes agree within 0.02 in every bin both fill
+    (at least :data:`FRAGMENTATION_MIN_WINDOWS` windows each), and on each mesh β is at least 0.03 lower in
+    its most cut filled bin than in its least cut one."""
+    n = FRAGMENTATION_MIN_WINDOWS
+    coarse, fine = bins["20"], bins["10"]
+    shared = [(a["beta_common"], b["beta_common"]) for a, b in zip(coarse, fine)
+              if a["n_windows"] >= n and b["n_windows"] >= n]
+    drops = {}
+    for km, row in bins.items():
+        filled = [r["beta_common"] for r in row if r["n_windows"] >= n]
+        drops[km] = filled[0] - filled[-1] if len(filled) >= 2 else None
+    agree = bool(shared) and all(abs(a - b) < 0.02 for a, b in shared)
+    falls = all(d is not None and d >= 0.03 for d in drops.values())
+    return {"bins_shared": len(shared), "largest_gap_shared": max((abs(a - b) for a, b in shared), default=None),
+            "meshes_agree": agree, "drop_least_to_most_cut": drops, "beta_falls_with_cutting": falls,
+            "k_fragmentation_sets_beta": bool(agree and falls)}
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=("run", "report", "basin"))
+    ap.add_argument("what", choices=("run", "report", "basin", "fragmentation"))
     ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
@@ -634,6 +693,9 @@ def main(argv=None) -> int:
     ap.add_argument("--variant", choices=sorted(MONTH_VARIANTS), default="",
                     help="stage month: a piece taken out (noheal: healing.law = none; rule RD8)")
     a = ap.parse_args(argv)
+    if a.what == "fragmentation":
+        fragmentation(a.family)
+        return 0
     if a.stage == "month" and a.what == "report":
         report_month(a.family, a.law, a.variant)
         return 0
