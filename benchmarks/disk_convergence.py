@@ -684,8 +684,8 @@ def main(argv=None) -> int:
     ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
-    ap.add_argument("--km", type=float, nargs="+", default=list(KM))
-    ap.add_argument("--seeds", type=int, nargs="+", default=list(SEEDS))
+    ap.add_argument("--km", type=float, nargs="+", help="meshes (default: 20 14 10 7 5; stage month: 20 10)")
+    ap.add_argument("--seeds", type=int, nargs="+", help="seeds (default 12-17; stage month: wind seeds 2026-2033)")
     ap.add_argument("--more-seeds", action="store_true", help="add rule RD2's seeds 18-23")
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--stage", choices=("storm", "month"), default="storm",
@@ -702,10 +702,9 @@ def main(argv=None) -> int:
     if a.what == "run":
         # the finest meshes first, so that two jobs finish together
         if a.stage == "month":
-            kms = a.km if a.km != list(KM) else list(MONTH_KM)
-            seeds = a.seeds if a.seeds != list(SEEDS) else list(MONTH_SEEDS)
+            kms, seeds = a.km or list(MONTH_KM), a.seeds or list(MONTH_SEEDS)
         else:
-            kms, seeds = a.km, list(a.seeds) + (list(MORE_SEEDS) if a.more_seeds else [])
+            kms, seeds = a.km or list(KM), list(a.seeds or SEEDS) + (list(MORE_SEEDS) if a.more_seeds else [])
         todo = [(a.family, a.law, km, s, a.stage, a.variant) for km in sorted(kms) for s in seeds]
         with ThreadPoolExecutor(a.jobs) as ex:
             for msg in ex.map(lambda t: run_one(*t), todo):

@@ -1521,3 +1521,25 @@ def test_disk_convergence_band_length_is_the_same_band_on_two_meshes(tmp_path):
     assert got[10e3] == pytest.approx(expected, rel=0.03) and got[5e3] == pytest.approx(expected, rel=0.03)
     assert got[5e3] == pytest.approx(got[10e3], rel=0.02)
     assert dc.band_length_per_km(tmp_path / "h5000-weak", days=(day,)) == [0.0]
+
+
+def test_disk_convergence_fragmentation_verdict_needs_agreement_and_a_fall_with_cutting():
+    """Rule RD7 (k): the meshes must agree within 0.02 in every bin both fill with at least 8 windows, and
+    each mesh's β must fall by at least 0.03 from its least to its most cut filled bin."""
+    import disk_convergence as dc
+
+    def row(*cells):
+        return [{"n_windows": n, "beta_common": b} for n, b in cells]
+
+    bins = {"20": row((27, 0.16), (38, 0.14), (7, 0.10), (0, None)),
+            "10": row((37, 0.15), (16, 0.145), (56, 0.12), (35, 0.11))}
+    v = dc.verdict_fragmentation(bins)
+    assert v["bins_shared"] == 2 and v["largest_gap_shared"] == pytest.approx(0.01) and v["meshes_agree"]
+    assert v["drop_least_to_most_cut"]["20"] == pytest.approx(0.02)  # the 7-window bin is not filled
+    assert v["drop_least_to_most_cut"]["10"] == pytest.approx(0.04)
+    assert not v["beta_falls_with_cutting"] and not v["k_fragmentation_sets_beta"]
+    bins["20"][1]["beta_common"] = 0.12
+    v = dc.verdict_fragmentation(bins)
+    assert v["beta_falls_with_cutting"] and not v["meshes_agree"] and not v["k_fragmentation_sets_beta"]
+    bins["10"][1]["beta_common"] = 0.125
+    assert dc.verdict_fragmentation(bins)["k_fragmentation_sets_beta"]
