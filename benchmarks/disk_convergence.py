@@ -133,6 +133,19 @@ none``), family ``lead``, law ``same_pa``, the eight wind seeds, 20 and 10 km.
       and is lower at 10 km in at least 6 of 8 months (RD5's (e) and (f) on these runs).
   Predicted: (m) holds; the band length per area on day 28 is at least 1.25 times the 20 km one.
 
+  Result (01:21 UTC): (m) fails; the prediction was wrong for β and right for the band length. Without healing
+  the pooled β on 20–120 km falls from 20 to 10 km by 0.010 (0.131 → 0.121), lower at 10 km in 5 of 8 months
+  (median −0.010), while the band length per area on day 28 is 1.57 times the 20 km one (0.0431 against
+  0.0274). β now falls through the month on both meshes (days 1–4 to days 25–28: 0.168 → 0.094 at 20 km,
+  0.166 → 0.102 at 10 km) and the rate rises (window medians 0.0235 and 0.0201 per day, against 0.0165 and
+  0.0149 with healing). The band length hardly moves with healing (day 28: 0.0274 against 0.0289 at 20 km,
+  0.0431 against 0.0478 at 10 km). So healing is what lets the 20 km mesh keep its β through the month, and
+  half of the fall between the meshes goes without it; what healing changes is not how far the bands cut.
+  How firmly (computed after the verdict, no rule): the month-by-month fall (10 km less 20 km, mean of the 8
+  months, 90 % interval from resampling the months) is −0.022 [−0.036, −0.009] with healing (RD5), −0.024
+  [−0.038, −0.011] under the scaled law (RD6) and −0.009 [−0.017, 0.000] without healing; paired by month,
+  healing adds −0.013 [−0.027, +0.001]. So healing's part is suggested by these eight months, not shown.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
