@@ -146,6 +146,17 @@ none``), family ``lead``, law ``same_pa``, the eight wind seeds, 20 and 10 km.
   [−0.038, −0.011] under the scaled law (RD6) and −0.009 [−0.017, 0.000] without healing; paired by month,
   healing adds −0.013 [−0.027, +0.001]. So healing's part is suggested by these eight months, not shown.
 
+Rule RD9 (written at 01:23 UTC, before its runs). The basin's months start from a 14-day spin-up, so every one
+of their windows comes after two weeks of breaking; on the disk the first window, on pristine ice, has a higher
+β at 10 km than at 20 km, and the later ones a lower. Variant ``spun``: each month starts from the end of a
+14-day run of the same scene, mesh and strength from pristine ice (wind seed 2025 from 1 January, as the
+basin's spin-up; the strength disorder is run.seed 2026's, as in the months), family ``lead``, law ``same_pa``,
+the eight wind seeds, 20 and 10 km.
+  (n) The spun-up start adds to the fall if the pooled β on 20–120 km falls from 20 to 10 km by at least 0.03
+      and is lower at 10 km in at least 6 of the 8 months.
+  Predicted: (n) holds, with a fall of 0.03–0.04 (the basin's 0.038): the rest of the basin's fall would be
+  its start, not its coast.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -157,6 +168,7 @@ none``), family ``lead``, law ``same_pa``, the eight wind seeds, 20 and 10 km.
     python benchmarks/disk_convergence.py run --stage month --family lead --law scaled --jobs 2        # RD6
     python benchmarks/disk_convergence.py run --stage month --variant noheal --family lead --law same_pa --jobs 2  # RD8
     python benchmarks/disk_convergence.py fragmentation                                               # RD7
+    python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
 
 Runs go to ``benchmarks/out/disk_convergence/FAMILY-LAW-KMkm-sSEED`` (``lagice run`` subprocesses, one
 numba thread each); ``report`` writes ``docs/figures/disk_convergence.json`` (every family and law run so
@@ -193,7 +205,36 @@ MORE_SEEDS = tuple(range(18, 24))
 MONTH_SEEDS = tuple(range(2026, 2034))
 MONTH_KM = (20, 10)
 #: stage ``month``'s variants (``--variant``): scene overrides, the basin's pieces taken out one at a time
-MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"]}
+MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], "spun": []}
+#: variant ``spun`` (rule RD9): each month starts from the end of a 14-day run of the same scene, mesh and
+#: strength from pristine ice, under wind seed 2025 from 1 January (as the basin's spin-up)
+SPINUP_SETS = ["forcing.wind.seed=2025", 'run.start_date="2026-01-01 00:00:00"', "run.duration=14d", "output.every=7d"]
+
+
+def spinup_path(family: str, law: str, km: float) -> Path:
+    return OUT / f"spinup-{family}-{law}-{km:g}km.npz"
+
+
+def make_spinup(family: str, law: str, km: float) -> str:
+    """Variant ``spun``: the 14-day spin-up of ``examples/winter_disk.toml`` on the mesh of ``km`` (the
+    family's settings and the law's strength), its last snapshot saved by :func:`lagice.spinup.save_spinup`."""
+    from lagice.spinup import save_spinup
+
+    target = spinup_path(family, law, km)
+    if target.exists():
+        return f"{target.name}: done before"
+    out = OUT / target.stem
+    cmd = [sys.executable, "-m", "lagice", "run", str(MONTH_SCENE), "--out", str(out)]
+    for x in [f"domain.resolution_m={km * 1e3:g}", f"rheology.strength_lab_pa={lab_cohesion_pa(family, law, km):.6g}",
+              *FAMILIES[family][0], *SPINUP_SETS]:
+        cmd += ["--set", x]
+    OUT.mkdir(parents=True, exist_ok=True)
+    env = {**os.environ, "NUMBA_NUM_THREADS": os.environ.get("NUMBA_NUM_THREADS", "1")}
+    with open(OUT / f"{target.stem}.log", "w") as log:
+        subprocess.run(cmd + (["--overwrite"] if out.exists() else []), check=True, stdout=log,
+                       stderr=subprocess.STDOUT, cwd=ROOT, env=env)
+    save_spinup(out, target)
+    return f"{target.name}: made"
 #: (scene overrides, C_lab [Pa] in lagice's form at the reference size)
 FAMILIES = {
     "lead": (["rheology.failure_stress=effective", "rheology.max_damage=0.97"], 22.4e6),
@@ -233,6 +274,9 @@ def command(family: str, law: str, km: float, seed: int, stage: str = "storm", v
             *FAMILIES[family][0]]
     if stage == "month":
         scene, sets = MONTH_SCENE, [f"forcing.wind.seed={seed}", *sets, *MONTH_VARIANTS[variant]]
+        if variant == "spun":
+            sets += [f"initial.state_file={spinup_path(family, law, km)}", "initial.thickness_m=from_state",
+                     "initial.concentration=from_state", "initial.damage=from_state"]
     else:
         scene, sets = SCENE, [f"domain.file={DISK}", f"run.seed={seed}", "output.every=6h", *sets]
     cmd = [sys.executable, "-m", "lagice", "run", str(scene), "--out",
@@ -704,7 +748,7 @@ def main(argv=None) -> int:
     ap.add_argument("--stage", choices=("storm", "month"), default="storm",
                     help="storm: one cyclone, 3 days (default); month: examples/winter_disk.toml, 28 days (RD5)")
     ap.add_argument("--variant", choices=sorted(MONTH_VARIANTS), default="",
-                    help="stage month: a piece taken out (noheal: healing.law = none; rule RD8)")
+                    help="stage month: noheal (healing.law = none; rule RD8), spun (from a 14-day spin-up; RD9)")
     a = ap.parse_args(argv)
     if a.what == "fragmentation":
         fragmentation(a.family)
@@ -720,6 +764,9 @@ def main(argv=None) -> int:
             kms, seeds = a.km or list(KM), list(a.seeds or SEEDS) + (list(MORE_SEEDS) if a.more_seeds else [])
         todo = [(a.family, a.law, km, s, a.stage, a.variant) for km in sorted(kms) for s in seeds]
         with ThreadPoolExecutor(a.jobs) as ex:
+            if a.variant == "spun":
+                for msg in ex.map(lambda km: make_spinup(a.family, a.law, km), sorted(kms)):
+                    print(msg, flush=True)
             for msg in ex.map(lambda t: run_one(*t), todo):
                 print(msg, flush=True)
         return 0
