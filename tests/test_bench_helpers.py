@@ -1472,6 +1472,11 @@ def test_disk_convergence_month_verdict_pairs_the_months_by_wind_seed():
     assert dc.run_name("lead", "same_pa", 10, 17) == "lead-same_pa-10km-s17"
     cmd = dc.command("lead", "same_pa", 10, 2027, "month")
     assert str(dc.MONTH_SCENE) in cmd and "forcing.wind.seed=2027" in cmd and "run.seed=2027" not in cmd
+    spun = dc.command("lead", "same_pa", 10, 2027, "month", "spun")
+    assert f"initial.state_file={dc.spinup_path('lead', 'same_pa', 10)}" in spun
+    assert {"initial.thickness_m=from_state", "initial.damage=from_state"} <= set(spun)
+    assert "healing.law=none" in dc.command("lead", "same_pa", 20, 2027, "month", "noheal")
+    assert dc.run_name("lead", "same_pa", 20, 2027, "month", "noheal") == "month-noheal-lead-same_pa-20km-w2027"
     coarse = {"beta_common": 0.18, "beta_common_per_run": {f"month-lead-same_pa-20km-w{s}": 0.18 for s in range(8)}}
     fine = {"beta_common": 0.15, "beta_common_per_run": {f"month-lead-same_pa-10km-w{s}": 0.15 + 0.04 * (s < 3)
                                                           for s in range(7)}}
