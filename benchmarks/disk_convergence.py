@@ -157,6 +157,13 @@ the eight wind seeds, 20 and 10 km.
   Predicted: (n) holds, with a fall of 0.03–0.04 (the basin's 0.038): the rest of the basin's fall would be
   its start, not its coast.
 
+  Result (01:58 UTC): (n) fails; the prediction was wrong. From the spun-up start the pooled β on 20–120 km
+  falls by 0.018 (0.139 → 0.120), as from pristine ice, but now lower at 10 km in all 8 months (median −0.014;
+  month by month −0.017, 90 % interval −0.023 to −0.011), and from the first window on (days 1–4: 0.116
+  against 0.158). The band length per area is 1.9 times the 20 km one from day 4 (0.043 against 0.023 km⁻¹)
+  to day 28 (0.053 against 0.027). So the spin-up makes the fall steadier, not larger. The basin's own fall,
+  month by month, is −0.034 (90 % interval −0.060 to −0.006; RD3's months): not firmly larger than the disk's.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
