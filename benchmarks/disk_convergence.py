@@ -553,7 +553,8 @@ def figure_month(family: str, law: str, groups: dict, pooled_windows: dict, path
     ax.set_ylabel(f"β on {BASIN_COMMON_FIT_M[0] / 1e3:g}–{BASIN_COMMON_FIT_M[1] / 1e3:g} km, pooled over months")
     ax.set_title("β window by window", fontsize=10)
     ax.legend(fontsize=8)
-    fig.suptitle(f"28 days of the winter climatology over a pristine 500 km disk: family {family}, strength {law}"
+    where = "a 500 km disk, from a 14-day spin-up" if family.endswith("spun") else "a pristine 500 km disk"
+    fig.suptitle(f"28 days of the winter climatology over {where}: family {family}, strength {law}"
                  f" (maps: wind seed {MAP_SEED})", fontsize=11)
     fig.savefig(path, dpi=80)
     plt.close(fig)
