@@ -235,11 +235,7 @@ def make_spinup(family: str, law: str, km: float) -> str:
     for x in [f"domain.resolution_m={km * 1e3:g}", f"rheology.strength_lab_pa={lab_cohesion_pa(family, law, km):.6g}",
               *FAMILIES[family][0], *SPINUP_SETS]:
         cmd += ["--set", x]
-    OUT.mkdir(parents=True, exist_ok=True)
-    env = {**os.environ, "NUMBA_NUM_THREADS": os.environ.get("NUMBA_NUM_THREADS", "1")}
-    with open(OUT / f"{target.stem}.log", "w") as log:
-        subprocess.run(cmd + (["--overwrite"] if out.exists() else []), check=True, stdout=log,
-                       stderr=subprocess.STDOUT, cwd=ROOT, env=env)
+    _lagice_run(cmd + (["--overwrite"] if out.exists() else []), target.stem)
     save_spinup(out, target)
     return f"{target.name}: made"
 #: (scene overrides, C_lab [Pa] in lagice's form at the reference size)
@@ -293,16 +289,20 @@ def command(family: str, law: str, km: float, seed: int, stage: str = "storm", v
     return cmd
 
 
-def run_one(family, law, km, seed, stage="storm", variant="") -> str:
-    name = run_name(family, law, km, seed, stage, variant)
-    out = OUT / name
-    if (out / "snapshots" / "index.json").exists():
-        return f"{name}: done before"
+def _lagice_run(cmd: list, name: str) -> None:
+    """``cmd`` (a ``lagice run``) with its output in ``OUT/NAME.log``, one numba thread unless the caller
+    set ``NUMBA_NUM_THREADS``."""
     OUT.mkdir(parents=True, exist_ok=True)
     env = {**os.environ, "NUMBA_NUM_THREADS": os.environ.get("NUMBA_NUM_THREADS", "1")}
     with open(OUT / f"{name}.log", "w") as log:
-        subprocess.run(command(family, law, km, seed, stage, variant), check=True, stdout=log, stderr=subprocess.STDOUT,
-                       cwd=ROOT, env=env)
+        subprocess.run(cmd, check=True, stdout=log, stderr=subprocess.STDOUT, cwd=ROOT, env=env)
+
+
+def run_one(family, law, km, seed, stage="storm", variant="") -> str:
+    name = run_name(family, law, km, seed, stage, variant)
+    if (OUT / name / "snapshots" / "index.json").exists():
+        return f"{name}: done before"
+    _lagice_run(command(family, law, km, seed, stage, variant), name)
     return f"{name}: made"
 
 
@@ -472,6 +472,13 @@ BAND_DAMAGE = 0.9
 DISK_RADIUS_M = 500e3
 
 
+def _snapshots_by_day(path) -> dict:
+    """{day of the run: snapshot file} of the run folder ``path`` (daily output)."""
+    from lagice.io.snapshots import read_index
+
+    return {round(e["time_s"] / DAY_S): Path(path) / "snapshots" / e["file"] for e in read_index(path)}
+
+
 def band_length_per_km(path, days=BAND_DAYS) -> list:
     """Length of broken bands per interior area [km⁻¹] in the snapshots of ``days`` (rule RD6): the
     elements with damage above :data:`BAND_DAMAGE` at least 100 km from the disk's coast, each counted as
@@ -480,19 +487,16 @@ def band_length_per_km(path, days=BAND_DAYS) -> list:
     counted 1.3 times its length, one of right triangles from squares √2 times)."""
     import xarray as xr
 
-    from lagice.io.snapshots import read_index
+    from lagice.mesh.core import signed_areas
 
-    path = Path(path)
-    idx = read_index(path)
-    by_day = {round(e["time_s"] / DAY_S): e["file"] for e in idx}
+    by_day = _snapshots_by_day(path)
     out = []
     for day in days:
-        with xr.open_dataset(path / "snapshots" / by_day[day], decode_times=False) as ds:
+        with xr.open_dataset(by_day[day], decode_times=False) as ds:
             x, y = ds["mesh_node_x"].values, ds["mesh_node_y"].values
             t = ds["mesh_face_nodes"].values.astype(np.int64)
             damage = ds["damage"].values[0]
-        area = 0.5 * np.abs((x[t[:, 1]] - x[t[:, 0]]) * (y[t[:, 2]] - y[t[:, 0]])
-                            - (x[t[:, 2]] - x[t[:, 0]]) * (y[t[:, 1]] - y[t[:, 0]]))
+        area = np.abs(signed_areas(np.column_stack([x, y]), t))
         inside = np.hypot(x[t].mean(axis=1), y[t].mean(axis=1)) < DISK_RADIUS_M - COAST_BUFFER_M
         band = inside & (damage > BAND_DAMAGE)
         out.append(float(np.sqrt(area[band]).sum() / area[inside].sum() * 1e3))
@@ -514,17 +518,15 @@ def figure_month(family: str, law: str, groups: dict, pooled_windows: dict, path
     import xarray as xr
     from matplotlib.colors import LogNorm
 
-    from lagice.io.snapshots import read_index
-
     kms = sorted(groups, key=float, reverse=True)
     fig, axes = plt.subplots(len(kms), len(MAP_DAYS) + 1, figsize=(4.2 * (len(MAP_DAYS) + 1), 4.0 * len(kms)),
                              layout="constrained")
     colours = {"20": "tab:blue", "10": "tab:red"}
     for row, km in enumerate(kms):
         run = next(p for p in groups[km] if Path(p).name.endswith(f"-w{MAP_SEED}"))
-        by_day = {round(e["time_s"] / DAY_S): e["file"] for e in read_index(run)}
+        by_day = _snapshots_by_day(run)
         for col, day in enumerate(MAP_DAYS):
-            with xr.open_dataset(Path(run) / "snapshots" / by_day[day], decode_times=False) as ds:
+            with xr.open_dataset(by_day[day], decode_times=False) as ds:
                 x, y = ds["mesh_node_x"].values / 1e3, ds["mesh_node_y"].values / 1e3
                 rate = ds["total_deformation_rate"].values[0] * DAY_S
                 im = axes[row, col].tripcolor(x, y, ds["mesh_face_nodes"].values.astype(np.int64),
