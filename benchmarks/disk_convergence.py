@@ -260,6 +260,15 @@ def lab_cohesion_pa(family: str, law: str, km: float) -> float:
     return base * (np.sqrt(km / REFERENCE_KM) if law == "same_pa" else 1.0)
 
 
+def variant_sets(variant: str, family: str, law: str, km: float) -> list:
+    """The scene overrides of stage ``month``'s ``variant`` on the mesh of ``km`` (``spun``: the spin-up
+    state of :func:`make_spinup` as the initial thickness, concentration and damage)."""
+    if variant == "spun":
+        return [f"initial.state_file={spinup_path(family, law, km)}", "initial.thickness_m=from_state",
+                "initial.concentration=from_state", "initial.damage=from_state"]
+    return list(MONTH_VARIANTS[variant])
+
+
 def _month_prefix(variant: str = "") -> str:
     return f"month-{variant}-" if variant else "month-"
 
@@ -276,10 +285,7 @@ def command(family: str, law: str, km: float, seed: int, stage: str = "storm", v
     sets = [f"domain.resolution_m={km * 1e3:g}", f"rheology.strength_lab_pa={lab_cohesion_pa(family, law, km):.6g}",
             *FAMILIES[family][0]]
     if stage == "month":
-        scene, sets = MONTH_SCENE, [f"forcing.wind.seed={seed}", *sets, *MONTH_VARIANTS[variant]]
-        if variant == "spun":
-            sets += [f"initial.state_file={spinup_path(family, law, km)}", "initial.thickness_m=from_state",
-                     "initial.concentration=from_state", "initial.damage=from_state"]
+        scene, sets = MONTH_SCENE, [f"forcing.wind.seed={seed}", *sets, *variant_sets(variant, family, law, km)]
     else:
         scene, sets = SCENE, [f"domain.file={DISK}", f"run.seed={seed}", "output.every=6h", *sets]
     cmd = [sys.executable, "-m", "lagice", "run", str(scene), "--out",
@@ -588,7 +594,9 @@ def report_month(family: str, law: str, variant: str = "") -> dict:
     figure_month(f"{family}{', ' + variant if variant else ''}", law, groups, out, fig)
     print(f"wrote {fig.relative_to(ROOT)}")
     _write_json(f"{_month_prefix(variant)}{family}-{law}",
-                {"scene": str(MONTH_SCENE.relative_to(ROOT)), "overrides": MONTH_VARIANTS[variant], "meshes": out,
+                {"scene": str(MONTH_SCENE.relative_to(ROOT)),
+                 "overrides": {km: [x.replace(f"{ROOT}/", "") for x in variant_sets(variant, family, law, float(km))]
+                               for km in groups}, "meshes": out,
                  "common_fit_m": list(BASIN_COMMON_FIT_M), "verdict": v})
     return {"meshes": out, "verdict": v}
 
