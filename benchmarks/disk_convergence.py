@@ -164,6 +164,17 @@ the eight wind seeds, 20 and 10 km.
   to day 28 (0.053 against 0.027). So the spin-up makes the fall steadier, not larger. The basin's own fall,
   month by month, is −0.034 (90 % interval −0.060 to −0.006; RD3's months): not firmly larger than the disk's.
 
+Rule RD10 (written at 02:21 UTC, 1 December, before its runs). The basin's months start from a spin-up of a
+thick-and-thin pack (thickness 1.1–1.85 m and concentration 0.87–0.97 varying over hundreds of kilometres), the
+disk's from uniform 1 m compact ice. Variant ``packspun``: as ``spun`` (RD9), with the spin-up started from
+``examples/winter_basin.toml``'s initial thickness and concentration expressions (``PACK_SETS``), family
+``lead``, law ``same_pa``, the eight wind seeds, 20 and 10 km.
+  (p) The thick-and-thin start adds to the fall if the pooled β on 20–120 km falls from 20 to 10 km by at least
+      0.03 and is lower at 10 km in at least 6 of the 8 months.
+  Predicted: (p) fails, with a fall of 0.012–0.025 as in RD9: the pack's structure varies over hundreds of
+  kilometres, much wider than either element, so it should move where the bands form, not how the two meshes
+  differ. If it fails, of the basin's pieces only its coast (and island) is left untested on the disk.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -176,6 +187,8 @@ the eight wind seeds, 20 and 10 km.
     python benchmarks/disk_convergence.py run --stage month --variant noheal --family lead --law same_pa --jobs 2  # RD8
     python benchmarks/disk_convergence.py fragmentation                                               # RD7
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
+    python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
+    # (RD10)
 
 Runs go to ``benchmarks/out/disk_convergence/FAMILY-LAW-KMkm-sSEED`` (``lagice run`` subprocesses, one
 numba thread each); ``report`` writes ``docs/figures/disk_convergence.json`` (every family and law run so
@@ -212,29 +225,45 @@ MORE_SEEDS = tuple(range(18, 24))
 MONTH_SEEDS = tuple(range(2026, 2034))
 MONTH_KM = (20, 10)
 #: stage ``month``'s variants (``--variant``): scene overrides, the basin's pieces taken out one at a time
-MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], "spun": []}
-#: variant ``spun`` (rule RD9): each month starts from the end of a 14-day run of the same scene, mesh and
-#: strength from pristine ice, under wind seed 2025 from 1 January (as the basin's spin-up)
+MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], "spun": [], "packspun": []}
+#: the variants whose months start from a spin-up, with the spin-up's own overrides. ``spun`` (rule RD9): each
+#: month starts from the end of a 14-day run of the same scene, mesh and strength from pristine ice, under wind
+#: seed 2025 from 1 January (as the basin's spin-up). ``packspun`` (rule RD10): the same, from the basin's
+#: thick-and-thin pack (``examples/winter_basin.toml``'s initial thickness and concentration, the fields from
+#: which ``examples/winter_basin_spinup.toml`` spins up the basin; the disk and the basin are both centred on 0)
+PACK_SETS = ['initial.thickness_m="1.6 - 0.5e-6*x + 0.25*sin(6e-6*x)*cos(5e-6*y)"',
+             'initial.concentration="0.92 + 0.05*sin(1.1e-5*x + 0.4)*cos(0.9e-5*y)"']
+SPUN_VARIANTS = {"spun": [], "packspun": PACK_SETS}
 SPINUP_SETS = ["forcing.wind.seed=2025", 'run.start_date="2026-01-01 00:00:00"', "run.duration=14d", "output.every=7d"]
 
 
-def spinup_path(family: str, law: str, km: float) -> Path:
-    return OUT / f"spinup-{family}-{law}-{km:g}km.npz"
+def spinup_path(family: str, law: str, km: float, variant: str = "spun") -> Path:
+    """The spin-up state of a variant in :data:`SPUN_VARIANTS` (``spun``'s keeps its first name)."""
+    tag = "" if variant == "spun" else f"{variant}-"
+    return OUT / f"spinup-{tag}{family}-{law}-{km:g}km.npz"
 
 
-def make_spinup(family: str, law: str, km: float) -> str:
-    """Variant ``spun``: the 14-day spin-up of ``examples/winter_disk.toml`` on the mesh of ``km`` (the
-    family's settings and the law's strength), its last snapshot saved by :func:`lagice.spinup.save_spinup`."""
+def spinup_command(family: str, law: str, km: float, variant: str = "spun") -> list:
+    """The ``lagice run`` of :func:`make_spinup`."""
+    cmd = [sys.executable, "-m", "lagice", "run", str(MONTH_SCENE), "--out",
+           str(OUT / spinup_path(family, law, km, variant).stem)]
+    for x in [f"domain.resolution_m={km * 1e3:g}", f"rheology.strength_lab_pa={lab_cohesion_pa(family, law, km):.6g}",
+              *FAMILIES[family][0], *SPINUP_SETS, *SPUN_VARIANTS[variant]]:
+        cmd += ["--set", x]
+    return cmd
+
+
+def make_spinup(family: str, law: str, km: float, variant: str = "spun") -> str:
+    """Variants ``spun`` and ``packspun``: the 14-day spin-up of ``examples/winter_disk.toml`` on the mesh of
+    ``km`` (the family's settings, the law's strength and the variant's initial fields), its last snapshot saved
+    by :func:`lagice.spinup.save_spinup`."""
     from lagice.spinup import save_spinup
 
-    target = spinup_path(family, law, km)
+    target = spinup_path(family, law, km, variant)
     if target.exists():
         return f"{target.name}: done before"
     out = OUT / target.stem
-    cmd = [sys.executable, "-m", "lagice", "run", str(MONTH_SCENE), "--out", str(out)]
-    for x in [f"domain.resolution_m={km * 1e3:g}", f"rheology.strength_lab_pa={lab_cohesion_pa(family, law, km):.6g}",
-              *FAMILIES[family][0], *SPINUP_SETS]:
-        cmd += ["--set", x]
+    cmd = spinup_command(family, law, km, variant)
     _lagice_run(cmd + (["--overwrite"] if out.exists() else []), target.stem)
     save_spinup(out, target)
     return f"{target.name}: made"
@@ -263,8 +292,8 @@ def lab_cohesion_pa(family: str, law: str, km: float) -> float:
 def variant_sets(variant: str, family: str, law: str, km: float) -> list:
     """The scene overrides of stage ``month``'s ``variant`` on the mesh of ``km`` (``spun``: the spin-up
     state of :func:`make_spinup` as the initial thickness, concentration and damage)."""
-    if variant == "spun":
-        return [f"initial.state_file={spinup_path(family, law, km)}", "initial.thickness_m=from_state",
+    if variant in SPUN_VARIANTS:
+        return [f"initial.state_file={spinup_path(family, law, km, variant)}", "initial.thickness_m=from_state",
                 "initial.concentration=from_state", "initial.damage=from_state"]
     return list(MONTH_VARIANTS[variant])
 
@@ -561,7 +590,8 @@ def figure_month(family: str, law: str, groups: dict, pooled_windows: dict, path
     ax.set_ylabel(f"β on {BASIN_COMMON_FIT_M[0] / 1e3:g}–{BASIN_COMMON_FIT_M[1] / 1e3:g} km, pooled over months")
     ax.set_title("β window by window", fontsize=10)
     ax.legend(fontsize=8)
-    where = "a 500 km disk, from a 14-day spin-up" if family.endswith("spun") else "a pristine 500 km disk"
+    where = ("a 500 km disk, from a 14-day spin-up of the basin's thick-and-thin pack" if family.endswith("packspun")
+             else "a 500 km disk, from a 14-day spin-up" if family.endswith("spun") else "a pristine 500 km disk")
     fig.suptitle(f"28 days of the winter climatology over {where}: family {family}, strength {law}"
                  f" (maps: wind seed {MAP_SEED})", fontsize=11)
     fig.savefig(path, dpi=80)
@@ -766,7 +796,8 @@ def main(argv=None) -> int:
     ap.add_argument("--stage", choices=("storm", "month"), default="storm",
                     help="storm: one cyclone, 3 days (default); month: examples/winter_disk.toml, 28 days (RD5)")
     ap.add_argument("--variant", choices=sorted(MONTH_VARIANTS), default="",
-                    help="stage month: noheal (healing.law = none; rule RD8), spun (from a 14-day spin-up; RD9)")
+                    help="stage month: noheal (healing.law = none; rule RD8), spun (from a 14-day spin-up; RD9), "
+                         "packspun (from a 14-day spin-up of the basin's thick-and-thin pack; RD10)")
     a = ap.parse_args(argv)
     if a.what == "fragmentation":
         fragmentation(a.family)
@@ -782,8 +813,8 @@ def main(argv=None) -> int:
             kms, seeds = a.km or list(KM), list(a.seeds or SEEDS) + (list(MORE_SEEDS) if a.more_seeds else [])
         todo = [(a.family, a.law, km, s, a.stage, a.variant) for km in sorted(kms) for s in seeds]
         with ThreadPoolExecutor(a.jobs) as ex:
-            if a.variant == "spun":
-                for msg in ex.map(lambda km: make_spinup(a.family, a.law, km), sorted(kms)):
+            if a.variant in SPUN_VARIANTS:
+                for msg in ex.map(lambda km: make_spinup(a.family, a.law, km, a.variant), sorted(kms)):
                     print(msg, flush=True)
             for msg in ex.map(lambda t: run_one(*t), todo):
                 print(msg, flush=True)

@@ -1475,6 +1475,12 @@ def test_disk_convergence_month_verdict_pairs_the_months_by_wind_seed():
     spun = dc.command("lead", "same_pa", 10, 2027, "month", "spun")
     assert f"initial.state_file={dc.spinup_path('lead', 'same_pa', 10)}" in spun
     assert {"initial.thickness_m=from_state", "initial.damage=from_state"} <= set(spun)
+    # rule RD10: the thick-and-thin pack is in the spin-up, not in the months, and has a state file of its own
+    pack = dc.command("lead", "same_pa", 10, 2027, "month", "packspun")
+    assert f"initial.state_file={dc.spinup_path('lead', 'same_pa', 10, 'packspun')}" in pack
+    assert dc.spinup_path("lead", "same_pa", 10, "packspun") != dc.spinup_path("lead", "same_pa", 10)
+    assert not set(dc.PACK_SETS) & set(pack) and not set(dc.PACK_SETS) & set(dc.spinup_command("lead", "same_pa", 10))
+    assert set(dc.PACK_SETS) <= set(dc.spinup_command("lead", "same_pa", 10, "packspun"))
     assert "healing.law=none" in dc.command("lead", "same_pa", 20, 2027, "month", "noheal")
     assert dc.run_name("lead", "same_pa", 20, 2027, "month", "noheal") == "month-noheal-lead-same_pa-20km-w2027"
     coarse = {"beta_common": 0.18, "beta_common_per_run": {f"month-lead-same_pa-20km-w{s}": 0.18 for s in range(8)}}
