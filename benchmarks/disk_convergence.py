@@ -175,6 +175,24 @@ disk's from uniform 1 m compact ice. Variant ``packspun``: as ``spun`` (RD9), wi
   kilometres, much wider than either element, so it should move where the bands form, not how the two meshes
   differ. If it fails, of the basin's pieces only its coast (and island) is left untested on the disk.
 
+Rule RD11 (written at 02:23 UTC, before its code and analysis; no new runs). RD5–RD9 read "the finer mesh cuts
+the pack into smaller floes" from the band length per area, which counts every element above damage 0.9 as a
+band as long as its size √area. That count doubles for a band of the same width in kilometres on a mesh of half
+the size: it cannot tell more bands from bands more elements wide. Command ``floes`` measures, on days 4, 10,
+16, 22 and 28 of RD5's months (pristine start) and RD9's (spun-up start), with the same band set (damage > 0.9,
+elements whose centroid is at least 100 km from the coast):
+  - the band perimeter length per area: half the length of the edges between a band element and an element
+    outside the band, both in the interior, over the interior's area; a band of any width in elements counts
+    once along its length;
+  - the floes: the interior's elements outside the band set, joined through shared edges; their area-weighted
+    mean area Σa²/Σa (the floe that a point of intact ice belongs to, on average).
+  (q) The extra length is more bands, not wider ones, if on day 28 the perimeter length at 10 km is at least
+      1.25 times the 20 km one (median over months), in both RD5's and RD9's months.
+  (r) The finer mesh cuts the pack into smaller floes if on day 28 the area-weighted mean floe area at 10 km
+      is at most 0.7 times the 20 km one (median over months), in both sets.
+  Predicted: (q) and (r) hold (perimeter ratio 1.3–1.5, floe area ratio 0.4–0.7); the bands at 10 km are also
+  wider in elements (perimeter ratio below the √area count's 1.65 and 1.9).
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
