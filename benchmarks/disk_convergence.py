@@ -204,6 +204,7 @@ elements whose centroid is at least 100 km from the coast):
     python benchmarks/disk_convergence.py run --stage month --family lead --law scaled --jobs 2        # RD6
     python benchmarks/disk_convergence.py run --stage month --variant noheal --family lead --law same_pa --jobs 2  # RD8
     python benchmarks/disk_convergence.py fragmentation                                               # RD7
+    python benchmarks/disk_convergence.py floes                                                       # RD11
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
     python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
     # (RD10)
@@ -556,6 +557,70 @@ def band_length_per_km(path, days=BAND_DAYS) -> list:
     return out
 
 
+#: the smallest floe counted by :func:`band_perimeter_and_floes` [km²]: five equilateral elements of 20 km
+MIN_FLOE_KM2 = 5 * np.sqrt(3.0) / 4 * 20.0 ** 2
+
+
+def element_neighbours(triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The elements that share an edge: ``(pairs, nodes)``, (k, 2) element indices and the shared edge's
+    two nodes, one row per interior edge of the triangulation."""
+    tri = np.asarray(triangles, np.int64)
+    edges = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+    owner = np.tile(np.arange(len(tri)), 3)
+    key = edges[:, 0] * (int(tri.max()) + 1) + edges[:, 1]
+    order = np.argsort(key, kind="stable")
+    first = np.flatnonzero(key[order][1:] == key[order][:-1])
+    return np.column_stack([owner[order[first]], owner[order[first + 1]]]), edges[order[first]]
+
+
+def band_perimeter_and_floes(path, days=BAND_DAYS) -> dict:
+    """Rule RD11, per day of ``days``: the band set of :func:`band_length_per_km` (damage above
+    :data:`BAND_DAMAGE`, 100 km from the coast) measured without counting elements:
+
+    * ``perimeter_per_km``: half the length of the edges between a band element and an interior element
+      outside the band, over the interior's area [km⁻¹] (a band of any width in elements counts once along
+      its length);
+    * ``band_width_km``: the band set's area over that length;
+    * ``floe_area_km2``: the interior's elements outside the band set joined through shared edges into floes,
+      their area-weighted mean area Σa²/Σa [km²];
+    * ``n_floes_per_1e5_km2``: the floes of at least :data:`MIN_FLOE_KM2` per 10⁵ km² of interior."""
+    import xarray as xr
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from lagice.mesh.core import signed_areas
+
+    by_day = _snapshots_by_day(path)
+    out = {k: [] for k in ("perimeter_per_km", "band_width_km", "floe_area_km2", "n_floes_per_1e5_km2")}
+    for day in days:
+        with xr.open_dataset(by_day[day], decode_times=False) as ds:
+            x, y = ds["mesh_node_x"].values, ds["mesh_node_y"].values
+            t = ds["mesh_face_nodes"].values.astype(np.int64)
+            damage = ds["damage"].values[0]
+        area = np.abs(signed_areas(np.column_stack([x, y]), t))
+        inside = np.hypot(x[t].mean(axis=1), y[t].mean(axis=1)) < DISK_RADIUS_M - COAST_BUFFER_M
+        band = inside & (damage > BAND_DAMAGE)
+        pairs, nodes = element_neighbours(t)
+        a, b = pairs[:, 0], pairs[:, 1]
+        rim = inside[a] & inside[b] & (band[a] != band[b])
+        seg = np.column_stack([x[nodes[rim, 1]] - x[nodes[rim, 0]], y[nodes[rim, 1]] - y[nodes[rim, 0]]])
+        length_m = 0.5 * np.hypot(seg[:, 0], seg[:, 1]).sum()
+        interior_m2 = area[inside].sum()
+        out["perimeter_per_km"].append(float(length_m / interior_m2 * 1e3))
+        out["band_width_km"].append(float(area[band].sum() / length_m / 1e3) if length_m > 0 else 0.0)
+        intact = inside & ~band
+        join = intact[a] & intact[b]
+        m = len(t)
+        graph = coo_matrix((np.ones(int(join.sum())), (a[join], b[join])), shape=(m, m))
+        _, labels = connected_components(graph, directed=False)
+        floes = np.bincount(labels[intact], weights=area[intact]) / 1e6
+        floes = floes[floes > 0]
+        out["floe_area_km2"].append(float((floes ** 2).sum() / floes.sum()))
+        out["n_floes_per_1e5_km2"].append(float((floes >= MIN_FLOE_KM2).sum() / (interior_m2 / 1e6) * 1e5))
+    return out
+
+
+
 #: the month whose maps the figure shows (the validation month's weather) and the days shown
 MAP_SEED, MAP_DAYS = 2026, (7, 16, 27)
 
@@ -782,6 +847,58 @@ def fragmentation(family: str = "lead", laws=("same_pa", "scaled")) -> dict:
     return {"bins": out, "verdict": v}
 
 
+#: rule RD11's sets: (label, variant, law); the first two are judged, the others reported
+FLOE_SETS = (("RD5", "", "same_pa"), ("RD9", "spun", "same_pa"), ("RD6", "", "scaled"), ("RD8", "noheal", "same_pa"))
+FLOE_JUDGED = ("RD5", "RD9")
+
+
+def floes(family: str = "lead") -> dict:
+    """Rule RD11: the band perimeter length, the bands' width and the floes' size on both meshes of each set
+    of :data:`FLOE_SETS`, medians over the months per day, and the verdict on the judged sets."""
+    result = {}
+    for label, variant, law in FLOE_SETS:
+        row = {}
+        for km in MONTH_KM:
+            paths = [p for p in sorted(OUT.glob(f"{_month_prefix(variant)}{family}-{law}-{km:g}km-w*"))
+                     if (p / "snapshots" / "index.json").exists()]
+            if not paths:
+                continue
+            per_run = {Path(p).name: band_perimeter_and_floes(p) for p in paths}
+            row[f"{km:g}"] = {"n_months": len(paths), "days": list(BAND_DAYS),
+                              "median": {k: [float(v) for v in np.median([r[k] for r in per_run.values()], 0)]
+                                         for k in next(iter(per_run.values()))},
+                              "per_run": per_run}
+        if len(row) < 2:
+            continue
+        med = {km: row[km]["median"] for km in row}
+        ratio = {k: med["10"][k][-1] / med["20"][k][-1] for k in med["20"]}
+        row["ratio_10_to_20_last_day"] = ratio
+        result[label] = row
+        print(f"{label} ({variant or 'pristine'}, {law}); days {BAND_DAYS}")
+        for km in ("20", "10"):
+            print(f"  {km} km: perimeter (km⁻¹) " + " ".join(f"{v:.4f}" for v in med[km]["perimeter_per_km"])
+                  + " | width (km) " + " ".join(f"{v:.1f}" for v in med[km]["band_width_km"])
+                  + " | floe area (km²) " + " ".join(f"{v:.0f}" for v in med[km]["floe_area_km2"])
+                  + " | floes per 1e5 km² " + " ".join(f"{v:.1f}" for v in med[km]["n_floes_per_1e5_km2"]))
+        print("  10/20 on day 28: " + ", ".join(f"{k} ×{v:.2f}" for k, v in ratio.items()))
+    v = verdict_floes(result)
+    print("rule RD11:", json.dumps(v))
+    _write_json("floes", {"sets": result, "verdict": v, "band_damage": BAND_DAMAGE,
+                          "min_floe_km2": MIN_FLOE_KM2})
+    return {"sets": result, "verdict": v}
+
+
+def verdict_floes(result: dict) -> dict:
+    """Rule RD11 (q) and (r) on the sets of :data:`FLOE_JUDGED` (ratios of the day-28 medians, 10 over 20 km)."""
+    judged = {k: result[k]["ratio_10_to_20_last_day"] for k in FLOE_JUDGED if k in result}
+    return {"perimeter_ratio": {k: r["perimeter_per_km"] for k, r in judged.items()},
+            "floe_area_ratio": {k: r["floe_area_km2"] for k, r in judged.items()},
+            "q_more_bands": len(judged) == len(FLOE_JUDGED) and all(r["perimeter_per_km"] >= 1.25
+                                                                    for r in judged.values()),
+            "r_smaller_floes": len(judged) == len(FLOE_JUDGED) and all(r["floe_area_km2"] <= 0.7
+                                                                       for r in judged.values())}
+
+
 def verdict_fragmentation(bins: dict) -> dict:
     """Rule RD7 (k) on :func:`fragmentation`'s bins: the two meshes agree within 0.02 in every bin both fill
     (at least :data:`FRAGMENTATION_MIN_WINDOWS` windows each), and on each mesh β is at least 0.03 lower in
@@ -803,7 +920,7 @@ def verdict_fragmentation(bins: dict) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=("run", "report", "basin", "fragmentation"))
+    ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes"))
     ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
@@ -819,6 +936,9 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     if a.what == "fragmentation":
         fragmentation(a.family)
+        return 0
+    if a.what == "floes":
+        floes(a.family)
         return 0
     if a.stage == "month" and a.what == "report":
         report_month(a.family, a.law, a.variant)

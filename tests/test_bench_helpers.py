@@ -1494,9 +1494,10 @@ def test_disk_convergence_month_verdict_pairs_the_months_by_wind_seed():
     assert not dc.verdict_month(coarse, fine)["e_falls"]
 
 
-def _square_mesh_snapshot(run_dir, h_m, band_damage, time_s):
+def _square_mesh_snapshot(run_dir, h_m, band_damage, time_s, band_width_m=None):
     """A run folder with one snapshot: squares of side ``h_m`` cut into two triangles over ±450 km, the
-    column of squares with 0 ≤ x ≤ h carrying ``band_damage`` and every other element 0.3."""
+    columns of squares with 0 ≤ x ≤ ``band_width_m`` (default ``h_m``) carrying ``band_damage`` and every
+    other element 0.3."""
     import xarray as xr
 
     n = int(round(900e3 / h_m))
@@ -1506,7 +1507,7 @@ def _square_mesh_snapshot(run_dir, h_m, band_damage, time_s):
     a, b, c, d = nid[:-1, :-1].ravel(), nid[1:, :-1].ravel(), nid[1:, 1:].ravel(), nid[:-1, 1:].ravel()
     tri = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
     cx = X.ravel()[tri].mean(axis=1)
-    damage = np.where((cx > 0) & (cx < h_m), band_damage, 0.3)
+    damage = np.where((cx > 0) & (cx < (band_width_m or h_m)), band_damage, 0.3)
     snap = Path(run_dir) / "snapshots"
     snap.mkdir(parents=True)
     xr.Dataset({"mesh_node_x": ("mesh_node", X.ravel()), "mesh_node_y": ("mesh_node", Y.ravel()),
@@ -1532,6 +1533,39 @@ def test_disk_convergence_band_length_is_the_same_band_on_two_meshes(tmp_path):
     assert got[10e3] == pytest.approx(expected, rel=0.03) and got[5e3] == pytest.approx(expected, rel=0.03)
     assert got[5e3] == pytest.approx(got[10e3], rel=0.02)
     assert dc.band_length_per_km(tmp_path / "h5000-weak", days=(day,)) == [0.0]
+
+
+def test_disk_convergence_band_perimeter_counts_a_wide_band_once_and_splits_the_floes(tmp_path):
+    """Rule RD11: one straight band 20 km wide across the interior (radius 400 km) is two elements wide on a
+    10 km mesh and four on a 5 km one. The √area count doubles; the perimeter length (half the band's
+    rim) is its length on both meshes, its width 20 km, and it cuts the interior into two floes of equal
+    area. A band at the band damage (not above it) is no band: no rim, one floe."""
+    import disk_convergence as dc
+
+    day, r_km, w_km = 28, 400.0, 20.0
+    for h in (10e3, 5e3):
+        _square_mesh_snapshot(tmp_path / f"h{h:g}", h, 0.95, day * dc.DAY_S, band_width_m=w_km * 1e3)
+    _square_mesh_snapshot(tmp_path / "weak", 5e3, dc.BAND_DAMAGE, day * dc.DAY_S, band_width_m=w_km * 1e3)
+    got = {h: dc.band_perimeter_and_floes(tmp_path / f"h{h:g}", days=(day,)) for h in (10e3, 5e3)}
+    counted = {h: dc.band_length_per_km(tmp_path / f"h{h:g}", days=(day,))[0] for h in (10e3, 5e3)}
+    assert counted[5e3] == pytest.approx(2 * counted[10e3], rel=0.03)
+    interior = np.pi * r_km ** 2
+    for h in (10e3, 5e3):
+        g = {k: v[0] for k, v in got[h].items()}
+        assert g["perimeter_per_km"] == pytest.approx(2 * r_km / interior, rel=0.03)
+        assert g["band_width_km"] == pytest.approx(w_km, rel=0.05)
+        assert g["floe_area_km2"] == pytest.approx((interior - 2 * r_km * w_km) / 2, rel=0.03)
+        assert g["n_floes_per_1e5_km2"] == pytest.approx(2 / interior * 1e5, rel=0.03)
+    weak = {k: v[0] for k, v in dc.band_perimeter_and_floes(tmp_path / "weak", days=(day,)).items()}
+    assert weak["perimeter_per_km"] == 0.0 and weak["floe_area_km2"] == pytest.approx(interior, rel=0.03)
+
+
+def test_disk_convergence_element_neighbours_are_the_shared_edges():
+    """Two triangles sharing one edge, and a third touching them at a node only: one pair, its edge's nodes."""
+    import disk_convergence as dc
+
+    pairs, nodes = dc.element_neighbours(np.array([[0, 1, 2], [2, 1, 3], [3, 4, 5]]))
+    assert np.sort(pairs, axis=1).tolist() == [[0, 1]] and nodes.tolist() == [[1, 2]]
 
 
 def test_disk_convergence_fragmentation_verdict_needs_agreement_and_a_fall_with_cutting():
