@@ -164,7 +164,7 @@ the eight wind seeds, 20 and 10 km.
   to day 28 (0.053 against 0.027). So the spin-up makes the fall steadier, not larger. The basin's own fall,
   month by month, is −0.034 (90 % interval −0.060 to −0.006; RD3's months): not firmly larger than the disk's.
 
-Rule RD10 (written at 02:21 UTC, 1 December, before its runs). The basin's months start from a spin-up of a
+Rule RD10 (written at 02:20 UTC, 1 December, before its runs). The basin's months start from a spin-up of a
 thick-and-thin pack (thickness 1.1–1.85 m and concentration 0.87–0.97 varying over hundreds of kilometres), the
 disk's from uniform 1 m compact ice. Variant ``packspun``: as ``spun`` (RD9), with the spin-up started from
 ``examples/winter_basin.toml``'s initial thickness and concentration expressions (``PACK_SETS``), family
@@ -175,7 +175,7 @@ disk's from uniform 1 m compact ice. Variant ``packspun``: as ``spun`` (RD9), wi
   kilometres, much wider than either element, so it should move where the bands form, not how the two meshes
   differ. If it fails, of the basin's pieces only its coast (and island) is left untested on the disk.
 
-Rule RD11 (written at 02:23 UTC, before its code and analysis; no new runs). RD5–RD9 read "the finer mesh cuts
+Rule RD11 (written at 02:21 UTC, before its code and analysis; no new runs). RD5–RD9 read "the finer mesh cuts
 the pack into smaller floes" from the band length per area, which counts every element above damage 0.9 as a
 band as long as its size √area. That count doubles for a band of the same width in kilometres on a mesh of half
 the size: it cannot tell more bands from bands more elements wide. Command ``floes`` measures, on days 4, 10,
