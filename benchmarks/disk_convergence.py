@@ -193,6 +193,18 @@ elements whose centroid is at least 100 km from the coast):
   Predicted: (q) and (r) hold (perimeter ratio 1.3–1.5, floe area ratio 0.4–0.7); the bands at 10 km are also
   wider in elements (perimeter ratio below the √area count's 1.65 and 1.9).
 
+  Result (02:31 UTC): (q) and (r) hold in both sets; the prediction was right on both and wrong on the bands'
+  width. On day 28 the band perimeter length at 10 km is 1.72 (RD5) and 1.75 (RD9) times the 20 km one, close
+  to the √area count (1.65, 1.94): the bands are one element wide on both meshes on every day (18–22 km wide
+  at 20 km, 9–11 km at 10 km). The area-weighted mean floe at 10 km is 0.69 and 0.51 times the 20 km one
+  (15 000 → 10 400 km² and 21 800 → 11 100 km²). So the finer mesh does make more bands and smaller floes.
+  But the floes' size does not carry the fall of β. Under the scaled law (RD6, reported, not judged) the 10 km
+  floes are as large as the 20 km ones (×0.96; perimeter ×1.47), yet β falls by 0.020; without healing (RD8)
+  they are smaller (×0.77), yet β falls by 0.010. Month by month (looked at after the verdict, no rule; 32
+  months of the four sets) the change of β from 20 to 10 km correlates with the log of the floe-area ratio
+  at r = +0.11 (within the sets +0.71, +0.55, −0.17, +0.08) and with the log of the perimeter ratio at
+  +0.14. How far the pack is cut into floes is not what sets β's fall; RD7 had found the same by window.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -573,6 +585,18 @@ def element_neighbours(triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.column_stack([owner[order[first]], owner[order[first + 1]]]), edges[order[first]]
 
 
+def floe_labels(pairs: np.ndarray, intact: np.ndarray) -> np.ndarray:
+    """(m,) a floe label per element: the elements of ``intact`` joined through the shared edges ``pairs``
+    (from :func:`element_neighbours`); the other elements are labelled too, each alone."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    join = intact[pairs[:, 0]] & intact[pairs[:, 1]]
+    m = len(intact)
+    graph = coo_matrix((np.ones(int(join.sum())), (pairs[join, 0], pairs[join, 1])), shape=(m, m))
+    return connected_components(graph, directed=False)[1]
+
+
 def band_perimeter_and_floes(path, days=BAND_DAYS) -> dict:
     """Rule RD11, per day of ``days``: the band set of :func:`band_length_per_km` (damage above
     :data:`BAND_DAMAGE`, 100 km from the coast) measured without counting elements:
@@ -585,8 +609,6 @@ def band_perimeter_and_floes(path, days=BAND_DAYS) -> dict:
       their area-weighted mean area Σa²/Σa [km²];
     * ``n_floes_per_1e5_km2``: the floes of at least :data:`MIN_FLOE_KM2` per 10⁵ km² of interior."""
     import xarray as xr
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
 
     from lagice.mesh.core import signed_areas
 
@@ -609,10 +631,7 @@ def band_perimeter_and_floes(path, days=BAND_DAYS) -> dict:
         out["perimeter_per_km"].append(float(length_m / interior_m2 * 1e3))
         out["band_width_km"].append(float(area[band].sum() / length_m / 1e3) if length_m > 0 else 0.0)
         intact = inside & ~band
-        join = intact[a] & intact[b]
-        m = len(t)
-        graph = coo_matrix((np.ones(int(join.sum())), (a[join], b[join])), shape=(m, m))
-        _, labels = connected_components(graph, directed=False)
+        labels = floe_labels(pairs, intact)
         floes = np.bincount(labels[intact], weights=area[intact]) / 1e6
         floes = floes[floes > 0]
         out["floe_area_km2"].append(float((floes ** 2).sum() / floes.sum()))
@@ -883,9 +902,114 @@ def floes(family: str = "lead") -> dict:
         print("  10/20 on day 28: " + ", ".join(f"{k} ×{v:.2f}" for k, v in ratio.items()))
     v = verdict_floes(result)
     print("rule RD11:", json.dumps(v))
+    pairs = month_pairs(family, result)
+    print("month by month (after the verdict; Δβ = β 10 km − β 20 km on 20–120 km):")
+    for label, r in pairs["by_set"].items():
+        print(f"  {label}: mean Δβ {r['mean_dbeta']:+.3f}; Pearson r of Δβ with log floe-area ratio "
+              f"{r['r_floe']:+.2f}, with log perimeter ratio {r['r_perimeter']:+.2f}")
+    print(f"  all {pairs['n']} months: r with log floe-area ratio {pairs['r_floe']:+.2f}, "
+          f"with log perimeter ratio {pairs['r_perimeter']:+.2f}")
+    result["month_pairs"] = pairs
+    fig = ROOT / "docs" / "figures" / f"disk_month_floes_{family}.png"
+    figure_floes(family, pairs, fig)
+    print(f"wrote {fig.relative_to(ROOT)}")
     _write_json("floes", {"sets": result, "verdict": v, "band_damage": BAND_DAMAGE,
                           "min_floe_km2": MIN_FLOE_KM2})
     return {"sets": result, "verdict": v}
+
+
+def figure_floes(family: str, pairs: dict, path: Path, seed: int = MAP_SEED, day: int = 28) -> None:
+    """Rule RD11's figure: the floes (colours) and bands (black) of month ``seed`` on ``day`` on both meshes
+    of the judged sets and RD6, and each month's Δβ against its floe-area ratio."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import xarray as xr
+
+    sets = [s for s in FLOE_SETS if s[0] in ("RD5", "RD6", "RD9")]
+    fig, axes = plt.subplots(2, len(sets) + 1, figsize=(4.2 * (len(sets) + 1), 8.4))
+    rng = np.random.default_rng(0)
+    palette = rng.uniform(0.35, 0.95, size=(4096, 3))
+    for col, (label, variant, law) in enumerate(sets):
+        for row, km in enumerate(MONTH_KM):
+            ax = axes[row, col]
+            run = OUT / run_name(family, law, km, seed, "month", variant)
+            with xr.open_dataset(_snapshots_by_day(run)[day], decode_times=False) as ds:
+                x, y = ds["mesh_node_x"].values / 1e3, ds["mesh_node_y"].values / 1e3
+                t = ds["mesh_face_nodes"].values.astype(np.int64)
+                damage = ds["damage"].values[0]
+            inside = np.hypot(x[t].mean(axis=1), y[t].mean(axis=1)) < (DISK_RADIUS_M - COAST_BUFFER_M) / 1e3
+            band = inside & (damage > BAND_DAMAGE)
+            labels = floe_labels(element_neighbours(t)[0], inside & ~band)
+            colour = palette[labels % len(palette)]
+            colour[band] = 0.0
+            colour[~inside] = 0.9
+            tc = ax.tripcolor(x, y, t, facecolors=np.zeros(len(t)), edgecolors="none")
+            tc.set_array(None)
+            tc.set_facecolor(colour)
+            ax.set_aspect("equal")
+            ax.set_xticks([])
+            ax.set_yticks([])
+            ax.set_title(f"{label} ({variant or 'pristine'}, {law}), {km} km", fontsize=9)
+    ax = axes[0, -1]
+    markers = {"RD5": "o", "RD9": "s", "RD6": "^", "RD8": "v"}
+    for label, r in pairs["by_set"].items():
+        ax.scatter([m["floe_area_km2_ratio"] for m in r["months"]], [m["dbeta"] for m in r["months"]],
+                   marker=markers.get(label, "x"), label=f"{label} (r = {r['r_floe']:+.2f})")
+    ax.axhline(0.0, color="0.6", lw=0.8)
+    ax.axvline(1.0, color="0.6", lw=0.8)
+    ax.set_xlabel(f"floe area, 10 km / 20 km (day {day})")
+    ax.set_ylabel("Δβ on 20–120 km, 10 km − 20 km")
+    ax.set_title(f"each month (all: r = {pairs.get('r_floe', np.nan):+.2f})", fontsize=9)
+    ax.legend(fontsize=7)
+    ax = axes[1, -1]
+    for label, r in pairs["by_set"].items():
+        ax.scatter([m["perimeter_per_km_ratio"] for m in r["months"]], [m["dbeta"] for m in r["months"]],
+                   marker=markers.get(label, "x"), label=f"{label} (r = {r['r_perimeter']:+.2f})")
+    ax.axhline(0.0, color="0.6", lw=0.8)
+    ax.set_xlabel(f"band perimeter length, 10 km / 20 km (day {day})")
+    ax.set_ylabel("Δβ on 20–120 km, 10 km − 20 km")
+    ax.legend(fontsize=7)
+    fig.suptitle(f"Floes (colours) and bands of damage > {BAND_DAMAGE} (black) on day {day} of wind seed {seed}, "
+                 f"100 km from the disk's coast; right: every month of each set", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+
+
+def month_pairs(family: str, result: dict) -> dict:
+    """Each month of each set of ``result`` paired by wind seed: the change of its β on the common widths
+    from 20 to 10 km (from the set's record in ``disk_convergence.json``, written by ``report --stage month``)
+    against the day-28 ratios (10 over 20 km) of its floe area and of its band perimeter length; Pearson's r
+    of Δβ with the logarithm of each ratio, per set and over all months."""
+    record = json.loads(JSON.read_text()) if JSON.exists() else {}
+    rows, by_set = [], {}
+    for label, variant, law in FLOE_SETS:
+        key = f"{_month_prefix(variant)}{family}-{law}"
+        if label not in result or key not in record:
+            continue
+        beta = {km: record[key]["meshes"][km]["beta_common_per_run"] for km in ("20", "10")}
+        runs = {km: result[label][km]["per_run"] for km in ("20", "10")}
+        mine = []
+        for name20, b20 in beta["20"].items():
+            name10 = name20.replace("-20km-", "-10km-")
+            if name10 in beta["10"] and name20 in runs["20"] and name10 in runs["10"]:
+                mine.append({"month": name20.rsplit("-w", 1)[1], "dbeta": beta["10"][name10] - b20,
+                             **{f"{k}_ratio": runs["10"][name10][k][-1] / runs["20"][name20][k][-1]
+                                for k in ("floe_area_km2", "perimeter_per_km")}})
+        if len(mine) < 3:
+            continue
+        rows += mine
+        by_set[label] = {"months": mine, "mean_dbeta": float(np.mean([m["dbeta"] for m in mine])),
+                         **_pair_correlations(mine)}
+    return {"by_set": by_set, "n": len(rows), **(_pair_correlations(rows) if len(rows) >= 3 else {})}
+
+
+def _pair_correlations(rows: list) -> dict:
+    db = np.array([r["dbeta"] for r in rows])
+    return {f"r_{name}": float(np.corrcoef(db, np.log([r[f"{key}_ratio"] for r in rows]))[0, 1])
+            for name, key in (("floe", "floe_area_km2"), ("perimeter", "perimeter_per_km"))}
 
 
 def verdict_floes(result: dict) -> dict:
