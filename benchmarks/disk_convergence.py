@@ -193,7 +193,7 @@ elements whose centroid is at least 100 km from the coast):
   Predicted: (q) and (r) hold (perimeter ratio 1.3–1.5, floe area ratio 0.4–0.7); the bands at 10 km are also
   wider in elements (perimeter ratio below the √area count's 1.65 and 1.9).
 
-  Result (02:31 UTC): (q) and (r) hold in both sets; the prediction was right on both and wrong on the bands'
+  Result (02:26 UTC): (q) and (r) hold in both sets; the prediction was right on both and wrong on the bands'
   width. On day 28 the band perimeter length at 10 km is 1.72 (RD5) and 1.75 (RD9) times the 20 km one, close
   to the √area count (1.65, 1.94): the bands are one element wide on both meshes on every day (18–22 km wide
   at 20 km, 9–11 km at 10 km). The area-weighted mean floe at 10 km is 0.69 and 0.51 times the 20 km one
