@@ -205,6 +205,18 @@ elements whose centroid is at least 100 km from the coast):
   at r = +0.11 (within the sets +0.71, +0.55, −0.17, +0.08) and with the log of the perimeter ratio at
   +0.14. How far the pack is cut into floes is not what sets β's fall; RD7 had found the same by window.
 
+Rule RD12 (written at 02:28 UTC, before its runs). RD8 suggested that healing makes about half of the disk's fall
+(paired by month over eight months, −0.013, 90 % interval −0.027 to +0.001), not firmly. Eight more wind seeds
+(2034–2041, ``MORE_MONTH_SEEDS``) for RD5's set (family ``lead``, law ``same_pa``, pristine) and RD8's
+(``noheal``), at 20 and 10 km. Command ``healing``: per month and set, Δβ = β on 20–120 km at 10 km less at
+20 km; healing's part is the mean over the months of Δβ(healing) − Δβ(no healing), paired by wind seed, with a
+90 % interval from 10 000 resamplings of the months (seeded).
+  (s) Healing's part is shown if, over the 16 months (2026–2041), its 90 % interval lies below 0.
+  Predicted: (s) holds, with a part of −0.008 to −0.015. If it fails, healing's part is no larger than the
+  months' noise, and the disk's fall does not need healing.
+  The eight-month records of RD5 and RD8 stay as they were (``report --stage month`` reads the seeds 2026–2033
+  unless given ``--seeds``).
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -217,6 +229,9 @@ elements whose centroid is at least 100 km from the coast):
     python benchmarks/disk_convergence.py run --stage month --variant noheal --family lead --law same_pa --jobs 2  # RD8
     python benchmarks/disk_convergence.py fragmentation                                               # RD7
     python benchmarks/disk_convergence.py floes                                                       # RD11
+    python benchmarks/disk_convergence.py run --stage month --family lead --law same_pa --seeds 2034 2035 2036 2037 \
+        2038 2039 2040 2041 --jobs 2                                         # RD12, and the same with --variant noheal
+    python benchmarks/disk_convergence.py healing                                                     # RD12
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
     python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
     # (RD10)
@@ -255,6 +270,8 @@ MORE_SEEDS = tuple(range(18, 24))
 #: month 2026, ENSEMBLE_SEEDS, MORE_SEEDS); the strength disorder is run.seed 2026's in every month
 MONTH_SEEDS = tuple(range(2026, 2034))
 MONTH_KM = (20, 10)
+#: rule RD12's eight more wind seeds
+MORE_MONTH_SEEDS = tuple(range(2034, 2042))
 #: stage ``month``'s variants (``--variant``): scene overrides, the basin's pieces taken out one at a time
 MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], "spun": [], "packspun": []}
 #: the variants whose months start from a spin-up, with the spin-up's own overrides. ``spun`` (rule RD9): each
