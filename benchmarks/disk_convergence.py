@@ -717,17 +717,30 @@ def figure_month(family: str, law: str, groups: dict, pooled_windows: dict, path
     plt.close(fig)
 
 
-def report_month(family: str, law: str, variant: str = "") -> dict:
-    """Stage ``month`` (rules RD5, RD6, RD8): pool the 3-day windows of the months on each mesh, as ``basin``
-    does for the basin's months, and judge the fall from 20 to 10 km."""
+def _seed_of(path) -> int:
+    return int(Path(path).name.rsplit("-w", 1)[1])
+
+
+def month_groups(family: str, law: str, variant: str = "", seeds=MONTH_SEEDS) -> dict:
+    """``{"20": [run folder, ...], "10": [...]}``: the finished months of a set whose wind seed is in ``seeds``."""
     groups = {}
     for km in MONTH_KM:
         paths = [p for p in sorted(OUT.glob(f"{_month_prefix(variant)}{family}-{law}-{km:g}km-w*"))
-                 if (p / "snapshots" / "index.json").exists()]
+                 if (p / "snapshots" / "index.json").exists() and _seed_of(p) in set(seeds)]
         if paths:
             groups[f"{km:g}"] = paths
     if len(groups) < 2:
-        raise SystemExit(f"stage month: need finished runs of {family}-{law} at 20 and 10 km in {OUT}")
+        raise SystemExit(f"stage month: need finished runs of {_month_prefix(variant)}{family}-{law} at 20 and "
+                         f"10 km in {OUT}")
+    return groups
+
+
+def report_month(family: str, law: str, variant: str = "", seeds=MONTH_SEEDS) -> dict:
+    """Stage ``month`` (rules RD5, RD6, RD8): pool the 3-day windows of the months on each mesh, as ``basin``
+    does for the basin's months, and judge the fall from 20 to 10 km. Months of other wind seeds than the
+    eight of :data:`MONTH_SEEDS` are recorded under a key and figure of their own."""
+    tag = "" if tuple(seeds) == MONTH_SEEDS else f"-w{min(seeds)}-{max(seeds)}"
+    groups = month_groups(family, law, variant, seeds)
     out = pool_windows(groups)
     for km, paths in groups.items():
         bands = np.array([band_length_per_km(p) for p in paths])
@@ -739,10 +752,10 @@ def report_month(family: str, law: str, variant: str = "") -> dict:
     ratio = out["10"]["band_length_per_km"]["median"][-1] / out["20"]["band_length_per_km"]["median"][-1]
     v.update({"band_length_ratio_10_to_20_last_day": ratio, "g_same_band_length": bool(0.8 <= ratio <= 1.25)})
     print("rules RD5 and RD6:", json.dumps(v))
-    fig = ROOT / "docs" / "figures" / f"disk_month_{variant + '_' if variant else ''}{family}_{law}.png"
+    fig = ROOT / "docs" / "figures" / f"disk_month_{variant + '_' if variant else ''}{family}_{law}{tag}.png"
     figure_month(f"{family}{', ' + variant if variant else ''}", law, groups, out, fig)
     print(f"wrote {fig.relative_to(ROOT)}")
-    _write_json(f"{_month_prefix(variant)}{family}-{law}",
+    _write_json(f"{_month_prefix(variant)}{family}-{law}{tag}",
                 {"scene": str(MONTH_SCENE.relative_to(ROOT)),
                  "overrides": {km: [x.replace(f"{ROOT}/", "") for x in variant_sets(variant, family, law, float(km))]
                                for km in groups}, "meshes": out,
@@ -1040,6 +1053,50 @@ def verdict_floes(result: dict) -> dict:
                                                                        for r in judged.values())}
 
 
+def mean_interval(values, n_resamplings: int = 10_000, seed: int = 0) -> tuple[float, float, float]:
+    """The mean of ``values`` and its 90 % interval from ``n_resamplings`` resamplings with replacement."""
+    x = np.asarray(values, dtype=float)
+    means = x[np.random.default_rng(seed).integers(0, x.size, (n_resamplings, x.size))].mean(axis=1)
+    lo, hi = np.percentile(means, [5.0, 95.0])
+    return float(x.mean()), float(lo), float(hi)
+
+
+def healing(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE_MONTH_SEEDS) -> dict:
+    """Rule RD12: Δβ (β on 20–120 km at 10 km less at 20 km) month by month with healing and without, and
+    healing's part, Δβ(healing) − Δβ(no healing) paired by wind seed, with its 90 % interval."""
+    dbeta, sets = {}, {}
+    for label, variant in (("healing", ""), ("no healing", "noheal")):
+        pooled = pool_windows(month_groups(family, law, variant, seeds))
+        per = {km: {_seed_of(k): v for k, v in pooled[km]["beta_common_per_run"].items()} for km in ("20", "10")}
+        dbeta[label] = {sd: per["10"][sd] - per["20"][sd] for sd in per["20"] if sd in per["10"]}
+        sets[label] = {"fall_pooled_common": pooled["20"]["beta_common"] - pooled["10"]["beta_common"],
+                       "n_months": len(dbeta[label]),
+                       "dbeta_by_month": {str(k): v for k, v in sorted(dbeta[label].items())},
+                       "mean_dbeta_interval": mean_interval(list(dbeta[label].values()))}
+    common = sorted(set(dbeta["healing"]) & set(dbeta["no healing"]))
+    part = [dbeta["healing"][sd] - dbeta["no healing"][sd] for sd in common]
+    v = verdict_healing(part)
+    halves = {name: mean_interval([p for sd, p in zip(common, part) if sd in chosen])
+              for name, chosen in (("seeds 2026-2033", MONTH_SEEDS), ("seeds 2034-2041", MORE_MONTH_SEEDS))
+              if any(sd in chosen for sd in common)}
+    for label, r in sets.items():
+        m, lo, hi = r["mean_dbeta_interval"]
+        print(f"{label}: {r['n_months']} months, pooled fall {r['fall_pooled_common']:.3f}; month by month "
+              f"Δβ {m:+.3f} [{lo:+.3f}, {hi:+.3f}]")
+    print("healing's part by half:", {k: [round(x, 3) for x in val] for k, val in halves.items()})
+    print("rule RD12:", json.dumps(v))
+    _write_json("healing", {"family": family, "law": law, "sets": sets, "months_paired": common,
+                            "healing_part_by_month": dict(zip(map(str, common), part)),
+                            "healing_part_by_half": halves, "verdict": v})
+    return {"sets": sets, "verdict": v}
+
+
+def verdict_healing(part) -> dict:
+    """Rule RD12 (s): healing's part is shown if the 90 % interval of its mean lies below 0."""
+    m, lo, hi = mean_interval(part)
+    return {"n_months": len(part), "healing_part": m, "interval_90": [lo, hi], "s_shown": bool(hi < 0.0)}
+
+
 def verdict_fragmentation(bins: dict) -> dict:
     """Rule RD7 (k) on :func:`fragmentation`'s bins: the two meshes agree within 0.02 in every bin both fill
     (at least :data:`FRAGMENTATION_MIN_WINDOWS` windows each), and on each mesh β is at least 0.03 lower in
@@ -1061,7 +1118,7 @@ def verdict_fragmentation(bins: dict) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes"))
+    ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes", "healing"))
     ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
@@ -1081,8 +1138,11 @@ def main(argv=None) -> int:
     if a.what == "floes":
         floes(a.family)
         return 0
+    if a.what == "healing":
+        healing(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
+        return 0
     if a.stage == "month" and a.what == "report":
-        report_month(a.family, a.law, a.variant)
+        report_month(a.family, a.law, a.variant, tuple(a.seeds) if a.seeds else MONTH_SEEDS)
         return 0
     if a.what == "run":
         # the finest meshes first, so that two jobs finish together

@@ -1560,6 +1560,42 @@ def test_disk_convergence_band_perimeter_counts_a_wide_band_once_and_splits_the_
     assert weak["perimeter_per_km"] == 0.0 and weak["floe_area_km2"] == pytest.approx(interior, rel=0.03)
 
 
+def test_disk_convergence_healing_part_needs_an_interval_below_zero():
+    """Rule RD12 (s): the resampled 90 % interval of the mean brackets the mean, is seeded (the same values
+    give the same interval) and narrows as the months add up; healing's part is shown only when the interval
+    lies below 0."""
+    import disk_convergence as dc
+
+    rng = np.random.default_rng(3)
+    few = -0.01 + 0.02 * rng.standard_normal(8)
+    many = np.concatenate([few, -0.01 + 0.02 * rng.standard_normal(56)])
+    m, lo, hi = dc.mean_interval(few)
+    assert lo < m < hi and m == pytest.approx(few.mean())
+    assert dc.mean_interval(few) == (m, lo, hi)
+    assert dc.mean_interval(many)[2] - dc.mean_interval(many)[1] < hi - lo
+    assert not dc.verdict_healing(np.array([-0.03, 0.02, -0.01, 0.01]))["s_shown"]
+    shown = dc.verdict_healing(np.array([-0.012, -0.015, -0.009, -0.011, -0.02, -0.008]))
+    assert shown["s_shown"] and shown["interval_90"][1] < 0 and shown["n_months"] == 6
+
+
+def test_disk_convergence_month_groups_keep_to_their_seeds(tmp_path, monkeypatch):
+    """Adding months of other wind seeds leaves a set's eight-month record alone: only the seeds asked for are
+    read, and a set with a mesh missing is refused by name."""
+    import disk_convergence as dc
+
+    monkeypatch.setattr(dc, "OUT", tmp_path)
+    for km in (20, 10):
+        for seed in (2026, 2027, 2035):
+            snap = tmp_path / dc.run_name("lead", "same_pa", km, seed, "month") / "snapshots"
+            snap.mkdir(parents=True)
+            (snap / "index.json").write_text("[]")
+    got = dc.month_groups("lead", "same_pa", "", dc.MONTH_SEEDS)
+    assert {k: [dc._seed_of(p) for p in v] for k, v in got.items()} == {"20": [2026, 2027], "10": [2026, 2027]}
+    assert [dc._seed_of(p) for p in dc.month_groups("lead", "same_pa", "", (2035,))["10"]] == [2035]
+    with pytest.raises(SystemExit, match="month-noheal-lead-same_pa"):
+        dc.month_groups("lead", "same_pa", "noheal", dc.MONTH_SEEDS)
+
+
 def test_disk_convergence_element_neighbours_are_the_shared_edges():
     """Two triangles sharing one edge, and a third touching them at a node only: one pair, its edge's nodes."""
     import disk_convergence as dc
