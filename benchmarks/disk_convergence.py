@@ -175,6 +175,15 @@ disk's from uniform 1 m compact ice. Variant ``packspun``: as ``spun`` (RD9), wi
   kilometres, much wider than either element, so it should move where the bands form, not how the two meshes
   differ. If it fails, of the basin's pieces only its coast (and island) is left untested on the disk.
 
+  Result (02:58 UTC): (p) holds, by 0.0005; the prediction was wrong. From the thick-and-thin spin-up the pooled β on
+  20–120 km falls from 0.153 at 20 km to 0.123 at 10 km (a fall of 0.030), lower at 10 km in all 8 months
+  (median −0.037; month by month −0.030, 90 % interval −0.039 to −0.019, against RD9's −0.017, −0.023 to
+  −0.011, and the basin's −0.034, −0.060 to −0.006). The band length per area on day 28 is 1.81 times the
+  20 km one (0.0457 against 0.0253 km⁻¹). Looked at after the verdict (no rule), paired by month against RD9:
+  the pack raises β at 20 km by 0.016 (90 % interval 0.006 to 0.026) and leaves it at 10 km (+0.003, −0.005 to
+  +0.011), so it adds −0.013 (−0.025 to 0.000) to the fall. With the basin's pack the disk's fall is the
+  basin's; the coast is not needed for it.
+
 Rule RD11 (written at 02:21 UTC, before its code and analysis; no new runs). RD5–RD9 read "the finer mesh cuts
 the pack into smaller floes" from the band length per area, which counts every element above damage 0.9 as a
 band as long as its size √area. That count doubles for a band of the same width in kilometres on a mesh of half
