@@ -226,6 +226,17 @@ Rule RD12 (written at 02:28 UTC, before its runs). RD8 suggested that healing ma
   The eight-month records of RD5 and RD8 stay as they were (``report --stage month`` reads the seeds 2026–2033
   unless given ``--seeds``).
 
+Rule RD13 (written at 02:58 UTC, before its runs). RD10's pack differs from RD9's uniform 1 m compact ice in its
+mean as well as its structure: over the disk its thickness averages 1.60 m and its concentration 0.920 (which
+alone scales the stiffness and strength by exp(−20 × 0.08) = 0.20). Variant ``meanspun``: as ``packspun``, with
+the spin-up started from uniform ice of the pack's means (1.6 m, 0.92), family ``lead``, law ``same_pa``, the
+eight wind seeds (2026–2033), 20 and 10 km.
+  (t) The pack's structure, not its mean, adds to the fall if the month-by-month fall (mean over the 8 months of
+      β at 10 km less at 20 km on 20–120 km) is at least 0.008 smaller in size than RD10's (−0.030), i.e. above
+      −0.022.
+  Predicted: (t) fails (a fall of 0.025–0.035): the mean state, weaker and thicker, sets the fall as the
+  strength did in the basin's families, and the structure adds little.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -241,6 +252,8 @@ Rule RD12 (written at 02:28 UTC, before its runs). RD8 suggested that healing ma
     python benchmarks/disk_convergence.py run --stage month --family lead --law same_pa --seeds 2034 2035 2036 2037 \
         2038 2039 2040 2041 --jobs 2                                         # RD12, and the same with --variant noheal
     python benchmarks/disk_convergence.py healing                                                     # RD12
+    python benchmarks/disk_convergence.py run --stage month --variant meanspun --family lead --law same_pa --jobs 2
+    # (RD13)
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
     python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
     # (RD10)
@@ -282,7 +295,7 @@ MONTH_KM = (20, 10)
 #: rule RD12's eight more wind seeds
 MORE_MONTH_SEEDS = tuple(range(2034, 2042))
 #: stage ``month``'s variants (``--variant``): scene overrides, the basin's pieces taken out one at a time
-MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], "spun": [], "packspun": []}
+MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], "spun": [], "packspun": [], "meanspun": []}
 #: the variants whose months start from a spin-up, with the spin-up's own overrides. ``spun`` (rule RD9): each
 #: month starts from the end of a 14-day run of the same scene, mesh and strength from pristine ice, under wind
 #: seed 2025 from 1 January (as the basin's spin-up). ``packspun`` (rule RD10): the same, from the basin's
@@ -290,7 +303,9 @@ MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], "spun": [], "packspun"
 #: which ``examples/winter_basin_spinup.toml`` spins up the basin; the disk and the basin are both centred on 0)
 PACK_SETS = ['initial.thickness_m="1.6 - 0.5e-6*x + 0.25*sin(6e-6*x)*cos(5e-6*y)"',
              'initial.concentration="0.92 + 0.05*sin(1.1e-5*x + 0.4)*cos(0.9e-5*y)"']
-SPUN_VARIANTS = {"spun": [], "packspun": PACK_SETS}
+#: ``meanspun`` (rule RD13): the same spin-up from uniform ice of the pack's means over the disk
+MEAN_PACK_SETS = ["initial.thickness_m=1.6", "initial.concentration=0.92"]
+SPUN_VARIANTS = {"spun": [], "packspun": PACK_SETS, "meanspun": MEAN_PACK_SETS}
 SPINUP_SETS = ["forcing.wind.seed=2025", 'run.start_date="2026-01-01 00:00:00"', "run.duration=14d", "output.every=7d"]
 
 
@@ -719,6 +734,8 @@ def figure_month(family: str, law: str, groups: dict, pooled_windows: dict, path
     ax.set_title("β window by window", fontsize=10)
     ax.legend(fontsize=8)
     where = ("a 500 km disk, from a 14-day spin-up of the basin's thick-and-thin pack" if family.endswith("packspun")
+             else "a 500 km disk, from a 14-day spin-up of uniform 1.6 m ice at concentration 0.92"
+             if family.endswith("meanspun")
              else "a 500 km disk, from a 14-day spin-up" if family.endswith("spun") else "a pristine 500 km disk")
     fig.suptitle(f"28 days of the winter climatology over {where}: family {family}, strength {law}"
                  f" (maps: wind seed {MAP_SEED})", fontsize=11)
@@ -1139,7 +1156,8 @@ def main(argv=None) -> int:
                     help="storm: one cyclone, 3 days (default); month: examples/winter_disk.toml, 28 days (RD5)")
     ap.add_argument("--variant", choices=sorted(MONTH_VARIANTS), default="",
                     help="stage month: noheal (healing.law = none; rule RD8), spun (from a 14-day spin-up; RD9), "
-                         "packspun (from a 14-day spin-up of the basin's thick-and-thin pack; RD10)")
+                         "packspun (from a 14-day spin-up of the basin's thick-and-thin pack; RD10), meanspun "
+                         "(the same from uniform ice of the pack's means; RD13)")
     a = ap.parse_args(argv)
     if a.what == "fragmentation":
         fragmentation(a.family)

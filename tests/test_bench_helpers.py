@@ -1481,6 +1481,8 @@ def test_disk_convergence_month_verdict_pairs_the_months_by_wind_seed():
     assert dc.spinup_path("lead", "same_pa", 10, "packspun") != dc.spinup_path("lead", "same_pa", 10)
     assert not set(dc.PACK_SETS) & set(pack) and not set(dc.PACK_SETS) & set(dc.spinup_command("lead", "same_pa", 10))
     assert set(dc.PACK_SETS) <= set(dc.spinup_command("lead", "same_pa", 10, "packspun"))
+    assert set(dc.MEAN_PACK_SETS) <= set(dc.spinup_command("lead", "same_pa", 10, "meanspun"))
+    assert len({dc.spinup_path("lead", "same_pa", 10, v) for v in dc.SPUN_VARIANTS}) == len(dc.SPUN_VARIANTS)
     assert "healing.law=none" in dc.command("lead", "same_pa", 20, 2027, "month", "noheal")
     assert dc.run_name("lead", "same_pa", 20, 2027, "month", "noheal") == "month-noheal-lead-same_pa-20km-w2027"
     coarse = {"beta_common": 0.18, "beta_common_per_run": {f"month-lead-same_pa-20km-w{s}": 0.18 for s in range(8)}}
