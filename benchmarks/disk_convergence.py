@@ -226,6 +226,13 @@ Rule RD12 (written at 02:28 UTC, before its runs). RD8 suggested that healing ma
   The eight-month records of RD5 and RD8 stay as they were (``report --stage month`` reads the seeds 2026–2033
   unless given ``--seeds``).
 
+  Result (03:50 UTC): (s) fails; the prediction was wrong. Over the 16 months healing's part is −0.010 (90 %
+  interval −0.021 to +0.001); the eight new months alone give −0.007 (−0.024 to +0.010). Month by month the fall
+  is −0.024 (−0.034 to −0.016) with healing and −0.015 (−0.023 to −0.006) without; pooled, 0.022 (0.153 → 0.131)
+  and 0.016 (0.143 → 0.127). So the disk's fall does not need healing: without it the fall is there over 16
+  months (RD8's eight had put its interval at −0.017 to 0.000), and healing's extra is within the months'
+  noise.
+
 Rule RD13 (written at 02:58 UTC, before its runs). RD10's pack differs from RD9's uniform 1 m compact ice in its
 mean as well as its structure: over the disk its thickness averages 1.60 m and its concentration 0.920 (which
 alone scales the stiffness and strength by exp(−20 × 0.08) = 0.20). Variant ``meanspun``: as ``packspun``, with
