@@ -244,6 +244,15 @@ eight wind seeds (2026–2033), 20 and 10 km.
   Predicted: (t) fails (a fall of 0.025–0.035): the mean state, weaker and thicker, sets the fall as the
   strength did in the basin's families, and the structure adds little.
 
+  Result (04:10 UTC): (t) fails, as predicted, but the fall is larger than predicted. From uniform ice of the pack's
+  means the pooled β on 20–120 km falls from 0.171 at 20 km to 0.120 at 10 km (0.051), lower at 10 km in all 8
+  months (month by month −0.048, 90 % interval −0.061 to −0.035; RD10's −0.030). Paired by month (after the
+  verdict, no rule), the mean pack raises β at 20 km by 0.033 (0.025 to 0.041) over RD9's 1 m compact ice and
+  leaves it at 10 km (+0.002, −0.009 to +0.012); the structure takes back 0.017 (0.004 to 0.028) at 20 km. At
+  10 km β is 0.120–0.123 from all three spin-ups; at 20 km it is 0.139, 0.153 and 0.171. So the fall is the
+  20 km mesh's β moving with the pack's mean state (its strength against the wind, ×0.32 here: the
+  concentration's factor 0.20 times the thickness 1.6 m) while the 10 km mesh's does not.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
