@@ -250,8 +250,10 @@ eight wind seeds (2026–2033), 20 and 10 km.
   verdict, no rule), the mean pack raises β at 20 km by 0.033 (0.025 to 0.041) over RD9's 1 m compact ice and
   leaves it at 10 km (+0.002, −0.009 to +0.012); the structure takes back 0.017 (0.004 to 0.028) at 20 km. At
   10 km β is 0.120–0.123 from all three spin-ups; at 20 km it is 0.139, 0.153 and 0.171. So the fall is the
-  20 km mesh's β moving with the pack's mean state (its strength against the wind, ×0.32 here: the
-  concentration's factor 0.20 times the thickness 1.6 m) while the 10 km mesh's does not.
+  20 km mesh's β moving with the pack's mean state while the 10 km mesh's does not. (A correction to the rule's
+  text: the concentration's factor exp(−20 (1 − A)) = 0.20 scales the elastic modulus, and its cube (α = 4) the
+  relaxation time, to 0.008; it does not scale the cohesion. The mean pack is thicker, so 1.6 times the force
+  at the same stress, five times softer and quicker to relax.)
 
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
