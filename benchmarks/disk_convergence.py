@@ -344,7 +344,7 @@ def spinup_command(family: str, law: str, km: float, variant: str = "spun") -> l
 
 
 def make_spinup(family: str, law: str, km: float, variant: str = "spun") -> str:
-    """Variants ``spun`` and ``packspun``: the 14-day spin-up of ``examples/winter_disk.toml`` on the mesh of
+    """The variants of :data:`SPUN_VARIANTS`: the 14-day spin-up of ``examples/winter_disk.toml`` on the mesh of
     ``km`` (the family's settings, the law's strength and the variant's initial fields), its last snapshot saved
     by :func:`lagice.spinup.save_spinup`."""
     from lagice.spinup import save_spinup
@@ -357,6 +357,8 @@ def make_spinup(family: str, law: str, km: float, variant: str = "spun") -> str:
     _lagice_run(cmd + (["--overwrite"] if out.exists() else []), target.stem)
     save_spinup(out, target)
     return f"{target.name}: made"
+
+
 #: (scene overrides, C_lab [Pa] in lagice's form at the reference size)
 FAMILIES = {
     "lead": (["rheology.failure_stress=effective", "rheology.max_damage=0.97"], 22.4e6),
@@ -604,26 +606,33 @@ def _snapshots_by_day(path) -> dict:
     return {round(e["time_s"] / DAY_S): Path(path) / "snapshots" / e["file"] for e in read_index(path)}
 
 
+def band_snapshot(file) -> tuple:
+    """One snapshot's mesh and band set: node x and y [m], the triangles, the element areas [m²], the interior
+    (elements whose centroid is at least 100 km from the disk's coast) and the band set (interior elements
+    with damage above :data:`BAND_DAMAGE`)."""
+    import xarray as xr
+
+    from lagice.mesh.core import signed_areas
+
+    with xr.open_dataset(file, decode_times=False) as ds:
+        x, y = ds["mesh_node_x"].values, ds["mesh_node_y"].values
+        t = ds["mesh_face_nodes"].values.astype(np.int64)
+        damage = ds["damage"].values[0]
+    area = np.abs(signed_areas(np.column_stack([x, y]), t))
+    inside = np.hypot(x[t].mean(axis=1), y[t].mean(axis=1)) < DISK_RADIUS_M - COAST_BUFFER_M
+    return x, y, t, area, inside, inside & (damage > BAND_DAMAGE)
+
+
 def band_length_per_km(path, days=BAND_DAYS) -> list:
     """Length of broken bands per interior area [km⁻¹] in the snapshots of ``days`` (rule RD6): the
     elements with damage above :data:`BAND_DAMAGE` at least 100 km from the disk's coast, each counted as
     a band as long as its size √area, over the interior's area. The same network of bands one element wide
     gives the same value on every mesh of the same element shape (a band of equilateral triangles is
     counted 1.3 times its length, one of right triangles from squares √2 times)."""
-    import xarray as xr
-
-    from lagice.mesh.core import signed_areas
-
     by_day = _snapshots_by_day(path)
     out = []
     for day in days:
-        with xr.open_dataset(by_day[day], decode_times=False) as ds:
-            x, y = ds["mesh_node_x"].values, ds["mesh_node_y"].values
-            t = ds["mesh_face_nodes"].values.astype(np.int64)
-            damage = ds["damage"].values[0]
-        area = np.abs(signed_areas(np.column_stack([x, y]), t))
-        inside = np.hypot(x[t].mean(axis=1), y[t].mean(axis=1)) < DISK_RADIUS_M - COAST_BUFFER_M
-        band = inside & (damage > BAND_DAMAGE)
+        _, _, _, area, inside, band = band_snapshot(by_day[day])
         out.append(float(np.sqrt(area[band]).sum() / area[inside].sum() * 1e3))
     return out
 
@@ -667,20 +676,10 @@ def band_perimeter_and_floes(path, days=BAND_DAYS) -> dict:
     * ``floe_area_km2``: the interior's elements outside the band set joined through shared edges into floes,
       their area-weighted mean area Σa²/Σa [km²];
     * ``n_floes_per_1e5_km2``: the floes of at least :data:`MIN_FLOE_KM2` per 10⁵ km² of interior."""
-    import xarray as xr
-
-    from lagice.mesh.core import signed_areas
-
     by_day = _snapshots_by_day(path)
     out = {k: [] for k in ("perimeter_per_km", "band_width_km", "floe_area_km2", "n_floes_per_1e5_km2")}
     for day in days:
-        with xr.open_dataset(by_day[day], decode_times=False) as ds:
-            x, y = ds["mesh_node_x"].values, ds["mesh_node_y"].values
-            t = ds["mesh_face_nodes"].values.astype(np.int64)
-            damage = ds["damage"].values[0]
-        area = np.abs(signed_areas(np.column_stack([x, y]), t))
-        inside = np.hypot(x[t].mean(axis=1), y[t].mean(axis=1)) < DISK_RADIUS_M - COAST_BUFFER_M
-        band = inside & (damage > BAND_DAMAGE)
+        x, y, t, area, inside, band = band_snapshot(by_day[day])
         pairs, nodes = element_neighbours(t)
         a, b = pairs[:, 0], pairs[:, 1]
         rim = inside[a] & inside[b] & (band[a] != band[b])
@@ -947,17 +946,14 @@ FLOE_JUDGED = ("RD5", "RD9")
 
 def floes(family: str = "lead") -> dict:
     """Rule RD11: the band perimeter length, the bands' width and the floes' size on both meshes of each set
-    of :data:`FLOE_SETS`, medians over the months per day, and the verdict on the judged sets."""
+    of :data:`FLOE_SETS` (the eight months of :data:`MONTH_SEEDS`), medians over the months per day, and the
+    verdict on the judged sets."""
     result = {}
     for label, variant, law in FLOE_SETS:
         row = {}
-        for km in MONTH_KM:
-            paths = [p for p in sorted(OUT.glob(f"{_month_prefix(variant)}{family}-{law}-{km:g}km-w*"))
-                     if (p / "snapshots" / "index.json").exists()]
-            if not paths:
-                continue
+        for km, paths in month_groups(family, law, variant, MONTH_SEEDS).items():
             per_run = {Path(p).name: band_perimeter_and_floes(p) for p in paths}
-            row[f"{km:g}"] = {"n_months": len(paths), "days": list(BAND_DAYS),
+            row[km] = {"n_months": len(paths), "days": list(BAND_DAYS),
                               "median": {k: [float(v) for v in np.median([r[k] for r in per_run.values()], 0)]
                                          for k in next(iter(per_run.values()))},
                               "per_run": per_run}
@@ -999,7 +995,6 @@ def figure_floes(family: str, pairs: dict, path: Path, seed: int = MAP_SEED, day
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import xarray as xr
 
     sets = [s for s in FLOE_SETS if s[0] in ("RD5", "RD6", "RD9")]
     fig, axes = plt.subplots(2, len(sets) + 1, figsize=(4.2 * (len(sets) + 1), 8.4))
@@ -1009,12 +1004,8 @@ def figure_floes(family: str, pairs: dict, path: Path, seed: int = MAP_SEED, day
         for row, km in enumerate(MONTH_KM):
             ax = axes[row, col]
             run = OUT / run_name(family, law, km, seed, "month", variant)
-            with xr.open_dataset(_snapshots_by_day(run)[day], decode_times=False) as ds:
-                x, y = ds["mesh_node_x"].values / 1e3, ds["mesh_node_y"].values / 1e3
-                t = ds["mesh_face_nodes"].values.astype(np.int64)
-                damage = ds["damage"].values[0]
-            inside = np.hypot(x[t].mean(axis=1), y[t].mean(axis=1)) < (DISK_RADIUS_M - COAST_BUFFER_M) / 1e3
-            band = inside & (damage > BAND_DAMAGE)
+            x, y, t, _, inside, band = band_snapshot(_snapshots_by_day(run)[day])
+            x, y = x / 1e3, y / 1e3
             labels = floe_labels(element_neighbours(t)[0], inside & ~band)
             colour = palette[labels % len(palette)]
             colour[band] = 0.0
