@@ -905,19 +905,17 @@ FRAGMENTATION_MIN_WINDOWS = 8
 
 
 def fragmentation(family: str = "lead", laws=("same_pa", "scaled")) -> dict:
-    """Rule RD7: every 3-day window of the ``month`` runs of ``laws`` labelled by the band length per area on
-    its first day; per mesh and bin of :data:`FRAGMENTATION_BINS`, the pooled β on
-    :data:`BASIN_COMMON_FIT_M`. The 20 km runs of ``same_pa`` and ``scaled`` have the same cohesion (the same
-    runs, bit for bit), so at 20 km only the first law's are taken."""
+    """Rule RD7: every 3-day window of the ``month`` runs of ``laws`` (the eight months of :data:`MONTH_SEEDS`)
+    labelled by the band length per area on its first day; per mesh and bin of :data:`FRAGMENTATION_BINS`, the
+    pooled β on :data:`BASIN_COMMON_FIT_M`. The 20 km runs of ``same_pa`` and ``scaled`` have the same cohesion
+    (the same runs, bit for bit), so at 20 km only the first law's are taken."""
     from lagice.diagnostics.windows import window_starts_days, window_summary
 
     out = {}
     for km in MONTH_KM:
         bins = [[] for _ in FRAGMENTATION_BINS[:-1]]
         for law in (laws[:1] if float(km) == REFERENCE_KM else laws):
-            for path in sorted(OUT.glob(f"month-{family}-{law}-{km:g}km-w*")):
-                if not (path / "snapshots" / "index.json").exists():
-                    continue
+            for path in month_groups(family, law, "", MONTH_SEEDS).get(f"{km:g}", []):
                 starts = window_starts_days(path, 3.0, start_day=1.0)
                 lengths = band_length_per_km(path, days=[round(x) for x in starts])
                 for start, length in zip(starts, lengths):
