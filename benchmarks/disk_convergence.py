@@ -287,6 +287,7 @@ import json
 import os
 import subprocess
 import sys
+import tomllib
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -312,18 +313,19 @@ MONTH_SEEDS = tuple(range(2026, 2034))
 MONTH_KM = (20, 10)
 #: rule RD12's eight more wind seeds
 MORE_MONTH_SEEDS = tuple(range(2034, 2042))
-#: stage ``month``'s variants (``--variant``): scene overrides, the basin's pieces taken out one at a time
-MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], "spun": [], "packspun": [], "meanspun": []}
 #: the variants whose months start from a spin-up, with the spin-up's own overrides. ``spun`` (rule RD9): each
 #: month starts from the end of a 14-day run of the same scene, mesh and strength from pristine ice, under wind
 #: seed 2025 from 1 January (as the basin's spin-up). ``packspun`` (rule RD10): the same, from the basin's
 #: thick-and-thin pack (``examples/winter_basin.toml``'s initial thickness and concentration, the fields from
 #: which ``examples/winter_basin_spinup.toml`` spins up the basin; the disk and the basin are both centred on 0)
-PACK_SETS = ['initial.thickness_m="1.6 - 0.5e-6*x + 0.25*sin(6e-6*x)*cos(5e-6*y)"',
-             'initial.concentration="0.92 + 0.05*sin(1.1e-5*x + 0.4)*cos(0.9e-5*y)"']
+PACK_SETS = [f'initial.{key}="{tomllib.loads((ROOT / "examples" / "winter_basin.toml").read_text())["initial"][key]}"'
+             for key in ("thickness_m", "concentration")]
 #: ``meanspun`` (rule RD13): the same spin-up from uniform ice of the pack's means over the disk
 MEAN_PACK_SETS = ["initial.thickness_m=1.6", "initial.concentration=0.92"]
 SPUN_VARIANTS = {"spun": [], "packspun": PACK_SETS, "meanspun": MEAN_PACK_SETS}
+#: stage ``month``'s variants (``--variant``): scene overrides of the months, the basin's pieces taken out or put
+#: in one at a time (the spun-up ones' overrides are their state files, :func:`variant_sets`)
+MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], **{v: [] for v in SPUN_VARIANTS}}
 SPINUP_SETS = ["forcing.wind.seed=2025", 'run.start_date="2026-01-01 00:00:00"', "run.duration=14d", "output.every=7d"]
 
 
