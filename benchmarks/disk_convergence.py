@@ -255,6 +255,23 @@ eight wind seeds (2026–2033), 20 and 10 km.
   relaxation time, to 0.008; it does not scale the cohesion. The mean pack is thicker, so 1.6 times the force
   at the same stress, five times softer and quicker to relax.)
 
+Rule RD14 (written at 04:41 UTC, before its runs). RD13's uniform pack of the basin's means differs from RD9's 1 m
+compact ice in two factors: its thickness (1.6 m, so the same wind stress makes 1/1.6 of the stress in the ice)
+and its concentration (0.92, so the elastic modulus ×0.20 and the relaxation time ×0.008, the strength
+unchanged). Variants ``thickspun`` (uniform 1.6 m, concentration 1) and ``concspun`` (uniform 1 m, concentration
+0.92), otherwise as ``meanspun`` (the 14-day spin-up, family ``lead``, law ``same_pa``, the eight wind seeds
+2026–2033, 20 and 10 km). Command ``factors``: for each of ``thickspun``, ``concspun`` and ``meanspun``, β on
+20–120 km month by month less RD9's (``spun``) on the same mesh and wind seed, the mean over the 8 months with
+its 90 % interval from 10 000 resamplings of the months (seeded).
+  (u) The thickness raises the 20 km β if ``thickspun``'s paired change at 20 km is at least +0.015 and its 90 %
+      interval lies above 0.
+  (v) The concentration raises the 20 km β if ``concspun``'s does the same.
+  Reported, not judged: the changes at 10 km, each variant's fall from 20 to 10 km, and whether the two changes
+  at 20 km add up to ``meanspun``'s (+0.033).
+  Predicted: (u) holds (+0.02 to +0.03) and (v) fails (0 to +0.01): thicker ice under the same wind is further
+  below its strength, as a stronger pack would be; the concentration changes the modulus and the relaxation
+  time, which set how fast stress moves and relaxes, not where the pack fails.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -272,6 +289,10 @@ eight wind seeds (2026–2033), 20 and 10 km.
     python benchmarks/disk_convergence.py healing                                                     # RD12
     python benchmarks/disk_convergence.py run --stage month --variant meanspun --family lead --law same_pa --jobs 2
     # (RD13)
+    python benchmarks/disk_convergence.py run --stage month --variant thickspun --family lead --law same_pa --jobs 2
+    python benchmarks/disk_convergence.py run --stage month --variant concspun --family lead --law same_pa --jobs 2
+    python benchmarks/disk_convergence.py report --stage month --variant thickspun --family lead --law same_pa
+    python benchmarks/disk_convergence.py factors                                                     # RD14
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
     python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
     # (RD10)
@@ -322,7 +343,11 @@ PACK_SETS = [f'initial.{key}="{tomllib.loads((ROOT / "examples" / "winter_basin.
              for key in ("thickness_m", "concentration")]
 #: ``meanspun`` (rule RD13): the same spin-up from uniform ice of the pack's means over the disk
 MEAN_PACK_SETS = ["initial.thickness_m=1.6", "initial.concentration=0.92"]
-SPUN_VARIANTS = {"spun": [], "packspun": PACK_SETS, "meanspun": MEAN_PACK_SETS}
+#: ``thickspun`` and ``concspun`` (rule RD14): the means one at a time, the other factor as RD9's compact 1 m ice
+THICK_SETS = ["initial.thickness_m=1.6", "initial.concentration=1.0"]
+CONC_SETS = ["initial.thickness_m=1.0", "initial.concentration=0.92"]
+SPUN_VARIANTS = {"spun": [], "packspun": PACK_SETS, "meanspun": MEAN_PACK_SETS, "thickspun": THICK_SETS,
+                 "concspun": CONC_SETS}
 #: stage ``month``'s variants (``--variant``): scene overrides of the months, the basin's pieces taken out or put
 #: in one at a time (the spun-up ones' overrides are their state files, :func:`variant_sets`)
 MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], **{v: [] for v in SPUN_VARIANTS}}
@@ -1132,6 +1157,65 @@ def verdict_healing(part) -> dict:
     return {"n_months": len(part), "healing_part": m, "interval_90": [lo, hi], "s_shown": bool(hi < 0.0)}
 
 
+#: rule RD14: the spun-up variants whose β is paired with RD9's (``spun``)
+FACTOR_VARIANTS = ("thickspun", "concspun", "meanspun")
+
+
+def paired_changes(record: dict, base: dict) -> dict:
+    """β on the common widths of a month set's ``record`` (a ``report --stage month`` entry of
+    ``disk_convergence.json``) less ``base``'s, paired by wind seed on each mesh, and the record's own change
+    from 20 to 10 km, each as (mean over the months, 90 % interval)."""
+    def per(rec):
+        return {km: {_seed_of(k): v for k, v in rec["meshes"][km]["beta_common_per_run"].items()}
+                for km in ("20", "10")}
+
+    p, b = per(record), per(base)
+    out = {}
+    for km in ("20", "10"):
+        seeds = sorted(set(p[km]) & set(b[km]))
+        out[f"change_{km}km"] = mean_interval([p[km][sd] - b[km][sd] for sd in seeds])
+        out[f"months_{km}km"] = len(seeds)
+    seeds = sorted(set(p["20"]) & set(p["10"]))
+    out["fall_10_less_20"] = mean_interval([p["10"][sd] - p["20"][sd] for sd in seeds])
+    out["beta_pooled"] = {km: record["meshes"][km]["beta_common"] for km in ("20", "10")}
+    return out
+
+
+def verdict_factors(changes: dict) -> dict:
+    """Rule RD14 (u), (v): a factor raises the 20 km β if its paired change is ≥ +0.015 with the 90 % interval
+    above 0; reported: whether the two factors' changes at 20 km add up to ``meanspun``'s (within 0.01)."""
+    def raises(v):
+        m, lo, _ = changes[v]["change_20km"]
+        return bool(m >= 0.015 and lo > 0.0)
+
+    total = changes["thickspun"]["change_20km"][0] + changes["concspun"]["change_20km"][0]
+    return {"u_thickness_raises_20km": raises("thickspun"), "v_concentration_raises_20km": raises("concspun"),
+            "sum_of_factors_20km": total, "meanspun_20km": changes["meanspun"]["change_20km"][0],
+            "factors_add_up": bool(abs(total - changes["meanspun"]["change_20km"][0]) <= 0.01)}
+
+
+def factors(family: str = "lead", law: str = "same_pa") -> dict:
+    """Rule RD14: each of :data:`FACTOR_VARIANTS` against RD9's spun-up compact 1 m ice, from the month sets'
+    records (``report --stage month --variant V`` first)."""
+    data = json.loads(JSON.read_text())
+    key = f"{family}-{law}"
+    missing = [v for v in ("spun", *FACTOR_VARIANTS) if f"month-{v}-{key}" not in data]
+    if missing:
+        raise SystemExit(f"factors: no record of {missing} in {JSON.relative_to(ROOT)}; run report --stage month "
+                         "--variant V first")
+    changes = {v: paired_changes(data[f"month-{v}-{key}"], data[f"month-spun-{key}"]) for v in FACTOR_VARIANTS}
+    for v, c in changes.items():
+        print(f"{v}: pooled β {c['beta_pooled']['20']:.3f} (20 km) {c['beta_pooled']['10']:.3f} (10 km); against "
+              "spun: " + ", ".join(f"{km} km {c[f'change_{km}km'][0]:+.3f} [{c[f'change_{km}km'][1]:+.3f}, "
+                                   f"{c[f'change_{km}km'][2]:+.3f}]" for km in ("20", "10"))
+              + f"; fall {c['fall_10_less_20'][0]:+.3f} [{c['fall_10_less_20'][1]:+.3f}, "
+                f"{c['fall_10_less_20'][2]:+.3f}]")
+    v = verdict_factors(changes)
+    print("rule RD14:", json.dumps(v))
+    _write_json("factors", {"family": family, "law": law, "against": "spun", "changes": changes, "verdict": v})
+    return {"changes": changes, "verdict": v}
+
+
 def verdict_fragmentation(bins: dict) -> dict:
     """Rule RD7 (k) on :func:`fragmentation`'s bins: the two meshes agree within 0.02 in every bin both fill
     (at least :data:`FRAGMENTATION_MIN_WINDOWS` windows each), and on each mesh β is at least 0.03 lower in
@@ -1153,7 +1237,7 @@ def verdict_fragmentation(bins: dict) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes", "healing"))
+    ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes", "healing", "factors"))
     ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
@@ -1166,13 +1250,17 @@ def main(argv=None) -> int:
     ap.add_argument("--variant", choices=sorted(MONTH_VARIANTS), default="",
                     help="stage month: noheal (healing.law = none; rule RD8), spun (from a 14-day spin-up; RD9), "
                          "packspun (from a 14-day spin-up of the basin's thick-and-thin pack; RD10), meanspun "
-                         "(the same from uniform ice of the pack's means; RD13)")
+                         "(the same from uniform ice of the pack's means; RD13), thickspun and concspun (its "
+                         "thickness alone, its concentration alone; RD14)")
     a = ap.parse_args(argv)
     if a.what == "fragmentation":
         fragmentation(a.family)
         return 0
     if a.what == "floes":
         floes(a.family)
+        return 0
+    if a.what == "factors":
+        factors(a.family, a.law)
         return 0
     if a.what == "healing":
         healing(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)

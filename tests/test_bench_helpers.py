@@ -1482,6 +1482,11 @@ def test_disk_convergence_month_verdict_pairs_the_months_by_wind_seed():
     assert not set(dc.PACK_SETS) & set(pack) and not set(dc.PACK_SETS) & set(dc.spinup_command("lead", "same_pa", 10))
     assert set(dc.PACK_SETS) <= set(dc.spinup_command("lead", "same_pa", 10, "packspun"))
     assert set(dc.MEAN_PACK_SETS) <= set(dc.spinup_command("lead", "same_pa", 10, "meanspun"))
+    # rule RD14: one factor of the means at a time, the other as RD9's compact 1 m ice
+    assert {"initial.thickness_m=1.6", "initial.concentration=1.0"} <= set(dc.spinup_command("lead", "same_pa", 10,
+                                                                                             "thickspun"))
+    assert {"initial.thickness_m=1.0", "initial.concentration=0.92"} <= set(dc.spinup_command("lead", "same_pa", 20,
+                                                                                              "concspun"))
     assert len({dc.spinup_path("lead", "same_pa", 10, v) for v in dc.SPUN_VARIANTS}) == len(dc.SPUN_VARIANTS)
     assert "healing.law=none" in dc.command("lead", "same_pa", 20, 2027, "month", "noheal")
     assert dc.run_name("lead", "same_pa", 20, 2027, "month", "noheal") == "month-noheal-lead-same_pa-20km-w2027"
@@ -1626,3 +1631,34 @@ def test_disk_convergence_fragmentation_verdict_needs_agreement_and_a_fall_with_
     assert v["beta_falls_with_cutting"] and not v["meshes_agree"] and not v["k_fragmentation_sets_beta"]
     bins["10"][1]["beta_common"] = 0.125
     assert dc.verdict_fragmentation(bins)["k_fragmentation_sets_beta"]
+
+
+def test_disk_convergence_factors_pair_each_variant_with_the_spun_up_months():
+    """Rule RD14: a variant's change is paired by wind seed with the spun-up set on the same mesh (a month only
+    one set has is left out), its fall is its own 10 km less 20 km month by month, and a factor raises the
+    20 km β only when the change is at least +0.015 with its interval above 0."""
+    import disk_convergence as dc
+
+    def record(variant, beta20, beta10):
+        return {"meshes": {km: {"beta_common": float(np.mean(list(b.values()))),
+                                "beta_common_per_run": {f"month-{variant}-lead-same_pa-{km}km-w{sd}": v
+                                                        for sd, v in b.items()}}
+                           for km, b in (("20", beta20), ("10", beta10))}}
+
+    seeds = range(2026, 2034)
+    base = record("spun", {sd: 0.14 + 0.002 * (sd % 3) for sd in seeds}, {sd: 0.12 for sd in seeds})
+    thick = record("thickspun", {sd: 0.165 + 0.002 * (sd % 3) + 0.001 * (sd % 2) for sd in seeds},
+                   {sd: 0.12 for sd in list(seeds) + [2040]})
+    c = dc.paired_changes(thick, base)
+    assert c["months_20km"] == 8 and c["months_10km"] == 8
+    assert c["change_20km"][0] == pytest.approx(0.0255) and c["change_10km"][0] == pytest.approx(0.0, abs=1e-12)
+    assert c["change_20km"][1] > 0.0
+    assert c["fall_10_less_20"][0] == pytest.approx(-(0.165 + np.mean([0.002 * (sd % 3) + 0.001 * (sd % 2)
+                                                                       for sd in seeds]) - 0.12))
+    noisy = record("concspun", {sd: 0.14 + 0.002 * (sd % 3) + 0.03 * (-1) ** sd for sd in seeds},
+                   {sd: 0.12 for sd in seeds})
+    mean = record("meanspun", {sd: 0.17 + 0.002 * (sd % 3) for sd in seeds}, {sd: 0.12 for sd in seeds})
+    v = dc.verdict_factors({"thickspun": c, "concspun": dc.paired_changes(noisy, base),
+                            "meanspun": dc.paired_changes(mean, base)})
+    assert v["u_thickness_raises_20km"] and not v["v_concentration_raises_20km"]
+    assert v["meanspun_20km"] == pytest.approx(0.03) and v["factors_add_up"]
