@@ -1194,6 +1194,26 @@ def verdict_factors(changes: dict) -> dict:
             "factors_add_up": bool(abs(total - changes["meanspun"]["change_20km"][0]) <= 0.01)}
 
 
+def spinup_state(family: str = "lead", law: str = "same_pa", variants=tuple(SPUN_VARIANTS)) -> dict:
+    """The state each spin-up of ``variants`` hands to its months, per mesh: over the elements whose centroid is
+    at least :data:`COAST_BUFFER_M` from the coast (element means; the meshes are near uniform), the mean
+    damage, the fraction of elements above :data:`BAND_DAMAGE`, the mean thickness [m] and concentration."""
+    out = {}
+    for v in variants:
+        for km in MONTH_KM:
+            path = spinup_path(family, law, km, v)
+            if not path.exists():
+                continue
+            z = np.load(path)
+            inner = np.hypot(z["centroid_x_m"], z["centroid_y_m"]) <= DISK_RADIUS_M - COAST_BUFFER_M
+            d = z["damage"][inner]
+            out.setdefault(v, {})[f"{km:g}"] = {
+                "mean_damage": float(d.mean()), "band_fraction": float((d > BAND_DAMAGE).mean()),
+                "mean_thickness_m": float(z["thickness"][inner].mean()),
+                "mean_concentration": float(z["concentration"][inner].mean())}
+    return out
+
+
 def factors(family: str = "lead", law: str = "same_pa") -> dict:
     """Rule RD14: each of :data:`FACTOR_VARIANTS` against RD9's spun-up compact 1 m ice, from the month sets'
     records (``report --stage month --variant V`` first)."""
@@ -1212,7 +1232,13 @@ def factors(family: str = "lead", law: str = "same_pa") -> dict:
                 f"{c['fall_10_less_20'][2]:+.3f}]")
     v = verdict_factors(changes)
     print("rule RD14:", json.dumps(v))
-    _write_json("factors", {"family": family, "law": law, "against": "spun", "changes": changes, "verdict": v})
+    state = spinup_state(family, law)
+    for name, meshes in state.items():
+        print(f"{name} spin-up, day 14: " + "; ".join(
+            f"{km} km damage {m['mean_damage']:.3f}, bands {m['band_fraction']:.3f}, h {m['mean_thickness_m']:.2f} m, "
+            f"A {m['mean_concentration']:.3f}" for km, m in meshes.items()))
+    _write_json("factors", {"family": family, "law": law, "against": "spun", "changes": changes, "verdict": v,
+                            "spinup_state": state})
     return {"changes": changes, "verdict": v}
 
 

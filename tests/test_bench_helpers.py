@@ -1662,3 +1662,20 @@ def test_disk_convergence_factors_pair_each_variant_with_the_spun_up_months():
                             "meanspun": dc.paired_changes(mean, base)})
     assert v["u_thickness_raises_20km"] and not v["v_concentration_raises_20km"]
     assert v["meanspun_20km"] == pytest.approx(0.03) and v["factors_add_up"]
+
+
+def test_disk_convergence_spinup_state_reads_the_interior(tmp_path, monkeypatch):
+    """The state a spin-up hands to its months is read over the interior only (100 km from the coast): a broken,
+    thin rim is left out, and the band fraction counts damage above 0.9."""
+    import disk_convergence as dc
+
+    monkeypatch.setattr(dc, "OUT", tmp_path)
+    r = np.array([0.0, 100e3, 200e3, 300e3, 450e3, 480e3])
+    np.savez(dc.spinup_path("lead", "same_pa", 20, "thickspun"), centroid_x_m=r, centroid_y_m=np.zeros_like(r),
+             damage=np.array([0.0, 0.95, 0.5, 0.0, 1.0, 1.0]), thickness=np.array([1.6, 1.6, 1.6, 1.6, 0.2, 0.2]),
+             concentration=np.array([1.0, 0.99, 0.98, 0.97, 0.5, 0.5]))
+    got = dc.spinup_state("lead", "same_pa")
+    assert list(got) == ["thickspun"] and list(got["thickspun"]) == ["20"]
+    m = got["thickspun"]["20"]
+    assert m["mean_damage"] == pytest.approx(1.45 / 4) and m["band_fraction"] == pytest.approx(0.25)
+    assert m["mean_thickness_m"] == pytest.approx(1.6) and m["mean_concentration"] == pytest.approx(0.985)
