@@ -272,6 +272,18 @@ its 90 % interval from 10 000 resamplings of the months (seeded).
   below its strength, as a stronger pack would be; the concentration changes the modulus and the relaxation
   time, which set how fast stress moves and relaxes, not where the pack fails.
 
+Rule RD15 (written at 04:43 UTC, before its runs). RD13's fall (0.171 at 20 km, 0.120 at 10 km) is the 20 km β
+moving, but two meshes cannot say which is nearer the converged answer. Variant ``meanspun`` on a 5 km mesh (its
+own 14-day spin-up, the same cohesion in pascals, family ``lead``), months of wind seeds 2026 and 2027 only (the
+first two of the eight, chosen before the runs; a 5 km month costs about 45 minutes of one core). Command
+``fine``: β on 20–120 km of each 5 km month against the same month's at 10 and 20 km (RD13's record).
+  (w) β keeps falling below 10 km if in both months it is lower at 5 km than at 10 km by at least 0.015.
+  (x) β at 5 km turns back towards the 20 km value if in both months it is higher than at 10 km by at least 0.015.
+  Neither: two months do not tell a change of 0.015 from the months' noise.
+  Predicted: neither holds, the 5 km β within 0.015 of the 10 km one in at least one month: on one storm over
+  pristine ice β on fixed widths did not change from 10 to 5 km (RD1), and the 10 km β stayed at 0.12 in every
+  spin-up (RD13).
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -293,6 +305,8 @@ its 90 % interval from 10 000 resamplings of the months (seeded).
     python benchmarks/disk_convergence.py run --stage month --variant concspun --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py report --stage month --variant thickspun --family lead --law same_pa
     python benchmarks/disk_convergence.py factors                                                     # RD14
+    python benchmarks/disk_convergence.py run --stage month --variant meanspun --km 5 --seeds 2026 2027 --jobs 2
+    python benchmarks/disk_convergence.py fine                                                        # RD15
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
     python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
     # (RD10)
@@ -1242,6 +1256,41 @@ def factors(family: str = "lead", law: str = "same_pa") -> dict:
     return {"changes": changes, "verdict": v}
 
 
+#: rule RD15: the 5 km mesh's months (the first two wind seeds of the eight) of RD13's variant
+FINE_KM, FINE_SEEDS, FINE_VARIANT = 5.0, (2026, 2027), "meanspun"
+
+
+def verdict_fine(rows: list) -> dict:
+    """Rule RD15 on rows ``{"seed", "beta_5km", "beta_10km", "beta_20km"}``: (w) β at 5 km lower than at 10 km by
+    at least 0.015 in every month, (x) higher by at least 0.015 in every month; neither: not told."""
+    d = [r["beta_5km"] - r["beta_10km"] for r in rows]
+    return {"months": len(rows), "change_5_less_10": d,
+            "w_keeps_falling": bool(rows and all(x <= -0.015 for x in d)),
+            "x_turns_back": bool(rows and all(x >= 0.015 for x in d))}
+
+
+def fine(family: str = "lead", law: str = "same_pa") -> dict:
+    """Rule RD15: :data:`FINE_VARIANT`'s months on the :data:`FINE_KM` mesh against the same months at 10 and
+    20 km (from the set's record, written by ``report --stage month``)."""
+    paths = [OUT / run_name(family, law, FINE_KM, sd, "month", FINE_VARIANT) for sd in FINE_SEEDS]
+    missing = [p.name for p in paths if not (p / "snapshots" / "index.json").exists()]
+    if missing:
+        raise SystemExit(f"fine: no finished run {missing} in {OUT}")
+    record = json.loads(JSON.read_text())[f"{_month_prefix(FINE_VARIANT)}{family}-{law}"]["meshes"]
+    per = {km: {_seed_of(k): v for k, v in record[km]["beta_common_per_run"].items()} for km in ("20", "10")}
+    pooled = pool_windows({f"{FINE_KM:g}": paths})[f"{FINE_KM:g}"]
+    rows = [{"seed": _seed_of(p), "beta_5km": pooled["beta_common_per_run"][p.name],
+             "beta_10km": per["10"][_seed_of(p)], "beta_20km": per["20"][_seed_of(p)]} for p in paths]
+    for r in rows:
+        print(f"wind seed {r['seed']}: β on 20-120 km {r['beta_20km']:.3f} (20 km) {r['beta_10km']:.3f} (10 km) "
+              f"{r['beta_5km']:.3f} (5 km)")
+    v = verdict_fine(rows)
+    print("rule RD15:", json.dumps(v))
+    _write_json(f"fine-{FINE_VARIANT}", {"family": family, "law": law, "km": FINE_KM, "months": rows,
+                                         "mesh": pooled, "verdict": v})
+    return {"months": rows, "verdict": v}
+
+
 def verdict_fragmentation(bins: dict) -> dict:
     """Rule RD7 (k) on :func:`fragmentation`'s bins: the two meshes agree within 0.02 in every bin both fill
     (at least :data:`FRAGMENTATION_MIN_WINDOWS` windows each), and on each mesh β is at least 0.03 lower in
@@ -1263,7 +1312,7 @@ def verdict_fragmentation(bins: dict) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes", "healing", "factors"))
+    ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes", "healing", "factors", "fine"))
     ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
@@ -1284,6 +1333,9 @@ def main(argv=None) -> int:
         return 0
     if a.what == "floes":
         floes(a.family)
+        return 0
+    if a.what == "fine":
+        fine(a.family, a.law)
         return 0
     if a.what == "factors":
         factors(a.family, a.law)

@@ -1679,3 +1679,23 @@ def test_disk_convergence_spinup_state_reads_the_interior(tmp_path, monkeypatch)
     m = got["thickspun"]["20"]
     assert m["mean_damage"] == pytest.approx(1.45 / 4) and m["band_fraction"] == pytest.approx(0.25)
     assert m["mean_thickness_m"] == pytest.approx(1.6) and m["mean_concentration"] == pytest.approx(0.985)
+
+
+def test_disk_convergence_fine_mesh_verdict_needs_every_month():
+    """Rule RD15: β keeps falling (or turns back) below 10 km only if every month moves by at least 0.015 the
+    same way; one month within 0.015 leaves it untold. The 5 km months are their own runs."""
+    import disk_convergence as dc
+
+    def row(b5, b10):
+        return {"seed": 0, "beta_5km": b5, "beta_10km": b10, "beta_20km": 0.17}
+
+    falling = dc.verdict_fine([row(0.10, 0.12), row(0.12, 0.14)])
+    assert falling["w_keeps_falling"] and not falling["x_turns_back"]
+    assert falling["change_5_less_10"] == pytest.approx([-0.02, -0.02])
+    assert dc.verdict_fine([row(0.15, 0.12), row(0.16, 0.14)])["x_turns_back"]
+    untold = dc.verdict_fine([row(0.10, 0.12), row(0.135, 0.14)])
+    assert not untold["w_keeps_falling"] and not untold["x_turns_back"]
+    assert not dc.verdict_fine([])["w_keeps_falling"]
+    name = dc.run_name("lead", "same_pa", dc.FINE_KM, 2026, "month", "meanspun")
+    assert name == "month-meanspun-lead-same_pa-5km-w2026"
+    assert "domain.resolution_m=5000" in dc.command("lead", "same_pa", dc.FINE_KM, 2026, "month", "meanspun")
