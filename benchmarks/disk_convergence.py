@@ -1228,6 +1228,37 @@ def spinup_state(family: str = "lead", law: str = "same_pa", variants=tuple(SPUN
     return out
 
 
+def figure_factors(family: str, law: str, data: dict, path: Path) -> None:
+    """Rule RD14: β on 20–120 km of every month (dots) and pooled (bars) at 20 and 10 km, for each spun-up start,
+    with the observed band."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    starts = [("spun", "1 m, A 1\n(RD9)"), ("thickspun", "1.6 m, A 1\n(RD14)"), ("concspun", "1 m, A 0.92\n(RD14)"),
+              ("meanspun", "1.6 m, A 0.92\n(RD13)"), ("packspun", "thick-and-thin\n(RD10)")]
+    starts = [(v, label) for v, label in starts if f"month-{v}-{family}-{law}" in data]
+    fig, ax = plt.subplots(figsize=(9.5, 4.6), layout="constrained")
+    ax.axhspan(0.17, 0.20, color="0.85", label="observed β (0.17–0.20)")
+    for i, (v, _) in enumerate(starts):
+        meshes = data[f"month-{v}-{family}-{law}"]["meshes"]
+        for km, dx, colour in (("20", -0.17, "tab:blue"), ("10", 0.17, "tab:red")):
+            betas = list(meshes[km]["beta_common_per_run"].values())
+            ax.bar(i + dx, meshes[km]["beta_common"], width=0.3, color=colour, alpha=0.35,
+                   label=f"{km} km, pooled" if i == 0 else None)
+            ax.plot(np.full(len(betas), i + dx), betas, "o", ms=4, color=colour,
+                    label=f"{km} km, each month" if i == 0 else None)
+    ax.set_xticks(range(len(starts)), [label for _, label in starts])
+    ax.set_ylabel("β on 20–120 km")
+    ax.set_ylim(0.0, 0.28)
+    ax.set_title(f"The disk's months from {len(starts)} 14-day spin-ups ({family}, {law.replace('_', ' ')}; "
+                 "eight wind seeds)")
+    ax.legend(loc="upper center", fontsize=8, ncol=5)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
 def factors(family: str = "lead", law: str = "same_pa") -> dict:
     """Rule RD14: each of :data:`FACTOR_VARIANTS` against RD9's spun-up compact 1 m ice, from the month sets'
     records (``report --stage month --variant V`` first)."""
@@ -1253,6 +1284,9 @@ def factors(family: str = "lead", law: str = "same_pa") -> dict:
             f"A {m['mean_concentration']:.3f}" for km, m in meshes.items()))
     _write_json("factors", {"family": family, "law": law, "against": "spun", "changes": changes, "verdict": v,
                             "spinup_state": state})
+    fig = ROOT / "docs" / "figures" / f"disk_month_factors_{family}.png"
+    figure_factors(family, law, json.loads(JSON.read_text()), fig)
+    print(f"wrote {fig.relative_to(ROOT)}")
     return {"changes": changes, "verdict": v}
 
 
