@@ -284,6 +284,20 @@ first two of the eight, chosen before the runs; a 5 km month costs about 45 minu
   pristine ice β on fixed widths did not change from 10 to 5 km (RD1), and the 10 km β stayed at 0.12 in every
   spin-up (RD13).
 
+Rule RD16 (written at 05:52 UTC, after RD14's result and before its runs). RD14 found that neither of the mean
+pack's factors alone raises the 20 km β (1.6 m: −0.006; concentration 0.92: −0.017) where both together raise
+it by +0.033, while the 10 km β is 0.120–0.123 from all five spin-ups. Every month of a set starts from the same
+spun-up state, one realisation of the spin-up's weather, and the paired intervals count only the months' noise.
+Variants ``spun2022``, ``spun2023`` and ``spun2024``: RD9's spin-up of uniform 1 m compact ice with the spin-up's
+wind seed 2022, 2023 or 2024 instead of 2025, family ``lead``, law ``same_pa``, the eight wind seeds of the
+months, at 20 km only (a 10 km month costs seven times a 20 km one). Command ``realisations``.
+  (y) The spin-up's realisation moves the 20 km β as much as the pack's state did if the pooled 20 km β of the
+      four realisations of the same pack (RD9's and the three new) spans at least 0.03 (largest less smallest).
+  Predicted: (y) holds, with a span of 0.03–0.05: the five spin-ups' 20 km β (0.120–0.171) do not follow their
+  factors, so one realisation of the spin-up's damage pattern decides much of it. If (y) holds, RD9–RD14's
+  "the pack raises the 20 km β" is not shown, and the disk's fall from 20 to 10 km (−0.001 to 0.051 over the
+  five spin-ups) is mostly the 20 km mesh's sensitivity to where the spin-up left its bands.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -307,6 +321,9 @@ first two of the eight, chosen before the runs; a 5 km month costs about 45 minu
     python benchmarks/disk_convergence.py factors                                                     # RD14
     python benchmarks/disk_convergence.py run --stage month --variant meanspun --km 5 --seeds 2026 2027 --jobs 2
     python benchmarks/disk_convergence.py fine                                                        # RD15
+    python benchmarks/disk_convergence.py run --stage month --variant spun2022 --km 20 --family lead --law same_pa
+    # (RD16; and spun2023, spun2024)
+    python benchmarks/disk_convergence.py realisations                                                # RD16
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
     python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
     # (RD10)
@@ -360,8 +377,10 @@ MEAN_PACK_SETS = ["initial.thickness_m=1.6", "initial.concentration=0.92"]
 #: ``thickspun`` and ``concspun`` (rule RD14): the means one at a time, the other factor as RD9's compact 1 m ice
 THICK_SETS = ["initial.thickness_m=1.6", "initial.concentration=1.0"]
 CONC_SETS = ["initial.thickness_m=1.0", "initial.concentration=0.92"]
+#: ``spun2022``–``spun2024`` (rule RD16): RD9's spin-up under another wind seed (replacing SPINUP_SETS's)
+REALISATION_SEEDS = (2022, 2023, 2024)
 SPUN_VARIANTS = {"spun": [], "packspun": PACK_SETS, "meanspun": MEAN_PACK_SETS, "thickspun": THICK_SETS,
-                 "concspun": CONC_SETS}
+                 "concspun": CONC_SETS, **{f"spun{sd}": [f"forcing.wind.seed={sd}"] for sd in REALISATION_SEEDS}}
 #: stage ``month``'s variants (``--variant``): scene overrides of the months, the basin's pieces taken out or put
 #: in one at a time (the spun-up ones' overrides are their state files, :func:`variant_sets`)
 MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], **{v: [] for v in SPUN_VARIANTS}}
@@ -378,8 +397,10 @@ def spinup_command(family: str, law: str, km: float, variant: str = "spun") -> l
     """The ``lagice run`` of :func:`make_spinup`."""
     cmd = [sys.executable, "-m", "lagice", "run", str(MONTH_SCENE), "--out",
            str(OUT / spinup_path(family, law, km, variant).stem)]
+    mine = {x.split("=")[0] for x in SPUN_VARIANTS[variant]}
+    base = [x for x in SPINUP_SETS if x.split("=")[0] not in mine]
     for x in [f"domain.resolution_m={km * 1e3:g}", f"rheology.strength_lab_pa={lab_cohesion_pa(family, law, km):.6g}",
-              *FAMILIES[family][0], *SPINUP_SETS, *SPUN_VARIANTS[variant]]:
+              *FAMILIES[family][0], *base, *SPUN_VARIANTS[variant]]:
         cmd += ["--set", x]
     return cmd
 
@@ -1325,6 +1346,36 @@ def fine(family: str = "lead", law: str = "same_pa") -> dict:
     return {"months": rows, "verdict": v}
 
 
+def verdict_realisations(beta_20km: dict) -> dict:
+    """Rule RD16 (y): the pooled 20 km β of the realisations of one pack's spin-up (``{variant: β}``) spans at
+    least 0.03."""
+    span = max(beta_20km.values()) - min(beta_20km.values())
+    return {"realisations": len(beta_20km), "span_20km": span, "y_realisation_moves_beta": bool(span >= 0.03)}
+
+
+def realisations(family: str = "lead", law: str = "same_pa") -> dict:
+    """Rule RD16: the pooled 20 km β of RD9's spin-up and of its realisations under the wind seeds of
+    :data:`REALISATION_SEEDS`, each over the eight months (the 20 km months only; ``spun``'s from its record)."""
+    data = json.loads(JSON.read_text())
+    beta, per_run = {"spun": data[f"month-spun-{family}-{law}"]["meshes"]["20"]["beta_common"]}, {}
+    for sd in REALISATION_SEEDS:
+        v = f"spun{sd}"
+        paths = [OUT / run_name(family, law, 20, s, "month", v) for s in MONTH_SEEDS]
+        missing = [p.name for p in paths if not (p / "snapshots" / "index.json").exists()]
+        if missing:
+            raise SystemExit(f"realisations: no finished run {missing} in {OUT}")
+        pooled = pool_windows({v: paths})[v]
+        beta[v], per_run[v] = pooled["beta_common"], pooled["beta_common_per_run"]
+    v = verdict_realisations(beta)
+    for name, b in beta.items():
+        print(f"{name}: pooled β on 20-120 km at 20 km {b:.3f}")
+    print("rule RD16:", json.dumps(v))
+    _write_json("realisations", {"family": family, "law": law, "km": 20, "beta_common_20km": beta,
+                                 "beta_common_per_run": per_run, "spinup_state": spinup_state(family, law, list(beta)),
+                                 "verdict": v})
+    return {"beta_common_20km": beta, "verdict": v}
+
+
 def verdict_fragmentation(bins: dict) -> dict:
     """Rule RD7 (k) on :func:`fragmentation`'s bins: the two meshes agree within 0.02 in every bin both fill
     (at least :data:`FRAGMENTATION_MIN_WINDOWS` windows each), and on each mesh β is at least 0.03 lower in
@@ -1346,7 +1397,8 @@ def verdict_fragmentation(bins: dict) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes", "healing", "factors", "fine"))
+    ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes", "healing", "factors", "fine",
+                                     "realisations"))
     ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
@@ -1367,6 +1419,9 @@ def main(argv=None) -> int:
         return 0
     if a.what == "floes":
         floes(a.family)
+        return 0
+    if a.what == "realisations":
+        realisations(a.family, a.law)
         return 0
     if a.what == "fine":
         fine(a.family, a.law)

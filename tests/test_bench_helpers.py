@@ -1699,3 +1699,20 @@ def test_disk_convergence_fine_mesh_verdict_needs_every_month():
     name = dc.run_name("lead", "same_pa", dc.FINE_KM, 2026, "month", "meanspun")
     assert name == "month-meanspun-lead-same_pa-5km-w2026"
     assert "domain.resolution_m=5000" in dc.command("lead", "same_pa", dc.FINE_KM, 2026, "month", "meanspun")
+
+
+def test_disk_convergence_realisations_replace_the_spin_up_wind_seed():
+    """Rule RD16: a realisation's spin-up runs under its own wind seed, given once (the scene refuses a key set
+    twice), with RD9's state file names kept apart; (y) needs a span of 0.03 in the 20 km β."""
+    import disk_convergence as dc
+
+    cmd = dc.spinup_command("lead", "same_pa", 20, "spun2023")
+    seeds = [x for x in cmd if x.startswith("forcing.wind.seed=")]
+    assert seeds == ["forcing.wind.seed=2023"]
+    assert "forcing.wind.seed=2025" in dc.spinup_command("lead", "same_pa", 20)
+    assert dc.spinup_path("lead", "same_pa", 20, "spun2023") != dc.spinup_path("lead", "same_pa", 20)
+    assert f"initial.state_file={dc.spinup_path('lead', 'same_pa', 20, 'spun2023')}" in dc.command(
+        "lead", "same_pa", 20, 2027, "month", "spun2023")
+    assert dc.verdict_realisations({"spun": 0.139, "spun2022": 0.15, "spun2023": 0.171})["y_realisation_moves_beta"]
+    small = dc.verdict_realisations({"spun": 0.139, "spun2022": 0.15, "spun2023": 0.16})
+    assert not small["y_realisation_moves_beta"] and small["span_20km"] == pytest.approx(0.021)
