@@ -1260,7 +1260,8 @@ def figure_factors(family: str, law: str, data: dict, path: Path) -> None:
     starts = [("spun", "1 m, A 1\n(RD9)"), ("thickspun", "1.6 m, A 1\n(RD14)"), ("concspun", "1 m, A 0.92\n(RD14)"),
               ("meanspun", "1.6 m, A 0.92\n(RD13)"), ("packspun", "thick-and-thin\n(RD10)")]
     starts = [(v, label) for v, label in starts if f"month-{v}-{family}-{law}" in data]
-    fig, ax = plt.subplots(figsize=(9.5, 4.6), layout="constrained")
+    n_real = len(data.get("realisations", {}).get("beta_common_per_run", {}))
+    fig, ax = plt.subplots(figsize=(9.5 + 1.6 * n_real, 4.6), layout="constrained")
     ax.axhspan(0.17, 0.20, color="0.85", label="observed β (0.17–0.20)")
     for i, (v, _) in enumerate(starts):
         meshes = data[f"month-{v}-{family}-{law}"]["meshes"]
@@ -1270,10 +1271,18 @@ def figure_factors(family: str, law: str, data: dict, path: Path) -> None:
                    label=f"{km} km, pooled" if i == 0 else None)
             ax.plot(np.full(len(betas), i + dx), betas, "o", ms=4, color=colour,
                     label=f"{km} km, each month" if i == 0 else None)
-    ax.set_xticks(range(len(starts)), [label for _, label in starts])
+    labels = [label for _, label in starts]
+    real = data.get("realisations", {})
+    for v, betas in real.get("beta_common_per_run", {}).items():
+        # rule RD16: RD9's spin-up under another wind seed, the 20 km mesh only
+        i = len(labels)
+        ax.bar(i - 0.17, real["beta_common_20km"][v], width=0.3, color="tab:blue", alpha=0.35)
+        ax.plot(np.full(len(betas), i - 0.17), list(betas.values()), "o", ms=4, color="tab:blue")
+        labels.append(f"1 m, A 1, spin-up\nwind {v[4:]} (RD16)")
+    ax.set_xticks(range(len(labels)), labels, fontsize=8 if len(labels) > 5 else None)
     ax.set_ylabel("β on 20–120 km")
     ax.set_ylim(0.0, 0.28)
-    ax.set_title(f"The disk's months from {len(starts)} 14-day spin-ups ({family}, {law.replace('_', ' ')}; "
+    ax.set_title(f"The disk's months from {len(starts) + n_real} 14-day spin-ups ({family}, {law.replace('_', ' ')}; "
                  "eight wind seeds)")
     ax.legend(loc="upper center", fontsize=8, ncol=5)
     fig.savefig(path, dpi=90)
@@ -1373,6 +1382,9 @@ def realisations(family: str = "lead", law: str = "same_pa") -> dict:
     _write_json("realisations", {"family": family, "law": law, "km": 20, "beta_common_20km": beta,
                                  "beta_common_per_run": per_run, "spinup_state": spinup_state(family, law, list(beta)),
                                  "verdict": v})
+    fig = ROOT / "docs" / "figures" / f"disk_month_factors_{family}.png"
+    figure_factors(family, law, json.loads(JSON.read_text()), fig)
+    print(f"wrote {fig.relative_to(ROOT)}")
     return {"beta_common_20km": beta, "verdict": v}
 
 
