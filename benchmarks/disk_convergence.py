@@ -272,6 +272,14 @@ its 90 % interval from 10 000 resamplings of the months (seeded).
   below its strength, as a stronger pack would be; the concentration changes the modulus and the relaxation
   time, which set how fast stress moves and relaxes, not where the pack fails.
 
+  Result (05:51 UTC): (u) and (v) fail; the prediction was wrong on the thickness. Paired with RD9's months, the
+  thickness alone changes the 20 km β by −0.006 (90 % interval −0.017 to +0.006; pooled 0.133), the
+  concentration alone by −0.017 (−0.024 to −0.010; pooled 0.120), where both together (RD13) raise it by +0.033:
+  the two changes do not add up (−0.022 against +0.033). At 10 km every variant is within ±0.003 of RD9 (pooled
+  0.120–0.121). Seen while the runs ran (``spinup_state``, no rule): every spin-up ends with an interior
+  concentration of 0.986–0.992 (leads refreeze), so what it hands to the months is its thickness and its damage
+  (elements above 0.9: 0.22–0.37 at 20 km, not in the order of the 20 km β).
+
 Rule RD15 (written at 04:43 UTC, before its runs). RD13's fall (0.171 at 20 km, 0.120 at 10 km) is the 20 km β
 moving, but two meshes cannot say which is nearer the converged answer. Variant ``meanspun`` on a 5 km mesh (its
 own 14-day spin-up, the same cohesion in pascals, family ``lead``), months of wind seeds 2026 and 2027 only (the
@@ -283,6 +291,11 @@ first two of the eight, chosen before the runs; a 5 km month costs about 45 minu
   Predicted: neither holds, the 5 km β within 0.015 of the 10 km one in at least one month: on one storm over
   pristine ice β on fixed widths did not change from 10 to 5 km (RD1), and the 10 km β stayed at 0.12 in every
   spin-up (RD13).
+
+  Result (07:01 UTC): (w) holds; the prediction was wrong. β on 20–120 km is 0.097 and 0.088 at 5 km against
+  0.153 and 0.136 at 10 km (0.171 and 0.180 at 20 km) in the months of wind seeds 2026 and 2027: lower by 0.056
+  and 0.047. Pooled over the two months the 5 km β is 0.092. On the weeks of the climatology, β on fixed
+  widths does not converge between 20 and 5 km: it falls by about 0.04–0.05 at each halving of the element.
 
 Rule RD16 (written at 05:52 UTC, after RD14's result and before its runs). RD14 found that neither of the mean
 pack's factors alone raises the 20 km β (1.6 m: −0.006; concentration 0.92: −0.017) where both together raise
@@ -297,6 +310,13 @@ months, at 20 km only (a 10 km month costs seven times a 20 km one). Command ``r
   factors, so one realisation of the spin-up's damage pattern decides much of it. If (y) holds, RD9–RD14's
   "the pack raises the 20 km β" is not shown, and the disk's fall from 20 to 10 km (−0.001 to 0.051 over the
   five spin-ups) is mostly the 20 km mesh's sensitivity to where the spin-up left its bands.
+
+  Result (06:25 UTC): (y) holds, as predicted: the four realisations' pooled 20 km β are 0.139 (2025, RD9), 0.137
+  (2022), 0.173 (2023) and 0.147 (2024), a span of 0.036; paired by month against 2025 the changes are 0.000,
+  +0.037 and +0.009. The eight 20 km spin-ups (five packs, three realisations) give 0.120–0.173 (mean 0.147,
+  standard deviation 0.018) and the five 10 km ones 0.120–0.123. So RD10's and RD13's "the pack raises the
+  20 km β" is not shown (one realisation each, with intervals that count the months only), and the disk's fall
+  from 20 to 10 km is about 0.026 on average, its size in one set mostly the 20 km mesh's realisation.
 
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
