@@ -846,6 +846,20 @@ def _seed_of(path) -> int:
     return int(Path(path).name.rsplit("-w", 1)[1])
 
 
+def beta_by_seed(meshes: dict) -> dict:
+    """``{"20": {wind seed: β}, "10": {...}}``: the β on the common widths run by run of a month set's meshes
+    (a :func:`pool_windows` result or a record's ``meshes``), keyed by wind seed."""
+    return {km: {_seed_of(k): v for k, v in meshes[km]["beta_common_per_run"].items()} for km in ("20", "10")}
+
+
+def finished_runs(paths: list, what: str) -> list:
+    """``paths`` if every run in it has finished, else a SystemExit naming the ones that have not."""
+    missing = [Path(p).name for p in paths if not (Path(p) / "snapshots" / "index.json").exists()]
+    if missing:
+        raise SystemExit(f"{what}: no finished run {missing} in {OUT}")
+    return paths
+
+
 def month_groups(family: str, law: str, variant: str = "", seeds=MONTH_SEEDS) -> dict:
     """``{"20": [run folder, ...], "10": [...]}``: the finished months of a set whose wind seed is in ``seeds``."""
     groups = {}
@@ -1182,7 +1196,7 @@ def healing(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE
     dbeta, sets = {}, {}
     for label, variant in (("healing", ""), ("no healing", "noheal")):
         pooled = pool_windows(month_groups(family, law, variant, seeds))
-        per = {km: {_seed_of(k): v for k, v in pooled[km]["beta_common_per_run"].items()} for km in ("20", "10")}
+        per = beta_by_seed(pooled)
         dbeta[label] = {sd: per["10"][sd] - per["20"][sd] for sd in per["20"] if sd in per["10"]}
         sets[label] = {"fall_pooled_common": pooled["20"]["beta_common"] - pooled["10"]["beta_common"],
                        "n_months": len(dbeta[label]),
@@ -1220,11 +1234,7 @@ def paired_changes(record: dict, base: dict) -> dict:
     """β on the common widths of a month set's ``record`` (a ``report --stage month`` entry of
     ``disk_convergence.json``) less ``base``'s, paired by wind seed on each mesh, and the record's own change
     from 20 to 10 km, each as (mean over the months, 90 % interval)."""
-    def per(rec):
-        return {km: {_seed_of(k): v for k, v in rec["meshes"][km]["beta_common_per_run"].items()}
-                for km in ("20", "10")}
-
-    p, b = per(record), per(base)
+    p, b = beta_by_seed(record["meshes"]), beta_by_seed(base["meshes"])
     out = {}
     for km in ("20", "10"):
         seeds = sorted(set(p[km]) & set(b[km]))
@@ -1356,12 +1366,9 @@ def verdict_fine(rows: list) -> dict:
 def fine(family: str = "lead", law: str = "same_pa") -> dict:
     """Rule RD15: :data:`FINE_VARIANT`'s months on the :data:`FINE_KM` mesh against the same months at 10 and
     20 km (from the set's record, written by ``report --stage month``)."""
-    paths = [OUT / run_name(family, law, FINE_KM, sd, "month", FINE_VARIANT) for sd in FINE_SEEDS]
-    missing = [p.name for p in paths if not (p / "snapshots" / "index.json").exists()]
-    if missing:
-        raise SystemExit(f"fine: no finished run {missing} in {OUT}")
-    record = json.loads(JSON.read_text())[f"{_month_prefix(FINE_VARIANT)}{family}-{law}"]["meshes"]
-    per = {km: {_seed_of(k): v for k, v in record[km]["beta_common_per_run"].items()} for km in ("20", "10")}
+    paths = finished_runs([OUT / run_name(family, law, FINE_KM, sd, "month", FINE_VARIANT) for sd in FINE_SEEDS],
+                          "fine")
+    per = beta_by_seed(json.loads(JSON.read_text())[f"{_month_prefix(FINE_VARIANT)}{family}-{law}"]["meshes"])
     pooled = pool_windows({f"{FINE_KM:g}": paths})[f"{FINE_KM:g}"]
     rows = [{"seed": _seed_of(p), "beta_5km": pooled["beta_common_per_run"][p.name],
              "beta_10km": per["10"][_seed_of(p)], "beta_20km": per["20"][_seed_of(p)]} for p in paths]
@@ -1389,10 +1396,7 @@ def realisations(family: str = "lead", law: str = "same_pa") -> dict:
     beta, per_run = {"spun": data[f"month-spun-{family}-{law}"]["meshes"]["20"]["beta_common"]}, {}
     for sd in REALISATION_SEEDS:
         v = f"spun{sd}"
-        paths = [OUT / run_name(family, law, 20, s, "month", v) for s in MONTH_SEEDS]
-        missing = [p.name for p in paths if not (p / "snapshots" / "index.json").exists()]
-        if missing:
-            raise SystemExit(f"realisations: no finished run {missing} in {OUT}")
+        paths = finished_runs([OUT / run_name(family, law, 20, s, "month", v) for s in MONTH_SEEDS], "realisations")
         pooled = pool_windows({v: paths})[v]
         beta[v], per_run[v] = pooled["beta_common"], pooled["beta_common_per_run"]
     v = verdict_realisations(beta)
