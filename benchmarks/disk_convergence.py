@@ -318,6 +318,27 @@ months, at 20 km only (a 10 km month costs seven times a 20 km one). Command ``r
   20 km β" is not shown (one realisation each, with intervals that count the months only), and the disk's fall
   from 20 to 10 km is about 0.026 on average, its size in one set mostly the 20 km mesh's realisation.
 
+Rule RD17 (written at 08:12 UTC on 2026-12-01, before its runs). RD15 found β on 20–120 km lower at 5 km than at
+10 km by 0.047–0.056 in two months, from one 5 km spin-up of one pack (``meanspun``). Variant ``spun`` (RD9's
+spin-up of uniform 1 m compact ice, wind seed 2025) on a 5 km mesh, its own 14-day spin-up, months of wind
+seeds 2026 and 2027 (the same two as RD15, chosen before the runs). Command ``fine --variant spun``: each 5 km
+month against the same month's 10 and 20 km β (RD9's record).
+  (w') β keeps falling below 10 km from another pack's spin-up if in both months it is lower at 5 km than at
+       10 km by at least 0.015; (x') it turns back if higher by at least 0.015 in both; neither: not told.
+  Predicted: (w') holds, by 0.03–0.05 in each month: RD15's fall was more than twice the 20 km realisations'
+  spread, and the 10 km β did not depend on the pack (0.120–0.123 from all five spin-ups).
+
+Rule RD18 (written at 08:12 UTC on 2026-12-01, before its runs). RD16 found that the spin-up's realisation moves
+the 20 km β by up to 0.034 (``spun2023``: 0.173 against ``spun``'s 0.139), while the five 10 km sets, each from
+a different pack's spin-up, agree within 0.003; no realisation of one pack was run at 10 km. Variant
+``spun2023`` (the realisation with the highest 20 km β) on the 10 km mesh, its own 14-day spin-up, the eight
+wind seeds 2026–2033. Command ``realisations --km 10``: its pooled 10 km β against ``spun``'s (RD9's record),
+and its months paired with ``spun``'s by wind seed.
+  (z) The 10 km β does not follow the spin-up's realisation if the pooled 10 km β of ``spun2023`` lies within
+      0.015 of ``spun``'s; it follows it if it is at least 0.02 higher.
+  Predicted: (z) holds (within 0.01): the 10 km mesh's many bands average the spin-up's pattern out, where the
+  20 km mesh's few bands keep it.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -344,6 +365,10 @@ months, at 20 km only (a 10 km month costs seven times a 20 km one). Command ``r
     python benchmarks/disk_convergence.py run --stage month --variant spun2022 --km 20 --family lead --law same_pa
     # (RD16; and spun2023, spun2024)
     python benchmarks/disk_convergence.py realisations                                                # RD16
+    python benchmarks/disk_convergence.py run --stage month --variant spun --km 5 --seeds 2026 2027 --jobs 2
+    python benchmarks/disk_convergence.py fine --variant spun                                         # RD17
+    python benchmarks/disk_convergence.py run --stage month --variant spun2023 --km 10 --family lead --law same_pa
+    python benchmarks/disk_convergence.py realisations --km 10                                        # RD18
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
     python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
     # (RD10)
@@ -1363,12 +1388,13 @@ def verdict_fine(rows: list) -> dict:
             "x_turns_back": bool(rows and all(x >= 0.015 for x in d))}
 
 
-def fine(family: str = "lead", law: str = "same_pa") -> dict:
-    """Rule RD15: :data:`FINE_VARIANT`'s months on the :data:`FINE_KM` mesh against the same months at 10 and
-    20 km (from the set's record, written by ``report --stage month``)."""
-    paths = finished_runs([OUT / run_name(family, law, FINE_KM, sd, "month", FINE_VARIANT) for sd in FINE_SEEDS],
+def fine(family: str = "lead", law: str = "same_pa", variant: str = FINE_VARIANT) -> dict:
+    """Rules RD15 (``meanspun``) and RD17 (``spun``): a variant's months on the :data:`FINE_KM` mesh against the
+    same months at 10 and 20 km (from the set's record, written by ``report --stage month``)."""
+    rule = "RD15" if variant == FINE_VARIANT else "RD17"
+    paths = finished_runs([OUT / run_name(family, law, FINE_KM, sd, "month", variant) for sd in FINE_SEEDS],
                           "fine")
-    per = beta_by_seed(json.loads(JSON.read_text())[f"{_month_prefix(FINE_VARIANT)}{family}-{law}"]["meshes"])
+    per = beta_by_seed(json.loads(JSON.read_text())[f"{_month_prefix(variant)}{family}-{law}"]["meshes"])
     pooled = pool_windows({f"{FINE_KM:g}": paths})[f"{FINE_KM:g}"]
     rows = [{"seed": _seed_of(p), "beta_5km": pooled["beta_common_per_run"][p.name],
              "beta_10km": per["10"][_seed_of(p)], "beta_20km": per["20"][_seed_of(p)]} for p in paths]
@@ -1376,9 +1402,9 @@ def fine(family: str = "lead", law: str = "same_pa") -> dict:
         print(f"wind seed {r['seed']}: β on 20-120 km {r['beta_20km']:.3f} (20 km) {r['beta_10km']:.3f} (10 km) "
               f"{r['beta_5km']:.3f} (5 km)")
     v = verdict_fine(rows)
-    print("rule RD15:", json.dumps(v))
-    _write_json(f"fine-{FINE_VARIANT}", {"family": family, "law": law, "km": FINE_KM, "months": rows,
-                                         "mesh": pooled, "verdict": v})
+    print(f"rule {rule}:", json.dumps(v))
+    _write_json(f"fine-{variant}", {"family": family, "law": law, "km": FINE_KM, "rule": rule, "months": rows,
+                                    "mesh": pooled, "verdict": v})
     return {"months": rows, "verdict": v}
 
 
@@ -1410,6 +1436,41 @@ def realisations(family: str = "lead", law: str = "same_pa") -> dict:
     figure_factors(family, law, json.loads(JSON.read_text()), fig)
     print(f"wrote {fig.relative_to(ROOT)}")
     return {"beta_common_20km": beta, "verdict": v}
+
+
+#: rule RD18: the realisation of RD9's spin-up with the highest 20 km β (RD16), on the 10 km mesh
+REALISATION_10KM_VARIANT = "spun2023"
+
+
+def verdict_realisation_10km(beta_variant: float, beta_spun: float) -> dict:
+    """Rule RD18 (z): the pooled 10 km β of a realisation within 0.015 of ``spun``'s (does not follow it), or at
+    least 0.02 higher (follows it); else neither."""
+    d = beta_variant - beta_spun
+    return {"change_10km": d, "z_10km_keeps_its_beta": bool(abs(d) < 0.015), "follows_realisation": bool(d >= 0.02)}
+
+
+def realisation_10km(family: str = "lead", law: str = "same_pa", variant: str = REALISATION_10KM_VARIANT) -> dict:
+    """Rule RD18: ``variant``'s eight months on the 10 km mesh against RD9's (``spun``, from its record), pooled
+    and paired by wind seed, beside the same realisation's change at 20 km (RD16's record)."""
+    data = json.loads(JSON.read_text())
+    paths = finished_runs([OUT / run_name(family, law, 10, s, "month", variant) for s in MONTH_SEEDS],
+                          "realisations --km 10")
+    pooled = pool_windows({variant: paths})[variant]
+    spun = data[f"month-spun-{family}-{law}"]["meshes"]
+    base = beta_by_seed(spun)["10"]
+    mine = {_seed_of(k): b for k, b in pooled["beta_common_per_run"].items()}
+    seeds = sorted(set(mine) & set(base))
+    r20 = data["realisations"]["beta_common_20km"]
+    v = verdict_realisation_10km(pooled["beta_common"], spun["10"]["beta_common"])
+    v["paired_change_10km"] = mean_interval([mine[s] - base[s] for s in seeds])
+    v["change_20km"] = r20[variant] - r20["spun"]
+    print(f"{variant}: pooled β on 20-120 km at 10 km {pooled['beta_common']:.3f} against spun's "
+          f"{spun['10']['beta_common']:.3f} (at 20 km {r20[variant]:.3f} against {r20['spun']:.3f})")
+    print("rule RD18:", json.dumps(v))
+    _write_json(f"realisation-10km-{variant}", {"family": family, "law": law, "km": 10, "variant": variant,
+                                                 "beta_common_per_run": pooled["beta_common_per_run"],
+                                                 "beta_common": pooled["beta_common"], "verdict": v})
+    return v
 
 
 def verdict_fragmentation(bins: dict) -> dict:
@@ -1448,7 +1509,8 @@ def main(argv=None) -> int:
                     help="stage month: noheal (healing.law = none; rule RD8), spun (from a 14-day spin-up; RD9), "
                          "packspun (from a 14-day spin-up of the basin's thick-and-thin pack; RD10), meanspun "
                          "(the same from uniform ice of the pack's means; RD13), thickspun and concspun (its "
-                         "thickness alone, its concentration alone; RD14)")
+                         "thickness alone, its concentration alone; RD14); fine: the spun-up variant "
+                         "(default meanspun, RD15; spun, RD17)")
     a = ap.parse_args(argv)
     if a.what == "fragmentation":
         fragmentation(a.family)
@@ -1457,10 +1519,18 @@ def main(argv=None) -> int:
         floes(a.family)
         return 0
     if a.what == "realisations":
-        realisations(a.family, a.law)
+        if a.km and a.km != [20.0]:
+            if a.km != [10.0]:
+                ap.error("realisations: --km 20 (rule RD16, the default) or --km 10 (rule RD18)")
+            realisation_10km(a.family, a.law)
+        else:
+            realisations(a.family, a.law)
         return 0
     if a.what == "fine":
-        fine(a.family, a.law)
+        variant = a.variant or FINE_VARIANT
+        if variant not in SPUN_VARIANTS:
+            ap.error(f"fine: --variant must be a spun-up variant ({', '.join(SPUN_VARIANTS)}), not {variant!r}")
+        fine(a.family, a.law, variant)
         return 0
     if a.what == "factors":
         factors(a.family, a.law)
