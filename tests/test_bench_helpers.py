@@ -1716,3 +1716,25 @@ def test_disk_convergence_realisations_replace_the_spin_up_wind_seed():
     assert dc.verdict_realisations({"spun": 0.139, "spun2022": 0.15, "spun2023": 0.171})["y_realisation_moves_beta"]
     small = dc.verdict_realisations({"spun": 0.139, "spun2022": 0.15, "spun2023": 0.16})
     assert not small["y_realisation_moves_beta"] and small["span_20km"] == pytest.approx(0.021)
+
+
+def test_disk_convergence_second_pack_fine_mesh_and_realisation_at_10km():
+    """Rules RD17 and RD18: ``fine`` reads a named spun-up variant's 5 km months, RD18's verdict separates
+    "keeps its β" (within 0.015), "follows the realisation" (0.02 higher) and neither, and the command line
+    refuses a mesh or variant no rule names before any work."""
+    import disk_convergence as dc
+
+    assert dc.run_name("lead", "same_pa", dc.FINE_KM, 2026, "month", "spun") == "month-spun-lead-same_pa-5km-w2026"
+    kept = dc.verdict_realisation_10km(0.128, 0.120)
+    assert kept["z_10km_keeps_its_beta"] and not kept["follows_realisation"]
+    assert kept["change_10km"] == pytest.approx(0.008)
+    follows = dc.verdict_realisation_10km(0.141, 0.120)
+    assert follows["follows_realisation"] and not follows["z_10km_keeps_its_beta"]
+    between = dc.verdict_realisation_10km(0.137, 0.120)
+    assert not between["follows_realisation"] and not between["z_10km_keeps_its_beta"]
+    lower = dc.verdict_realisation_10km(0.100, 0.120)
+    assert not lower["follows_realisation"] and not lower["z_10km_keeps_its_beta"]
+    with pytest.raises(SystemExit):
+        dc.main(["realisations", "--km", "5"])
+    with pytest.raises(SystemExit):
+        dc.main(["fine", "--variant", "noheal"])
