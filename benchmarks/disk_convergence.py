@@ -328,6 +328,9 @@ month against the same month's 10 and 20 km β (RD9's record).
   Predicted: (w') holds, by 0.03–0.05 in each month: RD15's fall was more than twice the 20 km realisations'
   spread, and the 10 km β did not depend on the pack (0.120–0.123 from all five spin-ups).
 
+  Result (10:50 UTC): (w') holds, as predicted. β on 20–120 km is 0.098 and 0.090 at 5 km against 0.144 and 0.136
+  at 10 km (0.158 and 0.151 at 20 km), lower by 0.046 and 0.047, as RD15's 0.056 and 0.047 from another pack.
+
 Rule RD18 (written at 08:12 UTC on 2026-12-01, before its runs). RD16 found that the spin-up's realisation moves
 the 20 km β by up to 0.034 (``spun2023``: 0.173 against ``spun``'s 0.139), while the five 10 km sets, each from
 a different pack's spin-up, agree within 0.003; no realisation of one pack was run at 10 km. Variant
@@ -338,6 +341,9 @@ and its months paired with ``spun``'s by wind seed.
       0.015 of ``spun``'s; it follows it if it is at least 0.02 higher.
   Predicted: (z) holds (within 0.01): the 10 km mesh's many bands average the spin-up's pattern out, where the
   20 km mesh's few bands keep it.
+
+  Result (10:50 UTC): (z) holds, as predicted. ``spun2023``'s pooled 10 km β is 0.119 against ``spun``'s 0.120
+  (paired by month −0.002, 90 % interval −0.014 to +0.010), where at 20 km it was 0.034 higher.
 
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
