@@ -345,6 +345,21 @@ and its months paired with ``spun``'s by wind seed.
   Result (10:50 UTC): (z) holds, as predicted. ``spun2023``'s pooled 10 km β is 0.119 against ``spun``'s 0.120
   (paired by month −0.002, 90 % interval −0.014 to +0.010), where at 20 km it was 0.034 higher.
 
+Rule RD19 (written at 14:43 UTC on 2026-12-01, before its runs; a 1-hour run at 40 km was made first to check that
+the scene accepts the override, and none of its output was looked at but the log). Of the month's time-dependent
+pieces, one storm on pristine ice has none and shows no fall; healing's part is within the months' noise (RD12);
+a fixed mesh does not stop the basin's fall (forty-fifth session). Thermodynamics (ice growth, and new ice in the
+leads that the bands open) was never taken out. Variant ``nothermo`` (``thermo.enabled = false``; healing keeps
+its air temperature), family ``lead``, law ``same_pa``, pristine start, the 16 wind seeds 2026–2041, at 20 and
+10 km. Command ``thermodynamics``: per month Δβ = β on 20–120 km at 10 km less at 20 km; thermodynamics' part is
+Δβ(RD12's set with healing, from its record) − Δβ(no thermodynamics), paired by wind seed, mean and 90 % interval
+from 10 000 resamplings of the months (seeded), as RD12.
+  (t) The fall does not need thermodynamics if, without it, the mean month-by-month Δβ has its 90 % interval
+      below 0.
+  (t') Thermodynamics' part is shown if its 90 % interval excludes 0 (below 0: it makes the fall larger).
+  Predicted: (t) holds, with a mean Δβ of −0.015 to −0.030; (t') is not shown (a part within ±0.01). Then the
+  fall needs only the breaking and healing of the pack under weeks of storms.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -375,6 +390,9 @@ and its months paired with ``spun``'s by wind seed.
     python benchmarks/disk_convergence.py fine --variant spun                                         # RD17
     python benchmarks/disk_convergence.py run --stage month --variant spun2023 --km 10 --family lead --law same_pa
     python benchmarks/disk_convergence.py realisations --km 10                                        # RD18
+    python benchmarks/disk_convergence.py run --stage month --variant nothermo --seeds 2026 2027 2028 2029 2030 \
+        2031 2032 2033 2034 2035 2036 2037 2038 2039 2040 2041 --family lead --law same_pa --jobs 2
+    python benchmarks/disk_convergence.py thermodynamics                                              # RD19
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
     python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
     # (RD10)
@@ -434,7 +452,8 @@ SPUN_VARIANTS = {"spun": [], "packspun": PACK_SETS, "meanspun": MEAN_PACK_SETS, 
                  "concspun": CONC_SETS, **{f"spun{sd}": [f"forcing.wind.seed={sd}"] for sd in REALISATION_SEEDS}}
 #: stage ``month``'s variants (``--variant``): scene overrides of the months, the basin's pieces taken out or put
 #: in one at a time (the spun-up ones' overrides are their state files, :func:`variant_sets`)
-MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], **{v: [] for v in SPUN_VARIANTS}}
+MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], "nothermo": ["thermo.enabled=false"],
+                  **{v: [] for v in SPUN_VARIANTS}}
 SPINUP_SETS = ["forcing.wind.seed=2025", 'run.start_date="2026-01-01 00:00:00"', "run.duration=14d", "output.every=7d"]
 
 
@@ -1257,6 +1276,49 @@ def verdict_healing(part) -> dict:
     return {"n_months": len(part), "healing_part": m, "interval_90": [lo, hi], "s_shown": bool(hi < 0.0)}
 
 
+def verdict_thermodynamics(dbeta_without: list, part: list) -> dict:
+    """Rule RD19 (t), (t'): the fall without thermodynamics is there if the 90 % interval of its mean Δβ lies
+    below 0; thermodynamics' part is shown if the 90 % interval of its mean excludes 0."""
+    m, lo, hi = mean_interval(dbeta_without)
+    pm, plo, phi = mean_interval(part)
+    return {"n_months": len(part), "dbeta_without_thermo": m, "dbeta_without_interval_90": [lo, hi],
+            "t_fall_without_thermo": bool(hi < 0.0), "thermo_part": pm, "thermo_part_interval_90": [plo, phi],
+            "t_prime_part_shown": bool(plo > 0.0 or phi < 0.0)}
+
+
+def thermodynamics(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE_MONTH_SEEDS) -> dict:
+    """Rule RD19: Δβ (β on 20–120 km at 10 km less at 20 km) month by month without thermodynamics (variant
+    ``nothermo``), and thermodynamics' part, Δβ(RD12's set with healing, from its record) − Δβ(nothermo), paired
+    by wind seed; beside it, the first eight months paired with RD5's record on each mesh."""
+    data = json.loads(JSON.read_text())
+    pooled = pool_windows(month_groups(family, law, "nothermo", seeds))
+    per = beta_by_seed(pooled)
+    mine = {sd: per["10"][sd] - per["20"][sd] for sd in per["20"] if sd in per["10"]}
+    base = {int(k): v for k, v in data["healing"]["sets"]["healing"]["dbeta_by_month"].items()}
+    common = sorted(set(mine) & set(base))
+    part = [base[sd] - mine[sd] for sd in common]
+    v = verdict_thermodynamics([mine[sd] for sd in common], part)
+    fall = pooled["20"]["beta_common"] - pooled["10"]["beta_common"]
+    rd5 = data[f"month-{family}-{law}"]
+    record = {"meshes": {km: {"beta_common_per_run": {k: b for k, b in pooled[km]["beta_common_per_run"].items()
+                                                      if _seed_of(k) in MONTH_SEEDS},
+                              "beta_common": pooled[km]["beta_common"]} for km in ("20", "10")}}
+    against_rd5 = paired_changes(record, rd5)
+    print(f"no thermodynamics: {len(mine)} months, pooled β on 20-120 km {pooled['20']['beta_common']:.3f} at 20 km, "
+          f"{pooled['10']['beta_common']:.3f} at 10 km (fall {fall:.3f})")
+    print("against RD5's eight months, paired:", json.dumps(against_rd5))
+    print("rule RD19:", json.dumps(v))
+    _write_json("thermodynamics", {"family": family, "law": law, "months_paired": common,
+                                   "dbeta_by_month_without": {str(k): mine[k] for k in sorted(mine)},
+                                   "thermo_part_by_month": dict(zip(map(str, common), part)),
+                                   "beta_common": {km: pooled[km]["beta_common"] for km in ("20", "10")},
+                                   "beta_common_per_run": {km: pooled[km]["beta_common_per_run"]
+                                                           for km in ("20", "10")},
+                                   "fall_pooled_common": fall, "against_rd5_first_eight": against_rd5,
+                                   "verdict": v})
+    return v
+
+
 #: rule RD14: the spun-up variants whose β is paired with RD9's (``spun``)
 FACTOR_VARIANTS = ("thickspun", "concspun", "meanspun")
 
@@ -1501,7 +1563,7 @@ def verdict_fragmentation(bins: dict) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes", "healing", "factors", "fine",
-                                     "realisations"))
+                                     "realisations", "thermodynamics"))
     ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
@@ -1512,7 +1574,8 @@ def main(argv=None) -> int:
     ap.add_argument("--stage", choices=("storm", "month"), default="storm",
                     help="storm: one cyclone, 3 days (default); month: examples/winter_disk.toml, 28 days (RD5)")
     ap.add_argument("--variant", choices=sorted(MONTH_VARIANTS), default="",
-                    help="stage month: noheal (healing.law = none; rule RD8), spun (from a 14-day spin-up; RD9), "
+                    help="stage month: noheal (healing.law = none; rule RD8), nothermo (thermo.enabled = false; "
+                         "RD19), spun (from a 14-day spin-up; RD9), "
                          "packspun (from a 14-day spin-up of the basin's thick-and-thin pack; RD10), meanspun "
                          "(the same from uniform ice of the pack's means; RD13), thickspun and concspun (its "
                          "thickness alone, its concentration alone; RD14); fine: the spun-up variant "
@@ -1540,6 +1603,9 @@ def main(argv=None) -> int:
         return 0
     if a.what == "factors":
         factors(a.family, a.law)
+        return 0
+    if a.what == "thermodynamics":
+        thermodynamics(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
         return 0
     if a.what == "healing":
         healing(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)

@@ -1738,3 +1738,30 @@ def test_disk_convergence_second_pack_fine_mesh_and_realisation_at_10km():
         dc.main(["realisations", "--km", "5"])
     with pytest.raises(SystemExit):
         dc.main(["fine", "--variant", "noheal"])
+
+
+def test_disk_convergence_thermodynamics_variant_and_verdict():
+    """Rule RD19: variant ``nothermo`` switches thermodynamics off in the month's command (and nothing else), and
+    the verdict separates a fall without thermodynamics (interval below 0) from none, and a part shown (interval
+    excluding 0, either side) from noise."""
+    import disk_convergence as dc
+
+    def sets_of(cmd):
+        return [cmd[i + 1] for i, x in enumerate(cmd) if x == "--set"]
+
+    cmd = dc.command("lead", "same_pa", 10, 2030, "month", "nothermo")
+    assert cmd[cmd.index("--out") + 1].endswith("month-nothermo-lead-same_pa-10km-w2030")
+    assert sets_of(cmd) == sets_of(dc.command("lead", "same_pa", 10, 2030, "month")) + ["thermo.enabled=false"]
+    falls = [-0.02, -0.03, -0.01, -0.025, -0.015, -0.02, -0.03, -0.01]
+    v = dc.verdict_thermodynamics(falls, [0.004, -0.006, 0.002, -0.003, 0.005, -0.004, 0.001, -0.002])
+    assert v["t_fall_without_thermo"] and not v["t_prime_part_shown"]
+    assert v["dbeta_without_thermo"] == pytest.approx(np.mean(falls))
+    lo, hi = v["dbeta_without_interval_90"]
+    assert lo < v["dbeta_without_thermo"] < hi < 0.0
+    none = dc.verdict_thermodynamics([0.02, -0.03, 0.01, -0.01, 0.015, -0.02, 0.0, 0.01], [0.0] * 8)
+    assert not none["t_fall_without_thermo"]
+    parts = [0.01, 0.02, 0.015, 0.012, 0.018, 0.011, 0.02, 0.016]
+    above = dc.verdict_thermodynamics(falls, parts)
+    below = dc.verdict_thermodynamics(falls, [-x for x in parts])
+    assert above["t_prime_part_shown"] and above["thermo_part"] > 0.0
+    assert below["t_prime_part_shown"] and below["thermo_part"] < 0.0
