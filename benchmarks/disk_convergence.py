@@ -360,6 +360,20 @@ from 10 000 resamplings of the months (seeded), as RD12.
   Predicted: (t) holds, with a mean Δβ of −0.015 to −0.030; (t') is not shown (a part within ±0.01). Then the
   fall needs only the breaking and healing of the pack under weeks of storms.
 
+Rule RD20 (written at 14:44 UTC on 2026-12-01, before its runs and before RD19's result; a 1-hour run at 40 km was
+made first to check that the scene accepts the overrides, and only its log was looked at). One storm on pristine
+ice shows no fall; weeks of the climatology with all the month's pieces do (RD5, RD12). Which of the pieces the
+fall needs is asked one at a time (healing: RD8, RD12; thermodynamics: RD19). Variant ``mechanics`` takes them all
+out at once, leaving the damage mechanics under weeks of storms: no thermodynamics, no healing, no mesh motion and
+no remeshing (the fields stay on the first mesh). Family ``lead``, law ``same_pa``, pristine start, wind seeds
+2026–2033, at 20 and 10 km. Command ``mechanics``: per month Δβ = β on 20–120 km at 10 km less at 20 km, mean and
+90 % interval from 10 000 resamplings of the months (seeded); beside it, the months paired on each mesh with
+RD5's record.
+  (u) The fall needs none of the month's pieces but its storms if the mean month-by-month Δβ has its 90 %
+      interval below 0 and the pooled β on 20–120 km is at least 0.015 lower at 10 km.
+  Predicted: (u) holds, with a fall of 0.01–0.03. Then the disk's fall is the damage law's answer to a sequence
+  of storms on a fixed mesh, and can be studied without the Lagrangian machinery.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -393,6 +407,8 @@ from 10 000 resamplings of the months (seeded), as RD12.
     python benchmarks/disk_convergence.py run --stage month --variant nothermo --seeds 2026 2027 2028 2029 2030 \
         2031 2032 2033 2034 2035 2036 2037 2038 2039 2040 2041 --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py thermodynamics                                              # RD19
+    python benchmarks/disk_convergence.py run --stage month --variant mechanics --family lead --law same_pa --jobs 2
+    python benchmarks/disk_convergence.py mechanics                                                   # RD20
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
     python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
     # (RD10)
@@ -453,6 +469,8 @@ SPUN_VARIANTS = {"spun": [], "packspun": PACK_SETS, "meanspun": MEAN_PACK_SETS, 
 #: stage ``month``'s variants (``--variant``): scene overrides of the months, the basin's pieces taken out or put
 #: in one at a time (the spun-up ones' overrides are their state files, :func:`variant_sets`)
 MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], "nothermo": ["thermo.enabled=false"],
+                  "mechanics": ["thermo.enabled=false", "healing.law=none", "lagrangian.enabled=false",
+                                "remesh.enabled=false"],
                   **{v: [] for v in SPUN_VARIANTS}}
 SPINUP_SETS = ["forcing.wind.seed=2025", 'run.start_date="2026-01-01 00:00:00"', "run.duration=14d", "output.every=7d"]
 
@@ -1319,6 +1337,38 @@ def thermodynamics(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS
     return v
 
 
+def verdict_mechanics(dbeta: list, fall_pooled: float) -> dict:
+    """Rule RD20 (u): the fall is there with the mechanics alone if the 90 % interval of the mean month-by-month
+    Δβ lies below 0 and the pooled β on 20–120 km is at least 0.015 lower at 10 km."""
+    m, lo, hi = mean_interval(dbeta)
+    return {"n_months": len(dbeta), "dbeta": m, "dbeta_interval_90": [lo, hi], "fall_pooled_common": fall_pooled,
+            "u_fall_with_mechanics_alone": bool(hi < 0.0 and fall_pooled >= 0.015)}
+
+
+def mechanics(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS) -> dict:
+    """Rule RD20: variant ``mechanics``'s months (no thermodynamics, healing, mesh motion or remeshing), Δβ month
+    by month and pooled, and the months paired on each mesh with RD5's record."""
+    data = json.loads(JSON.read_text())
+    pooled = pool_windows(month_groups(family, law, "mechanics", seeds))
+    per = beta_by_seed(pooled)
+    mine = {sd: per["10"][sd] - per["20"][sd] for sd in sorted(per["20"]) if sd in per["10"]}
+    fall = pooled["20"]["beta_common"] - pooled["10"]["beta_common"]
+    v = verdict_mechanics(list(mine.values()), fall)
+    record = {"meshes": {km: {k: pooled[km][k] for k in ("beta_common_per_run", "beta_common")} for km in ("20", "10")}}
+    against_rd5 = paired_changes(record, data[f"month-{family}-{law}"])
+    print(f"mechanics alone: {len(mine)} months, pooled β on 20-120 km {pooled['20']['beta_common']:.3f} at 20 km, "
+          f"{pooled['10']['beta_common']:.3f} at 10 km (fall {fall:.3f})")
+    print("against RD5, paired:", json.dumps(against_rd5))
+    print("rule RD20:", json.dumps(v))
+    _write_json("mechanics", {"family": family, "law": law, "overrides": MONTH_VARIANTS["mechanics"],
+                              "dbeta_by_month": {str(k): x for k, x in mine.items()},
+                              "beta_common": {km: pooled[km]["beta_common"] for km in ("20", "10")},
+                              "beta_common_per_run": {km: pooled[km]["beta_common_per_run"] for km in ("20", "10")},
+                              "mean_total_per_day": {km: pooled[km]["mean_total_per_day"] for km in ("20", "10")},
+                              "against_rd5": against_rd5, "verdict": v})
+    return v
+
+
 #: rule RD14: the spun-up variants whose β is paired with RD9's (``spun``)
 FACTOR_VARIANTS = ("thickspun", "concspun", "meanspun")
 
@@ -1563,7 +1613,7 @@ def verdict_fragmentation(bins: dict) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes", "healing", "factors", "fine",
-                                     "realisations", "thermodynamics"))
+                                     "realisations", "thermodynamics", "mechanics"))
     ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
@@ -1575,7 +1625,8 @@ def main(argv=None) -> int:
                     help="storm: one cyclone, 3 days (default); month: examples/winter_disk.toml, 28 days (RD5)")
     ap.add_argument("--variant", choices=sorted(MONTH_VARIANTS), default="",
                     help="stage month: noheal (healing.law = none; rule RD8), nothermo (thermo.enabled = false; "
-                         "RD19), spun (from a 14-day spin-up; RD9), "
+                         "RD19), mechanics (nor healing, mesh motion or remeshing; RD20), spun (from a 14-day spin-up; "
+                         "RD9), "
                          "packspun (from a 14-day spin-up of the basin's thick-and-thin pack; RD10), meanspun "
                          "(the same from uniform ice of the pack's means; RD13), thickspun and concspun (its "
                          "thickness alone, its concentration alone; RD14); fine: the spun-up variant "
@@ -1603,6 +1654,9 @@ def main(argv=None) -> int:
         return 0
     if a.what == "factors":
         factors(a.family, a.law)
+        return 0
+    if a.what == "mechanics":
+        mechanics(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS)
         return 0
     if a.what == "thermodynamics":
         thermodynamics(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)

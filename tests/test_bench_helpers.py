@@ -1765,3 +1765,22 @@ def test_disk_convergence_thermodynamics_variant_and_verdict():
     below = dc.verdict_thermodynamics(falls, [-x for x in parts])
     assert above["t_prime_part_shown"] and above["thermo_part"] > 0.0
     assert below["t_prime_part_shown"] and below["thermo_part"] < 0.0
+
+
+def test_disk_convergence_mechanics_variant_and_verdict():
+    """Rule RD20: variant ``mechanics`` takes thermodynamics, healing, mesh motion and remeshing out of the month
+    (and changes nothing else), and its verdict needs both a month-by-month fall and a pooled one of 0.015."""
+    import disk_convergence as dc
+
+    def sets_of(cmd):
+        return [cmd[i + 1] for i, x in enumerate(cmd) if x == "--set"]
+
+    extra = sets_of(dc.command("lead", "same_pa", 20, 2026, "month", "mechanics"))[
+        len(sets_of(dc.command("lead", "same_pa", 20, 2026, "month"))):]
+    assert sorted(extra) == ["healing.law=none", "lagrangian.enabled=false", "remesh.enabled=false",
+                             "thermo.enabled=false"]
+    falls = [-0.02, -0.03, -0.01, -0.025, -0.015, -0.02, -0.03, -0.01]
+    assert dc.verdict_mechanics(falls, 0.02)["u_fall_with_mechanics_alone"]
+    assert not dc.verdict_mechanics(falls, 0.010)["u_fall_with_mechanics_alone"]
+    mixed = dc.verdict_mechanics([0.02, -0.03, 0.01, -0.01, 0.015, -0.02, 0.0, 0.01], 0.02)
+    assert not mixed["u_fall_with_mechanics_alone"] and mixed["dbeta_interval_90"][1] > 0.0
