@@ -360,6 +360,15 @@ from 10 000 resamplings of the months (seeded), as RD12.
   Predicted: (t) holds, with a mean Δβ of −0.015 to −0.030; (t') is not shown (a part within ±0.01). Then the
   fall needs only the breaking and healing of the pack under weeks of storms.
 
+  Result (03:25 UTC on 2026-12-02; the runs of 14:45 were lost with that session's machine and made again): (t)
+  holds, with a smaller fall than predicted: without thermodynamics the mean Δβ is −0.012 (90 % interval −0.021
+  to −0.003; pooled β on 20–120 km 0.152 at 20 km and 0.139 at 10 km). (t') is shown, against the prediction,
+  only just: thermodynamics' part is −0.012 (−0.024 to −0.0003), about half the fall with it (−0.024), negative
+  in 10 of 16 months. The two halves disagree: −0.003 over RD5's eight seeds (2026–2033; without thermodynamics
+  β there is +0.003 at 20 km and +0.006 at 10 km against RD5, both intervals across 0) and −0.022 over the
+  other eight, where the fall without thermodynamics is −0.019 and −0.006. A part shown by a margin of 0.0003,
+  and carried by half the months, is read as weak evidence.
+
 Rule RD20 (written at 14:44 UTC on 2026-12-01, before its runs and before RD19's result; a 1-hour run at 40 km was
 made first to check that the scene accepts the overrides, and only its log was looked at). One storm on pristine
 ice shows no fall; weeks of the climatology with all the month's pieces do (RD5, RD12). Which of the pieces the
@@ -373,6 +382,14 @@ RD5's record.
       interval below 0 and the pooled β on 20–120 km is at least 0.015 lower at 10 km.
   Predicted: (u) holds, with a fall of 0.01–0.03. Then the disk's fall is the damage law's answer to a sequence
   of storms on a fixed mesh, and can be studied without the Lagrangian machinery.
+
+  Result (03:40 UTC on 2026-12-02; runs made again, as RD19's): (u) fails; the prediction was wrong. With the
+  mechanics alone the pooled β on 20–120 km is 0.131 at 20 km and 0.129 at 10 km (a fall of 0.002); month by
+  month Δβ is −0.004 (90 % interval −0.013 to +0.008), lower at 10 km in 6 of 8 months. Against RD5's months
+  (all the pieces) the 20 km β is lower by 0.016 (−0.031 to −0.0003) and the 10 km β unchanged (+0.003,
+  −0.003 to +0.008): taking the pieces out brings the 20 km β down to the 10 km one. Each piece taken out alone
+  left a fall (healing: RD12, thermodynamics: RD19; the moving mesh and remeshing: the basin's fixed month of
+  the forty-fifth session), so the fall needs at least one of them and no one of them alone is needed.
 
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
