@@ -391,6 +391,23 @@ RD5's record.
   left a fall (healing: RD12, thermodynamics: RD19; the moving mesh and remeshing: the basin's fixed month of
   the forty-fifth session), so the fall needs at least one of them and no one of them alone is needed.
 
+Rule RD21 (written at 03:43 UTC on 2026-12-02, after RD20's result and before its own runs; a 1-hour run at
+40 km of each variant was made first to check that the scene accepts the overrides, and only its log was looked
+at). RD20 took every time-dependent piece out of the month and the fall went with them, while each one taken out
+alone left it. Which of them brings it back alone? Two variants put one piece back into ``mechanics``:
+``mechheal`` (neXtSIM's healing back; no thermodynamics, fixed mesh) and ``mechmove`` (mesh motion and remeshing
+back; no thermodynamics, no healing). Thermodynamics alone on the fixed mesh is not run: there the fields stay in
+their elements, so no lead opens and no new ice forms, and it would only thicken the pack. Family ``lead``, law
+``same_pa``, pristine start, wind seeds 2026–2033, 20 and 10 km. Command ``restoring``: per variant Δβ = β on
+20–120 km at 10 km less at 20 km month by month, mean and 90 % interval (10 000 resamplings, seeded), the pooled
+fall, and the piece's part, Δβ(variant) − Δβ(``mechanics``, from RD20's record), paired by wind seed.
+  (x) Healing alone brings the fall back if ``mechheal``'s month-by-month Δβ has its 90 % interval below 0 and
+      its pooled β on 20–120 km is at least 0.010 lower at 10 km.
+  (y) The moving mesh alone brings it back if ``mechmove``'s does the same.
+  Predicted: (x) holds, with a fall of 0.01–0.02 (healing's part in RD12 was −0.010, RD20's mechanics −0.004);
+  (y) fails (a fixed mesh kept the basin's fall, forty-fifth session). Then the fall would come with a pack that
+  heals and breaks again, which thermodynamics' new ice in the leads can stand in for.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -426,6 +443,9 @@ RD5's record.
     python benchmarks/disk_convergence.py thermodynamics                                              # RD19
     python benchmarks/disk_convergence.py run --stage month --variant mechanics --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py mechanics                                                   # RD20
+    python benchmarks/disk_convergence.py run --stage month --variant mechheal --family lead --law same_pa --jobs 2
+    python benchmarks/disk_convergence.py run --stage month --variant mechmove --family lead --law same_pa --jobs 2
+    python benchmarks/disk_convergence.py restoring                                                   # RD21
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
     python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
     # (RD10)
@@ -488,6 +508,8 @@ SPUN_VARIANTS = {"spun": [], "packspun": PACK_SETS, "meanspun": MEAN_PACK_SETS, 
 MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], "nothermo": ["thermo.enabled=false"],
                   "mechanics": ["thermo.enabled=false", "healing.law=none", "lagrangian.enabled=false",
                                 "remesh.enabled=false"],
+                  "mechheal": ["thermo.enabled=false", "lagrangian.enabled=false", "remesh.enabled=false"],
+                  "mechmove": ["thermo.enabled=false", "healing.law=none"],
                   **{v: [] for v in SPUN_VARIANTS}}
 SPINUP_SETS = ["forcing.wind.seed=2025", 'run.start_date="2026-01-01 00:00:00"', "run.duration=14d", "output.every=7d"]
 
@@ -1386,6 +1408,46 @@ def mechanics(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS) -> 
     return v
 
 
+#: rule RD21: the variants that put one piece back into ``mechanics``, and the rule's letter for each
+RESTORING_VARIANTS = {"mechheal": "x_healing_alone", "mechmove": "y_moving_mesh_alone"}
+
+
+def verdict_restoring(dbeta: list, fall_pooled: float, part: list) -> dict:
+    """Rule RD21 (x) or (y): one piece put back brings the fall back if the 90 % interval of the mean
+    month-by-month Δβ lies below 0 and the pooled β on 20–120 km is at least 0.010 lower at 10 km; the piece's
+    part (Δβ less ``mechanics``'s, paired) is reported with its interval."""
+    m, lo, hi = mean_interval(dbeta)
+    pm, plo, phi = mean_interval(part)
+    return {"n_months": len(dbeta), "dbeta": m, "dbeta_interval_90": [lo, hi], "fall_pooled_common": fall_pooled,
+            "part": pm, "part_interval_90": [plo, phi], "brings_fall_back": bool(hi < 0.0 and fall_pooled >= 0.010)}
+
+
+def restoring(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS) -> dict:
+    """Rule RD21: for ``mechheal`` and ``mechmove``, Δβ month by month and pooled, and the piece's part against
+    RD20's ``mechanics`` record, paired by wind seed."""
+    data = json.loads(JSON.read_text())
+    base = {int(k): v for k, v in data["mechanics"]["dbeta_by_month"].items()}
+    out, verdict = {}, {}
+    for variant, letter in RESTORING_VARIANTS.items():
+        pooled = pool_windows(month_groups(family, law, variant, seeds))
+        per = beta_by_seed(pooled)
+        mine = {sd: per["10"][sd] - per["20"][sd] for sd in sorted(per["20"]) if sd in per["10"]}
+        common = sorted(set(mine) & set(base))
+        fall = pooled["20"]["beta_common"] - pooled["10"]["beta_common"]
+        v = verdict_restoring([mine[sd] for sd in common], fall, [mine[sd] - base[sd] for sd in common])
+        verdict[letter] = v["brings_fall_back"]
+        print(f"{variant}: {len(mine)} months, pooled β on 20-120 km {pooled['20']['beta_common']:.3f} at 20 km, "
+              f"{pooled['10']['beta_common']:.3f} at 10 km (fall {fall:.3f})")
+        print(f"rule RD21 ({variant}):", json.dumps(v))
+        out[variant] = {"overrides": MONTH_VARIANTS[variant], "dbeta_by_month": {str(k): x for k, x in mine.items()},
+                        "beta_common": {km: pooled[km]["beta_common"] for km in ("20", "10")},
+                        "beta_common_per_run": {km: pooled[km]["beta_common_per_run"] for km in ("20", "10")},
+                        "mean_total_per_day": {km: pooled[km]["mean_total_per_day"] for km in ("20", "10")},
+                        "verdict": v}
+    _write_json("restoring", {"family": family, "law": law, "variants": out, "verdict": verdict})
+    return verdict
+
+
 #: rule RD14: the spun-up variants whose β is paired with RD9's (``spun``)
 FACTOR_VARIANTS = ("thickspun", "concspun", "meanspun")
 
@@ -1630,7 +1692,7 @@ def verdict_fragmentation(bins: dict) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes", "healing", "factors", "fine",
-                                     "realisations", "thermodynamics", "mechanics"))
+                                     "realisations", "thermodynamics", "mechanics", "restoring"))
     ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
@@ -1642,8 +1704,9 @@ def main(argv=None) -> int:
                     help="storm: one cyclone, 3 days (default); month: examples/winter_disk.toml, 28 days (RD5)")
     ap.add_argument("--variant", choices=sorted(MONTH_VARIANTS), default="",
                     help="stage month: noheal (healing.law = none; rule RD8), nothermo (thermo.enabled = false; "
-                         "RD19), mechanics (nor healing, mesh motion or remeshing; RD20), spun (from a 14-day spin-up; "
-                         "RD9), "
+                         "RD19), mechanics (nor healing, mesh motion or remeshing; RD20), mechheal and mechmove "
+                         "(mechanics with healing, or mesh motion and remeshing, back; RD21), spun (from a 14-day "
+                         "spin-up; RD9), "
                          "packspun (from a 14-day spin-up of the basin's thick-and-thin pack; RD10), meanspun "
                          "(the same from uniform ice of the pack's means; RD13), thickspun and concspun (its "
                          "thickness alone, its concentration alone; RD14); fine: the spun-up variant "
@@ -1674,6 +1737,9 @@ def main(argv=None) -> int:
         return 0
     if a.what == "mechanics":
         mechanics(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS)
+        return 0
+    if a.what == "restoring":
+        restoring(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS)
         return 0
     if a.what == "thermodynamics":
         thermodynamics(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)

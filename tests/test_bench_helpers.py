@@ -1784,3 +1784,25 @@ def test_disk_convergence_mechanics_variant_and_verdict():
     assert not dc.verdict_mechanics(falls, 0.010)["u_fall_with_mechanics_alone"]
     mixed = dc.verdict_mechanics([0.02, -0.03, 0.01, -0.01, 0.015, -0.02, 0.0, 0.01], 0.02)
     assert not mixed["u_fall_with_mechanics_alone"] and mixed["dbeta_interval_90"][1] > 0.0
+
+
+def test_disk_convergence_restoring_variants_and_verdict():
+    """Rule RD21: ``mechheal`` and ``mechmove`` each put one piece back into ``mechanics`` (healing; mesh motion and
+    remeshing), and the verdict needs both a month-by-month fall and a pooled one of 0.010; the part is paired."""
+    import disk_convergence as dc
+
+    def sets_of(cmd):
+        return [cmd[i + 1] for i, x in enumerate(cmd) if x == "--set"]
+
+    n = len(sets_of(dc.command("lead", "same_pa", 20, 2026, "month")))
+    mech = set(sets_of(dc.command("lead", "same_pa", 20, 2026, "month", "mechanics"))[n:])
+    heal = set(sets_of(dc.command("lead", "same_pa", 20, 2026, "month", "mechheal"))[n:])
+    move = set(sets_of(dc.command("lead", "same_pa", 20, 2026, "month", "mechmove"))[n:])
+    assert mech - heal == {"healing.law=none"} and heal <= mech
+    assert mech - move == {"lagrangian.enabled=false", "remesh.enabled=false"} and move <= mech
+    falls = [-0.02, -0.03, -0.01, -0.025, -0.015, -0.02, -0.03, -0.01]
+    v = dc.verdict_restoring(falls, 0.015, [x + 0.004 for x in falls])
+    assert v["brings_fall_back"] and abs(v["part"] - (-0.02 + 0.004)) < 1e-12 and v["part_interval_90"][1] < 0.0
+    assert not dc.verdict_restoring(falls, 0.008, falls)["brings_fall_back"]
+    mixed = dc.verdict_restoring([0.02, -0.03, 0.01, -0.01, 0.015, -0.02, 0.0, 0.01], 0.02, falls)
+    assert not mixed["brings_fall_back"] and mixed["dbeta_interval_90"][1] > 0.0
