@@ -408,6 +408,18 @@ fall, and the piece's part, Δβ(variant) − Δβ(``mechanics``, from RD20's re
   (y) fails (a fixed mesh kept the basin's fall, forty-fifth session). Then the fall would come with a pack that
   heals and breaks again, which thermodynamics' new ice in the leads can stand in for.
 
+  Result (15:05 UTC on 2026-12-02; runs made again in the next session, from this rule, the first runs being
+  lost with that session's machine): (x) and (y) both fail; (x)'s prediction was wrong, (y)'s right. Healing
+  alone: pooled β on 20–120 km 0.155 at 20 km and 0.148 at 10 km (a fall of 0.008); month by month Δβ −0.009
+  (90 % interval −0.021 to +0.004), lower at 10 km in 5 of 8 months; healing's part −0.005 (−0.018 to
+  +0.008). The moving mesh alone: 0.147 and 0.135 (a fall of 0.012, above the rule's 0.010); Δβ −0.011
+  (−0.033 to +0.013), lower at 10 km in 5 of 8 months; its part −0.007 (−0.026 to +0.013). Each piece put back
+  raises the 20 km β from the mechanics' 0.131 and leaves a fall half the size of all the pieces' (0.022, RD5
+  and RD12), in the same direction, not shown over eight months: the months scatter by about 0.03 (the same
+  three wind seeds, 2026, 2027 and 2030, have a higher β at 10 km in both sets). So no one piece was shown to
+  bring the fall back; what the sets show together is a fall that grows with the number of pieces (0.002 with
+  none, 0.008–0.012 with one, 0.013–0.016 with all but one, 0.022 with all), not a piece that carries it.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
