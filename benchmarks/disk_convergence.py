@@ -420,6 +420,22 @@ fall, and the piece's part, Δβ(variant) − Δβ(``mechanics``, from RD20's re
   bring the fall back; what the sets show together is a fall that grows with the number of pieces (0.002 with
   none, 0.008–0.012 with one, 0.013–0.016 with all but one, 0.022 with all), not a piece that carries it.
 
+Rule RD22 (written at 15:07 UTC on 2026-12-02, after RD21's result and before its own runs). RD20 and RD21 rest
+on eight months, whose Δβ scatter by about 0.03; the sets with every piece and with all but one have sixteen
+(RD12, RD19). RD22 runs ``mechanics`` and ``mechheal`` on the other eight wind seeds (2034–2041; family
+``lead``, law ``same_pa``, pristine start, 20 and 10 km), so that no pieces, one piece and every piece are
+compared over the same sixteen months. Command ``counted``: per set Δβ = β on 20–120 km at 10 km less at 20 km,
+month by month, mean and 90 % interval (10 000 resamplings, seeded), by the number of pieces (0: ``mechanics``;
+1: ``mechheal``; 2: RD12's without healing and RD19's without thermodynamics; 3: RD12's with every piece, from
+their records), and two parts paired by wind seed: the pieces' joint part, Δβ(every piece) − Δβ(``mechanics``),
+and healing's part alone, Δβ(``mechheal``) − Δβ(``mechanics``). RD20's runs of ``mechanics`` on seeds 2026–2033
+were lost with the fifty-seventh session's machine: their Δβ month by month comes from RD20's record.
+  (p) The pieces together make the fall if the joint part's 90 % interval lies below 0.
+  (q) Healing alone brings the fall back if ``mechheal``'s month-by-month Δβ has its 90 % interval below 0 and
+      its pooled β on 20–120 km is at least 0.010 lower at 10 km (RD21's (x), over sixteen months).
+  Predicted: (p) holds, with a joint part of −0.015 to −0.025; (q) fails, with a fall of 0.005–0.012 (RD21's
+  mean, −0.009, and an interval that sixteen months narrow to about ±0.009 would reach 0).
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -458,6 +474,9 @@ fall, and the piece's part, Δβ(variant) − Δβ(``mechanics``, from RD20's re
     python benchmarks/disk_convergence.py run --stage month --variant mechheal --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --stage month --variant mechmove --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py restoring                                                   # RD21
+    python benchmarks/disk_convergence.py run --stage month --variant mechanics --seeds 2034 2035 2036 2037 2038 \
+        2039 2040 2041 --family lead --law same_pa --jobs 2                  # RD22, and the same with mechheal
+    python benchmarks/disk_convergence.py counted                                                     # RD22
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
     python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
     # (RD10)
@@ -1460,6 +1479,62 @@ def restoring(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS) -> 
     return verdict
 
 
+def verdict_counted(joint_part: list, heal_dbeta: list, heal_fall_pooled: float) -> dict:
+    """Rule RD22 (p): the pieces together make the fall if the 90 % interval of their joint part (Δβ with every
+    piece less Δβ with the mechanics alone, paired) lies below 0; (q): healing alone brings the fall back if
+    ``mechheal``'s month-by-month Δβ has its 90 % interval below 0 and its pooled fall is at least 0.010."""
+    pm, plo, phi = mean_interval(joint_part)
+    hm, hlo, hhi = mean_interval(heal_dbeta)
+    return {"n_months": len(joint_part), "joint_part": pm, "joint_part_interval_90": [plo, phi],
+            "healing_alone_dbeta": hm, "healing_alone_dbeta_interval_90": [hlo, hhi],
+            "healing_alone_fall_pooled_common": heal_fall_pooled,
+            "p_pieces_make_the_fall": bool(phi < 0.0),
+            "q_healing_alone": bool(hhi < 0.0 and heal_fall_pooled >= 0.010)}
+
+
+def counted(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE_MONTH_SEEDS) -> dict:
+    """Rule RD22: Δβ month by month over sixteen months by the number of time-dependent pieces (0 ``mechanics``,
+    1 ``mechheal``, 2 RD12's without healing and RD19's without thermodynamics, 3 RD12's with every piece, the
+    last three from their records), the pieces' joint part and healing's part alone, paired by wind seed."""
+    data = json.loads(JSON.read_text())
+    mine, falls, from_record = {}, {}, {}
+    records = {"mechanics": data["mechanics"]["dbeta_by_month"],
+               "mechheal": data["restoring"]["variants"]["mechheal"]["dbeta_by_month"]}
+    for variant in ("mechanics", "mechheal"):
+        pooled = pool_windows(month_groups(family, law, variant, seeds))
+        per = beta_by_seed(pooled)
+        mine[variant] = {sd: per["10"][sd] - per["20"][sd] for sd in sorted(per["20"]) if sd in per["10"]}
+        falls[variant] = pooled["20"]["beta_common"] - pooled["10"]["beta_common"]
+        # months whose runs are not on this machine come from RD20's and RD21's records (Δβ month by month)
+        from_record[variant] = sorted(int(sd) for sd in records[variant] if int(sd) not in mine[variant])
+        mine[variant].update({sd: records[variant][str(sd)] for sd in from_record[variant]})
+    recs = {"every piece": data["healing"]["sets"]["healing"]["dbeta_by_month"],
+            "without healing": data["healing"]["sets"]["no healing"]["dbeta_by_month"],
+            "without thermodynamics": data["thermodynamics"]["dbeta_by_month_without"]}
+    sets = {"mechanics": mine["mechanics"], "mechheal": mine["mechheal"]}
+    sets.update({k: {int(sd): x for sd, x in v.items()} for k, v in recs.items()})
+    pieces = {"mechanics": 0, "mechheal": 1, "without healing": 2, "without thermodynamics": 2, "every piece": 3}
+    common = sorted(set.intersection(*(set(v) for v in sets.values())))
+    joint = [sets["every piece"][sd] - sets["mechanics"][sd] for sd in common]
+    heal_part = mean_interval([sets["mechheal"][sd] - sets["mechanics"][sd] for sd in common])
+    v = verdict_counted(joint, [sets["mechheal"][sd] for sd in common], falls["mechheal"])
+    v["healing_alone_part"], v["healing_alone_part_interval_90"] = heal_part[0], list(heal_part[1:])
+    by_set = {}
+    for name, d in sets.items():
+        m, lo, hi = mean_interval([d[sd] for sd in common])
+        by_set[name] = {"pieces": pieces[name], "dbeta": m, "dbeta_interval_90": [lo, hi],
+                        "months_lower_at_10km": int(sum(d[sd] < 0.0 for sd in common))}
+        print(f"{name} ({pieces[name]} pieces): {len(common)} months, Δβ {m:+.3f} [{lo:+.3f}, {hi:+.3f}], lower at "
+              f"10 km in {by_set[name]['months_lower_at_10km']}")
+    print("pooled falls on 20-120 km, over the runs on this machine:", {k: round(x, 4) for k, x in falls.items()},
+          "; months from the records:", from_record)
+    print("rule RD22:", json.dumps(v))
+    _write_json("counted", {"family": family, "law": law, "months": common, "by_set": by_set,
+                            "fall_pooled_common": falls, "months_from_records": from_record, "verdict": v,
+                            "dbeta_by_month": {k: {str(sd): d[sd] for sd in common} for k, d in sets.items()}})
+    return v
+
+
 #: rule RD14: the spun-up variants whose β is paired with RD9's (``spun``)
 FACTOR_VARIANTS = ("thickspun", "concspun", "meanspun")
 
@@ -1704,7 +1779,8 @@ def verdict_fragmentation(bins: dict) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes", "healing", "factors", "fine",
-                                     "realisations", "thermodynamics", "mechanics", "restoring"))
+                                     "realisations", "thermodynamics", "mechanics", "restoring",
+                                     "counted"))
     ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
@@ -1749,6 +1825,9 @@ def main(argv=None) -> int:
         return 0
     if a.what == "mechanics":
         mechanics(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS)
+        return 0
+    if a.what == "counted":
+        counted(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
         return 0
     if a.what == "restoring":
         restoring(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS)

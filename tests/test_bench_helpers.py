@@ -1806,3 +1806,18 @@ def test_disk_convergence_restoring_variants_and_verdict():
     assert not dc.verdict_restoring(falls, 0.008, falls)["brings_fall_back"]
     mixed = dc.verdict_restoring([0.02, -0.03, 0.01, -0.01, 0.015, -0.02, 0.0, 0.01], 0.02, falls)
     assert not mixed["brings_fall_back"] and mixed["dbeta_interval_90"][1] > 0.0
+
+
+def test_disk_convergence_counted_verdict():
+    """Rule RD22: (p) needs the pieces' joint part below 0 over its whole interval; (q) needs healing alone's
+    month-by-month fall below 0 and a pooled fall of 0.010, as RD21's (x)."""
+    import disk_convergence as dc
+
+    joint = [-0.02, -0.03, -0.01, -0.025, -0.015, -0.02, -0.03, -0.01]
+    v = dc.verdict_counted(joint, joint, 0.012)
+    assert v["p_pieces_make_the_fall"] and v["q_healing_alone"] and v["n_months"] == 8
+    assert abs(v["joint_part"] - sum(joint) / 8) < 1e-12 and v["joint_part_interval_90"][1] < 0.0
+    assert not dc.verdict_counted(joint, joint, 0.008)["q_healing_alone"]
+    mixed = [0.02, -0.03, 0.01, -0.01, 0.015, -0.02, 0.0, 0.01]
+    w = dc.verdict_counted(mixed, mixed, 0.02)
+    assert not w["p_pieces_make_the_fall"] and not w["q_healing_alone"]
