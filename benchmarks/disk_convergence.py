@@ -436,6 +436,17 @@ were lost with the fifty-seventh session's machine: their Δβ month by month co
   Predicted: (p) holds, with a joint part of −0.015 to −0.025; (q) fails, with a fall of 0.005–0.012 (RD21's
   mean, −0.009, and an interval that sixteen months narrow to about ±0.009 would reach 0).
 
+  Result (15:43 UTC on 2026-12-02): (p) holds, (q) fails, as predicted; the joint part, −0.014 (90 %
+  interval −0.026 to −0.002), is 0.001 short of the predicted range. Healing alone: Δβ −0.006 (−0.015 to +0.003),
+  pooled fall 0.007 (within the predicted 0.005–0.012); healing's part against the mechanics +0.004 (−0.006 to
+  +0.014). The new months change RD20's reading: over seeds 2034–2041 the mechanics alone has a fall of −0.017
+  (against −0.004 over RD20's seeds 2026–2033), so over sixteen months its Δβ is −0.010 (−0.019 to −0.001),
+  lower at 10 km in 11 of 16 months, and its pooled fall over the eight new months is 0.019. By the number of
+  pieces, over the same sixteen months: none −0.010, healing alone −0.006, all but healing −0.015, all but
+  thermodynamics −0.012, every piece −0.024 (lower at 10 km in 11, 11, 11, 11 and 15 months). So a fall of
+  about 0.01 comes with the damage mechanics on a fixed mesh after all; RD20's "no fall" was its eight months';
+  every piece together about doubles it, and no one piece was shown to.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
