@@ -1001,6 +1001,13 @@ def beta_by_seed(meshes: dict) -> dict:
     return {km: {_seed_of(k): v for k, v in meshes[km]["beta_common_per_run"].items()} for km in ("20", "10")}
 
 
+def dbeta_by_seed(meshes: dict) -> dict:
+    """``{wind seed: Δβ}`` in seed order: β on the common widths at 10 km less at 20 km, month by month, for
+    the wind seeds run on both meshes of ``meshes`` (as :func:`beta_by_seed` takes it)."""
+    per = beta_by_seed(meshes)
+    return {sd: per["10"][sd] - per["20"][sd] for sd in sorted(per["20"]) if sd in per["10"]}
+
+
 def finished_runs(paths: list, what: str) -> list:
     """``paths`` if every run in it has finished, else a SystemExit naming the ones that have not."""
     missing = [Path(p).name for p in paths if not (Path(p) / "snapshots" / "index.json").exists()]
@@ -1345,8 +1352,7 @@ def healing(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE
     dbeta, sets = {}, {}
     for label, variant in (("healing", ""), ("no healing", "noheal")):
         pooled = pool_windows(month_groups(family, law, variant, seeds))
-        per = beta_by_seed(pooled)
-        dbeta[label] = {sd: per["10"][sd] - per["20"][sd] for sd in per["20"] if sd in per["10"]}
+        dbeta[label] = dbeta_by_seed(pooled)
         sets[label] = {"fall_pooled_common": pooled["20"]["beta_common"] - pooled["10"]["beta_common"],
                        "n_months": len(dbeta[label]),
                        "dbeta_by_month": {str(k): v for k, v in sorted(dbeta[label].items())},
@@ -1391,8 +1397,7 @@ def thermodynamics(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS
     by wind seed; beside it, the first eight months paired with RD5's record on each mesh."""
     data = json.loads(JSON.read_text())
     pooled = pool_windows(month_groups(family, law, "nothermo", seeds))
-    per = beta_by_seed(pooled)
-    mine = {sd: per["10"][sd] - per["20"][sd] for sd in per["20"] if sd in per["10"]}
+    mine = dbeta_by_seed(pooled)
     base = {int(k): v for k, v in data["healing"]["sets"]["healing"]["dbeta_by_month"].items()}
     common = sorted(set(mine) & set(base))
     part = [base[sd] - mine[sd] for sd in common]
@@ -1431,8 +1436,7 @@ def mechanics(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS) -> 
     by month and pooled, and the months paired on each mesh with RD5's record."""
     data = json.loads(JSON.read_text())
     pooled = pool_windows(month_groups(family, law, "mechanics", seeds))
-    per = beta_by_seed(pooled)
-    mine = {sd: per["10"][sd] - per["20"][sd] for sd in sorted(per["20"]) if sd in per["10"]}
+    mine = dbeta_by_seed(pooled)
     fall = pooled["20"]["beta_common"] - pooled["10"]["beta_common"]
     v = verdict_mechanics(list(mine.values()), fall)
     record = {"meshes": {km: {k: pooled[km][k] for k in ("beta_common_per_run", "beta_common")} for km in ("20", "10")}}
@@ -1472,8 +1476,7 @@ def restoring(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS) -> 
     out, verdict = {}, {}
     for variant, letter in RESTORING_VARIANTS.items():
         pooled = pool_windows(month_groups(family, law, variant, seeds))
-        per = beta_by_seed(pooled)
-        mine = {sd: per["10"][sd] - per["20"][sd] for sd in sorted(per["20"]) if sd in per["10"]}
+        mine = dbeta_by_seed(pooled)
         common = sorted(set(mine) & set(base))
         fall = pooled["20"]["beta_common"] - pooled["10"]["beta_common"]
         v = verdict_restoring([mine[sd] for sd in common], fall, [mine[sd] - base[sd] for sd in common])
@@ -1513,8 +1516,7 @@ def counted(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE
                "mechheal": data["restoring"]["variants"]["mechheal"]["dbeta_by_month"]}
     for variant in ("mechanics", "mechheal"):
         pooled = pool_windows(month_groups(family, law, variant, seeds))
-        per = beta_by_seed(pooled)
-        mine[variant] = {sd: per["10"][sd] - per["20"][sd] for sd in sorted(per["20"]) if sd in per["10"]}
+        mine[variant] = dbeta_by_seed(pooled)
         falls[variant] = pooled["20"]["beta_common"] - pooled["10"]["beta_common"]
         # months whose runs are not on this machine come from RD20's and RD21's records (Δβ month by month)
         from_record[variant] = sorted(int(sd) for sd in records[variant] if int(sd) not in mine[variant])
