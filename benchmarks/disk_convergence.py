@@ -447,6 +447,23 @@ were lost with the fifty-seventh session's machine: their Δβ month by month co
   about 0.01 comes with the damage mechanics on a fixed mesh after all; RD20's "no fall" was its eight months';
   every piece together about doubles it, and no one piece was shown to.
 
+Rule RD23 (written at 16:20 UTC on 2026-12-02, after RD22's result and before its own runs). RD21's (y), mesh
+motion with remeshing put back alone into the mechanics, rests on eight months (Δβ −0.011, 90 % interval −0.033
+to +0.013), as healing alone did before RD22 gave it sixteen. RD23 runs ``mechmove`` on the other eight wind
+seeds (2034–2041; family ``lead``, law ``same_pa``, pristine start, 20 and 10 km), so that each piece that can be
+put back alone has sixteen months (thermodynamics alone on a fixed mesh opens no lead: RD21). Command ``moved``:
+``mechmove``'s Δβ = β on 20–120 km at 10 km less at 20 km month by month over sixteen months, mean and 90 %
+interval (10 000 resamplings, seeded), its pooled fall over the runs on this machine, and the moving mesh's part
+alone, Δβ(``mechmove``) − Δβ(``mechanics``), paired by wind seed (the mechanics' months 2026–2033 from RD20's
+record, as in RD22).
+  (y') The moving mesh alone keeps the fall if ``mechmove``'s month-by-month Δβ has its 90 % interval below 0 and
+       its pooled β on 20–120 km is at least 0.010 lower at 10 km (RD21's (y), over sixteen months).
+  (y'') The moving mesh's part is shown if its 90 % interval lies below 0 (it makes the fall larger than the
+       mechanics' own).
+  Predicted: (y') holds, with a mean Δβ of −0.010 to −0.016 (the mechanics' own −0.010 and RD21's −0.011 over
+  eight months); (y'') fails, with a part within ±0.008, as healing's (+0.004). Then neither piece put back alone
+  adds to the fall that the storms make on a fixed mesh, and only the pieces together do (RD22's joint part).
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -488,6 +505,9 @@ were lost with the fifty-seventh session's machine: their Δβ month by month co
     python benchmarks/disk_convergence.py run --stage month --variant mechanics --seeds 2034 2035 2036 2037 2038 \
         2039 2040 2041 --family lead --law same_pa --jobs 2                  # RD22, and the same with mechheal
     python benchmarks/disk_convergence.py counted                                                     # RD22
+    python benchmarks/disk_convergence.py run --stage month --variant mechmove --seeds 2034 2035 2036 2037 2038 \
+        2039 2040 2041 --family lead --law same_pa --jobs 2                  # RD23
+    python benchmarks/disk_convergence.py moved                                                       # RD23
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
     python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
     # (RD10)
@@ -1548,6 +1568,46 @@ def counted(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE
     return v
 
 
+
+def verdict_moved(dbeta: list, fall_pooled: float, part: list) -> dict:
+    """Rule RD23 (y'): the moving mesh alone keeps the fall if ``mechmove``'s month-by-month Δβ has its 90 %
+    interval below 0 and its pooled fall is at least 0.010 (RD21's (y)); (y''): its part against the mechanics
+    (paired) is shown if that part's 90 % interval lies below 0."""
+    v = verdict_restoring(dbeta, fall_pooled, part)
+    return {"n_months": v["n_months"], "dbeta": v["dbeta"], "dbeta_interval_90": v["dbeta_interval_90"],
+            "fall_pooled_common": fall_pooled, "part": v["part"], "part_interval_90": v["part_interval_90"],
+            "y1_moving_mesh_alone_keeps_fall": v["brings_fall_back"],
+            "y2_moving_mesh_part_shown": bool(v["part_interval_90"][1] < 0.0)}
+
+
+def moved(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE_MONTH_SEEDS) -> dict:
+    """Rule RD23: ``mechmove``'s Δβ month by month over sixteen months and its pooled fall, and the moving mesh's
+    part alone, Δβ(``mechmove``) − Δβ(``mechanics``), paired by wind seed (the mechanics' months not run on this
+    machine, and ``mechmove``'s, from the ``counted`` and ``restoring`` records)."""
+    data = json.loads(JSON.read_text())
+    pooled = pool_windows(month_groups(family, law, "mechmove", seeds))
+    mine = dbeta_by_seed(pooled)
+    fall = pooled["20"]["beta_common"] - pooled["10"]["beta_common"]
+    record = data["restoring"]["variants"]["mechmove"]["dbeta_by_month"]
+    from_record = sorted(int(sd) for sd in record if int(sd) not in mine and int(sd) in seeds)
+    mine.update({sd: record[str(sd)] for sd in from_record})
+    base = {int(k): x for k, x in data["counted"]["dbeta_by_month"]["mechanics"].items()}
+    common = sorted(set(mine) & set(base))
+    v = verdict_moved([mine[sd] for sd in common], fall, [mine[sd] - base[sd] for sd in common])
+    halves = {name: mean_interval([mine[sd] for sd in common if sd in part])[0]
+              for name, part in (("2026-2033", MONTH_SEEDS), ("2034-2041", MORE_MONTH_SEEDS))}
+    v["months_lower_at_10km"] = int(sum(mine[sd] < 0.0 for sd in common))
+    print(f"mechmove: {len(common)} months, pooled β on 20-120 km {pooled['20']['beta_common']:.3f} at 20 km, "
+          f"{pooled['10']['beta_common']:.3f} at 10 km over the runs on this machine (fall {fall:.3f}); "
+          f"months from the record: {from_record}; Δβ by halves {json.dumps(halves)}")
+    print("rule RD23:", json.dumps(v))
+    _write_json("moved", {"family": family, "law": law, "overrides": MONTH_VARIANTS["mechmove"], "months": common,
+                          "dbeta_by_month": {str(sd): mine[sd] for sd in common}, "dbeta_by_half": halves,
+                          "beta_common": {km: pooled[km]["beta_common"] for km in ("20", "10")},
+                          "beta_common_per_run": {km: pooled[km]["beta_common_per_run"] for km in ("20", "10")},
+                          "months_from_record": from_record, "verdict": v})
+    return v
+
 #: rule RD14: the spun-up variants whose β is paired with RD9's (``spun``)
 FACTOR_VARIANTS = ("thickspun", "concspun", "meanspun")
 
@@ -1793,7 +1853,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes", "healing", "factors", "fine",
                                      "realisations", "thermodynamics", "mechanics", "restoring",
-                                     "counted"))
+                                     "counted", "moved"))
     ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
@@ -1841,6 +1901,9 @@ def main(argv=None) -> int:
         return 0
     if a.what == "counted":
         counted(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
+        return 0
+    if a.what == "moved":
+        moved(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
         return 0
     if a.what == "restoring":
         restoring(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS)

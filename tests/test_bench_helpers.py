@@ -1821,3 +1821,18 @@ def test_disk_convergence_counted_verdict():
     mixed = [0.02, -0.03, 0.01, -0.01, 0.015, -0.02, 0.0, 0.01]
     w = dc.verdict_counted(mixed, mixed, 0.02)
     assert not w["p_pieces_make_the_fall"] and not w["q_healing_alone"]
+
+
+def test_disk_convergence_moved_verdict():
+    """Rule RD23: (y') needs the moving mesh's month-by-month fall below 0 and a pooled fall of 0.010; (y'') needs
+    its part against the mechanics below 0 over its whole interval, independently of (y')."""
+    import disk_convergence as dc
+
+    falls = [-0.02, -0.03, -0.01, -0.025, -0.015, -0.02, -0.03, -0.01]
+    small = [0.01, -0.01, 0.005, -0.005, 0.0, 0.01, -0.01, 0.0]
+    v = dc.verdict_moved(falls, 0.012, small)
+    assert v["y1_moving_mesh_alone_keeps_fall"] and not v["y2_moving_mesh_part_shown"] and v["n_months"] == 8
+    assert abs(v["dbeta"] - sum(falls) / 8) < 1e-12 and abs(v["part"]) < 1e-12
+    assert not dc.verdict_moved(falls, 0.008, small)["y1_moving_mesh_alone_keeps_fall"]
+    w = dc.verdict_moved(small, 0.02, falls)
+    assert not w["y1_moving_mesh_alone_keeps_fall"] and w["y2_moving_mesh_part_shown"]
