@@ -463,6 +463,12 @@ record, as in RD22).
   Predicted: (y') holds, with a mean Δβ of −0.010 to −0.016 (the mechanics' own −0.010 and RD21's −0.011 over
   eight months); (y'') fails, with a part within ±0.008, as healing's (+0.004). Then neither piece put back alone
   adds to the fall that the storms make on a fixed mesh, and only the pieces together do (RD22's joint part).
+  Added at 16:29 UTC, while the runs were under way and before any of their results: with ``mechmove`` over
+  sixteen months, the sets with the moving mesh and without healing differ only by thermodynamics.
+  (y''') Thermodynamics' part where the mesh moves and nothing heals, Δβ(RD12's ``noheal``) − Δβ(``mechmove``),
+       paired by wind seed, is shown if its 90 % interval lies below 0.
+  Predicted: (y''') fails, with a part of −0.002 to −0.008 (RD19 showed thermodynamics' part with healing on,
+  −0.012, by a margin of 0.0003).
 
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
@@ -1597,6 +1603,11 @@ def moved(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE_M
     halves = {name: mean_interval([mine[sd] for sd in common if sd in part])[0]
               for name, part in (("2026-2033", MONTH_SEEDS), ("2034-2041", MORE_MONTH_SEEDS))}
     v["months_lower_at_10km"] = int(sum(mine[sd] < 0.0 for sd in common))
+    noheal = {int(k): x for k, x in data["healing"]["sets"]["no healing"]["dbeta_by_month"].items()}
+    both = [sd for sd in common if sd in noheal]
+    tm, tlo, thi = mean_interval([noheal[sd] - mine[sd] for sd in both])
+    v.update({"thermo_part_moving_mesh": tm, "thermo_part_moving_mesh_interval_90": [tlo, thi],
+              "y3_thermo_part_shown": bool(thi < 0.0), "thermo_part_months": len(both)})
     print(f"mechmove: {len(common)} months, pooled β on 20-120 km {pooled['20']['beta_common']:.3f} at 20 km, "
           f"{pooled['10']['beta_common']:.3f} at 10 km over the runs on this machine (fall {fall:.3f}); "
           f"months from the record: {from_record}; Δβ by halves {json.dumps(halves)}")
