@@ -470,6 +470,27 @@ record, as in RD22).
   Predicted: (y''') fails, with a part of −0.002 to −0.008 (RD19 showed thermodynamics' part with healing on,
   −0.012, by a margin of 0.0003).
 
+Rule RD24 (written at 16:40 UTC on 2026-12-02, before its runs and before RD23's result; a 1-hour run at 40 km
+was made first to check that the scene accepts the overrides and that every element's cohesion is uniform on
+[C, 2C], and only its log and its cohesion field were looked at). With the damage mechanics alone on a fixed
+mesh β falls by about 0.010 from 20 to 10 km over sixteen months (RD22). On a fixed mesh the one thing that is
+laid element by element is the white strength disorder: each element draws its own factor on [1, 2], so a 10 km
+mesh holds four times as many independent draws per area, and all sixteen months share one draw per mesh (the
+run seed is the same in every month). A disorder correlated over 40 km had left the basin's fall in one month
+(forty-fourth session), which is weak evidence. Variant ``mechcorr``: ``mechanics``, with the white disorder off
+and the correlated factor g on instead (``strength_correlation_m`` = 40 km, amplitude 1/3, C_lab × 1.5), so that
+each element's cohesion is again uniform on [C, 2C] but laid by one field, the same on both meshes, that both
+resolve. Family ``lead``, law ``same_pa``, pristine start, wind seeds 2026–2041, 20 and 10 km. Command
+``correlated``: ``mechcorr``'s Δβ = β on 20–120 km at 10 km less at 20 km month by month, mean and 90 % interval
+(10 000 resamplings, seeded), its pooled fall, and the disorder's part, Δβ(``mechcorr``) − Δβ(``mechanics``),
+paired by wind seed (the mechanics' months from RD22's record).
+  (v) The fall on a fixed mesh comes with the white disorder if that part's 90 % interval lies above 0 (with the
+      correlated field the fall is smaller).
+  (v') The fall does not need it if ``mechcorr``'s month-by-month Δβ has its 90 % interval below 0.
+  Predicted: (v) fails and (v') holds, with a Δβ of −0.008 to −0.015, as the basin's month with the correlated
+  field suggested. Then what makes β fall on a fixed mesh is the mesh itself (the bands one element wide), not
+  how the strength is drawn on it.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -514,6 +535,9 @@ record, as in RD22).
     python benchmarks/disk_convergence.py run --stage month --variant mechmove --seeds 2034 2035 2036 2037 2038 \
         2039 2040 2041 --family lead --law same_pa --jobs 2                  # RD23
     python benchmarks/disk_convergence.py moved                                                       # RD23
+    python benchmarks/disk_convergence.py run --stage month --variant mechcorr --seeds 2026 2027 2028 2029 2030 \
+        2031 2032 2033 2034 2035 2036 2037 2038 2039 2040 2041 --family lead --law same_pa --jobs 2
+    python benchmarks/disk_convergence.py correlated                                                  # RD24
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
     python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
     # (RD10)
@@ -578,7 +602,14 @@ MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], "nothermo": ["thermo.e
                                 "remesh.enabled=false"],
                   "mechheal": ["thermo.enabled=false", "lagrangian.enabled=false", "remesh.enabled=false"],
                   "mechmove": ["thermo.enabled=false", "healing.law=none"],
+                  "mechcorr": ["thermo.enabled=false", "healing.law=none", "lagrangian.enabled=false",
+                               "remesh.enabled=false", "rheology.strength_disorder=0",
+                               "rheology.strength_correlation_m=40e3",
+                               "rheology.strength_correlated_amplitude=0.333333333333"],
                   **{v: [] for v in SPUN_VARIANTS}}
+#: rule RD24: C_lab factors of the month variants that change how the disorder is laid (``mechcorr``: the white
+#: disorder's mean factor 1.5, so that with g on [2/3, 4/3] every element's cohesion is again uniform on [C, 2C])
+VARIANT_LAB_FACTOR = {"mechcorr": 1.5}
 SPINUP_SETS = ["forcing.wind.seed=2025", 'run.start_date="2026-01-01 00:00:00"', "run.duration=14d", "output.every=7d"]
 
 
@@ -660,8 +691,8 @@ def run_name(family: str, law: str, km: float, seed: int, stage: str = "storm", 
 
 
 def command(family: str, law: str, km: float, seed: int, stage: str = "storm", variant: str = "") -> list:
-    sets = [f"domain.resolution_m={km * 1e3:g}", f"rheology.strength_lab_pa={lab_cohesion_pa(family, law, km):.6g}",
-            *FAMILIES[family][0]]
+    lab = lab_cohesion_pa(family, law, km) * (VARIANT_LAB_FACTOR.get(variant, 1.0) if stage == "month" else 1.0)
+    sets = [f"domain.resolution_m={km * 1e3:g}", f"rheology.strength_lab_pa={lab:.6g}", *FAMILIES[family][0]]
     if stage == "month":
         scene, sets = MONTH_SCENE, [f"forcing.wind.seed={seed}", *sets, *variant_sets(variant, family, law, km)]
     else:
@@ -1619,6 +1650,42 @@ def moved(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE_M
                           "months_from_record": from_record, "verdict": v})
     return v
 
+
+def verdict_correlated(dbeta: list, part: list) -> dict:
+    """Rule RD24 (v): the fall on a fixed mesh comes with the white disorder if the disorder's part (Δβ with the
+    correlated field less Δβ with the white disorder, paired) has its 90 % interval above 0; (v'): it does not
+    need it if the correlated set's month-by-month Δβ has its 90 % interval below 0."""
+    m, lo, hi = mean_interval(dbeta)
+    pm, plo, phi = mean_interval(part)
+    return {"n_months": len(dbeta), "dbeta": m, "dbeta_interval_90": [lo, hi], "part": pm,
+            "part_interval_90": [plo, phi], "v_fall_with_white_disorder": bool(plo > 0.0),
+            "v2_fall_without_white_disorder": bool(hi < 0.0)}
+
+
+def correlated(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE_MONTH_SEEDS) -> dict:
+    """Rule RD24: ``mechcorr``'s Δβ month by month over sixteen months and its pooled fall, and the disorder's
+    part, Δβ(``mechcorr``) − Δβ(``mechanics``), paired by wind seed (the mechanics' months from RD22's record)."""
+    data = json.loads(JSON.read_text())
+    pooled = pool_windows(month_groups(family, law, "mechcorr", seeds))
+    mine = dbeta_by_seed(pooled)
+    fall = pooled["20"]["beta_common"] - pooled["10"]["beta_common"]
+    base = {int(k): x for k, x in data["counted"]["dbeta_by_month"]["mechanics"].items()}
+    common = sorted(set(mine) & set(base))
+    v = verdict_correlated([mine[sd] for sd in common], [mine[sd] - base[sd] for sd in common])
+    v["fall_pooled_common"] = fall
+    v["months_lower_at_10km"] = int(sum(mine[sd] < 0.0 for sd in common))
+    print(f"mechcorr: {len(common)} months, pooled β on 20-120 km {pooled['20']['beta_common']:.3f} at 20 km, "
+          f"{pooled['10']['beta_common']:.3f} at 10 km (fall {fall:.3f})")
+    print("rule RD24:", json.dumps(v))
+    _write_json("correlated", {"family": family, "law": law, "overrides": MONTH_VARIANTS["mechcorr"],
+                               "lab_factor": VARIANT_LAB_FACTOR["mechcorr"], "months": common,
+                               "dbeta_by_month": {str(sd): mine[sd] for sd in common},
+                               "beta_common": {km: pooled[km]["beta_common"] for km in ("20", "10")},
+                               "beta_common_per_run": {km: pooled[km]["beta_common_per_run"] for km in ("20", "10")},
+                               "mean_total_per_day": {km: pooled[km]["mean_total_per_day"] for km in ("20", "10")},
+                               "verdict": v})
+    return v
+
 #: rule RD14: the spun-up variants whose β is paired with RD9's (``spun``)
 FACTOR_VARIANTS = ("thickspun", "concspun", "meanspun")
 
@@ -1864,7 +1931,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes", "healing", "factors", "fine",
                                      "realisations", "thermodynamics", "mechanics", "restoring",
-                                     "counted", "moved"))
+                                     "counted", "moved", "correlated"))
     ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
@@ -1912,6 +1979,9 @@ def main(argv=None) -> int:
         return 0
     if a.what == "counted":
         counted(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
+        return 0
+    if a.what == "correlated":
+        correlated(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
         return 0
     if a.what == "moved":
         moved(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)

@@ -1836,3 +1836,24 @@ def test_disk_convergence_moved_verdict():
     assert not dc.verdict_moved(falls, 0.008, small)["y1_moving_mesh_alone_keeps_fall"]
     w = dc.verdict_moved(small, 0.02, falls)
     assert not w["y1_moving_mesh_alone_keeps_fall"] and w["y2_moving_mesh_part_shown"]
+
+
+def test_disk_convergence_correlated_verdict_and_cohesion():
+    """Rule RD24: (v) needs the disorder's part above 0 over its whole interval, (v') the correlated set's fall
+    below 0; the variant keeps each element's cohesion on [C, 2C]: C_lab × 1.5 with g on [2/3, 4/3] and the white
+    disorder off, and only in the month stage."""
+    import disk_convergence as dc
+
+    falls = [-0.02, -0.03, -0.01, -0.025, -0.015, -0.02, -0.03, -0.01]
+    rises = [-x for x in falls]
+    v = dc.verdict_correlated(falls, rises)
+    assert v["v_fall_with_white_disorder"] and v["v2_fall_without_white_disorder"] and v["n_months"] == 8
+    w = dc.verdict_correlated(rises, falls)
+    assert not w["v_fall_with_white_disorder"] and not w["v2_fall_without_white_disorder"]
+    sets = dict(x.split("=") for x in dc.command("lead", "same_pa", 10, 2030, "month", "mechcorr")[8::2])
+    base = dict(x.split("=") for x in dc.command("lead", "same_pa", 10, 2030, "month", "mechanics")[8::2])
+    amp = float(sets["rheology.strength_correlated_amplitude"])
+    assert float(sets["rheology.strength_disorder"]) == 0.0 and float(sets["rheology.strength_correlation_m"]) == 40e3
+    lab, lab0 = float(sets["rheology.strength_lab_pa"]), float(base["rheology.strength_lab_pa"])
+    assert abs(lab * (1 - amp) - lab0) < 1e-5 * lab0 and abs(lab * (1 + amp) - 2 * lab0) < 1e-5 * lab0
+    assert {k: x for k, x in base.items() if k != "rheology.strength_lab_pa"}.items() <= sets.items()
