@@ -470,6 +470,16 @@ record, as in RD22).
   Predicted: (y''') fails, with a part of −0.002 to −0.008 (RD19 showed thermodynamics' part with healing on,
   −0.012, by a margin of 0.0003).
 
+  Result (16:53 UTC): (y') holds, with a larger fall than predicted; (y'') and (y''') fail, as predicted, with
+  values at or beyond the edges of the predicted ranges. The moving mesh alone: Δβ −0.019 (90 % interval −0.031
+  to −0.006), lower at 10 km in 13 of 16 months; pooled β on 20–120 km 0.162 at 20 km and 0.142 at 10 km (a fall
+  of 0.021); −0.011 over RD21's eight seeds and −0.027 over the other eight. Its part against the mechanics is
+  −0.009 (−0.021 to +0.003), 0.001 beyond the predicted ±0.008 and not shown. Thermodynamics' part where the mesh
+  moves and nothing heals is +0.004 (−0.006 to +0.016), not shown, of the other sign than predicted. So over
+  sixteen months the moving mesh with remeshing, put back alone, gives about four fifths of every piece's fall
+  (−0.019 against −0.024) where healing alone gave a quarter (−0.006), but its part beyond the mechanics' own
+  −0.010 is not shown, and the halves of its months differ by 0.016.
+
 Rule RD24 (written at 16:40 UTC on 2026-12-02, before its runs and before RD23's result; a 1-hour run at 40 km
 was made first to check that the scene accepts the overrides and that every element's cohesion is uniform on
 [C, 2C], and only its log and its cohesion field were looked at). With the damage mechanics alone on a fixed
