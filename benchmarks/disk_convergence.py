@@ -501,6 +501,14 @@ paired by wind seed (the mechanics' months from RD22's record).
   field suggested. Then what makes β fall on a fixed mesh is the mesh itself (the bands one element wide), not
   how the strength is drawn on it.
 
+  Result (17:27 UTC): (v) fails and (v') holds, as predicted, with a larger fall than predicted. With the
+  correlated field the mechanics' Δβ is −0.019 (90 % interval −0.034 to −0.006), lower at 10 km in 10 of 16
+  months; pooled β on 20–120 km 0.144 at 20 km and 0.127 at 10 km (a fall of 0.018). The disorder's part is
+  −0.009 (−0.024 to +0.005): laid by one 40 km field that both meshes resolve, the disorder leaves the fall at
+  least as large as the white one's (−0.010). So on a fixed mesh β falls from 20 to 10 km without an element
+  scale in the strength and without a draw of its own on each mesh: what is left that differs between the two
+  meshes is the mesh, whose bands are one element wide.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
