@@ -509,6 +509,23 @@ paired by wind seed (the mechanics' months from RD22's record).
   scale in the strength and without a draw of its own on each mesh: what is left that differs between the two
   meshes is the mesh, whose bands are one element wide.
 
+Rule RD25 (written at 17:29 UTC on 2026-12-02, after RD24's result and before its own runs; a 1-hour run at 40 km
+was made first to check that the scene accepts the overrides, and only its log was looked at). If the fixed
+mesh's fall comes from bands one element wide whose softening does not know their width, the two lengths the
+damage law takes from the element should be given a physical length on both meshes: the damage time td = ℓ/cs
+instead of Δx/cs (``rheology.damage_length_m``), and the crack band of the viscous flow, λ × Δx/ℓ, so that a band
+of any width slips at the same rate under the same stress (``rheology.crack_band_length_m``; Bažant and Oh 1983).
+Each was tried alone in the basin, with all its pieces, and left the fall there (forty-fourth and forty-fifth
+sessions, one month each); together, and on the fixed mesh, they were not. Variant ``mechband``: ``mechanics``
+with both, ℓ = 20 km. Family ``lead``, law ``same_pa``, pristine start, wind seeds 2026–2041, 20 and 10 km.
+Command ``banded``: ``mechband``'s Δβ month by month, mean and 90 % interval (10 000 resamplings, seeded), its
+pooled fall, and the regularisation's part, Δβ(``mechband``) − Δβ(``mechanics``), paired by wind seed (the
+mechanics' months from RD22's record).
+  (r) The regularisation makes the fall smaller if its part has its 90 % interval above 0.
+  (r') The fall survives it if ``mechband``'s month-by-month Δβ has its 90 % interval below 0.
+  Predicted: (r) fails and (r') holds, with a Δβ of −0.008 to −0.020: each length alone left the basin's fall.
+  Then a band's width is not the cause in the form these two lengths can reach.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
@@ -556,6 +573,9 @@ paired by wind seed (the mechanics' months from RD22's record).
     python benchmarks/disk_convergence.py run --stage month --variant mechcorr --seeds 2026 2027 2028 2029 2030 \
         2031 2032 2033 2034 2035 2036 2037 2038 2039 2040 2041 --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py correlated                                                  # RD24
+    python benchmarks/disk_convergence.py run --stage month --variant mechband --seeds 2026 2027 2028 2029 2030 \
+        2031 2032 2033 2034 2035 2036 2037 2038 2039 2040 2041 --family lead --law same_pa --jobs 2
+    python benchmarks/disk_convergence.py banded                                                      # RD25
     python benchmarks/disk_convergence.py run --stage month --variant spun --family lead --law same_pa --jobs 2    # RD9
     python benchmarks/disk_convergence.py run --stage month --variant packspun --family lead --law same_pa --jobs 2
     # (RD10)
@@ -624,6 +644,9 @@ MONTH_VARIANTS = {"": [], "noheal": ["healing.law=none"], "nothermo": ["thermo.e
                                "remesh.enabled=false", "rheology.strength_disorder=0",
                                "rheology.strength_correlation_m=40e3",
                                "rheology.strength_correlated_amplitude=0.333333333333"],
+                  "mechband": ["thermo.enabled=false", "healing.law=none", "lagrangian.enabled=false",
+                               "remesh.enabled=false", "rheology.damage_length_m=20e3",
+                               "rheology.crack_band_length_m=20e3"],
                   **{v: [] for v in SPUN_VARIANTS}}
 #: rule RD24: C_lab factors of the month variants that change how the disorder is laid (``mechcorr``: the white
 #: disorder's mean factor 1.5, so that with g on [2/3, 4/3] every element's cohesion is again uniform on [C, 2C])
@@ -1704,6 +1727,41 @@ def correlated(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + M
                                "verdict": v})
     return v
 
+
+def verdict_banded(dbeta: list, part: list) -> dict:
+    """Rule RD25 (r): the band-width regularisation makes the fixed mesh's fall smaller if its part (Δβ with it
+    less Δβ without, paired) has its 90 % interval above 0; (r'): the fall survives it if the regularised set's
+    month-by-month Δβ has its 90 % interval below 0."""
+    m, lo, hi = mean_interval(dbeta)
+    pm, plo, phi = mean_interval(part)
+    return {"n_months": len(dbeta), "dbeta": m, "dbeta_interval_90": [lo, hi], "part": pm,
+            "part_interval_90": [plo, phi], "r_regularisation_reduces_fall": bool(plo > 0.0),
+            "r2_fall_survives": bool(hi < 0.0)}
+
+
+def banded(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE_MONTH_SEEDS) -> dict:
+    """Rule RD25: ``mechband``'s Δβ month by month over sixteen months and its pooled fall, and the
+    regularisation's part, Δβ(``mechband``) − Δβ(``mechanics``), paired by wind seed (RD22's record)."""
+    data = json.loads(JSON.read_text())
+    pooled = pool_windows(month_groups(family, law, "mechband", seeds))
+    mine = dbeta_by_seed(pooled)
+    fall = pooled["20"]["beta_common"] - pooled["10"]["beta_common"]
+    base = {int(k): x for k, x in data["counted"]["dbeta_by_month"]["mechanics"].items()}
+    common = sorted(set(mine) & set(base))
+    v = verdict_banded([mine[sd] for sd in common], [mine[sd] - base[sd] for sd in common])
+    v["fall_pooled_common"] = fall
+    v["months_lower_at_10km"] = int(sum(mine[sd] < 0.0 for sd in common))
+    print(f"mechband: {len(common)} months, pooled β on 20-120 km {pooled['20']['beta_common']:.3f} at 20 km, "
+          f"{pooled['10']['beta_common']:.3f} at 10 km (fall {fall:.3f})")
+    print("rule RD25:", json.dumps(v))
+    _write_json("banded", {"family": family, "law": law, "overrides": MONTH_VARIANTS["mechband"], "months": common,
+                           "dbeta_by_month": {str(sd): mine[sd] for sd in common},
+                           "beta_common": {km: pooled[km]["beta_common"] for km in ("20", "10")},
+                           "beta_common_per_run": {km: pooled[km]["beta_common_per_run"] for km in ("20", "10")},
+                           "mean_total_per_day": {km: pooled[km]["mean_total_per_day"] for km in ("20", "10")},
+                           "verdict": v})
+    return v
+
 #: rule RD14: the spun-up variants whose β is paired with RD9's (``spun``)
 FACTOR_VARIANTS = ("thickspun", "concspun", "meanspun")
 
@@ -1949,7 +2007,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("what", choices=("run", "report", "basin", "fragmentation", "floes", "healing", "factors", "fine",
                                      "realisations", "thermodynamics", "mechanics", "restoring",
-                                     "counted", "moved", "correlated"))
+                                     "counted", "moved", "correlated", "banded"))
     ap.add_argument("groups", nargs="*", help="basin: NAME=RUN,RUN,... (runs in benchmarks/out/physics)")
     ap.add_argument("--family", choices=sorted(FAMILIES), default="lead")
     ap.add_argument("--law", choices=LAWS, default="same_pa")
@@ -1997,6 +2055,9 @@ def main(argv=None) -> int:
         return 0
     if a.what == "counted":
         counted(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
+        return 0
+    if a.what == "banded":
+        banded(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
         return 0
     if a.what == "correlated":
         correlated(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)

@@ -1857,3 +1857,18 @@ def test_disk_convergence_correlated_verdict_and_cohesion():
     lab, lab0 = float(sets["rheology.strength_lab_pa"]), float(base["rheology.strength_lab_pa"])
     assert abs(lab * (1 - amp) - lab0) < 1e-5 * lab0 and abs(lab * (1 + amp) - 2 * lab0) < 1e-5 * lab0
     assert {k: x for k, x in base.items() if k != "rheology.strength_lab_pa"}.items() <= sets.items()
+
+
+def test_disk_convergence_banded_verdict_and_overrides():
+    """Rule RD25: (r) needs the regularisation's part above 0 over its whole interval, (r') the regularised set's
+    fall below 0; the variant is the mechanics with both lengths at 20 km and nothing else changed."""
+    import disk_convergence as dc
+
+    falls = [-0.02, -0.03, -0.01, -0.025, -0.015, -0.02, -0.03, -0.01]
+    v = dc.verdict_banded(falls, [-x for x in falls])
+    assert v["r_regularisation_reduces_fall"] and v["r2_fall_survives"]
+    w = dc.verdict_banded([-x for x in falls], falls)
+    assert not w["r_regularisation_reduces_fall"] and not w["r2_fall_survives"]
+    extra = set(dc.MONTH_VARIANTS["mechband"]) - set(dc.MONTH_VARIANTS["mechanics"])
+    assert extra == {"rheology.damage_length_m=20e3", "rheology.crack_band_length_m=20e3"}
+    assert set(dc.MONTH_VARIANTS["mechanics"]) <= set(dc.MONTH_VARIANTS["mechband"])
