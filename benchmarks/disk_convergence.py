@@ -1692,74 +1692,68 @@ def moved(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE_M
     return v
 
 
+def _fall_and_part(dbeta: list, part: list) -> dict:
+    """Mean month-by-month Δβ and a part (paired differences), each with its 90 % interval."""
+    m, lo, hi = mean_interval(dbeta)
+    pm, plo, phi = mean_interval(part)
+    return {"n_months": len(dbeta), "dbeta": m, "dbeta_interval_90": [lo, hi], "part": pm,
+            "part_interval_90": [plo, phi]}
+
+
 def verdict_correlated(dbeta: list, part: list) -> dict:
     """Rule RD24 (v): the fall on a fixed mesh comes with the white disorder if the disorder's part (Δβ with the
     correlated field less Δβ with the white disorder, paired) has its 90 % interval above 0; (v'): it does not
     need it if the correlated set's month-by-month Δβ has its 90 % interval below 0."""
-    m, lo, hi = mean_interval(dbeta)
-    pm, plo, phi = mean_interval(part)
-    return {"n_months": len(dbeta), "dbeta": m, "dbeta_interval_90": [lo, hi], "part": pm,
-            "part_interval_90": [plo, phi], "v_fall_with_white_disorder": bool(plo > 0.0),
-            "v2_fall_without_white_disorder": bool(hi < 0.0)}
-
-
-def correlated(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE_MONTH_SEEDS) -> dict:
-    """Rule RD24: ``mechcorr``'s Δβ month by month over sixteen months and its pooled fall, and the disorder's
-    part, Δβ(``mechcorr``) − Δβ(``mechanics``), paired by wind seed (the mechanics' months from RD22's record)."""
-    data = json.loads(JSON.read_text())
-    pooled = pool_windows(month_groups(family, law, "mechcorr", seeds))
-    mine = dbeta_by_seed(pooled)
-    fall = pooled["20"]["beta_common"] - pooled["10"]["beta_common"]
-    base = {int(k): x for k, x in data["counted"]["dbeta_by_month"]["mechanics"].items()}
-    common = sorted(set(mine) & set(base))
-    v = verdict_correlated([mine[sd] for sd in common], [mine[sd] - base[sd] for sd in common])
-    v["fall_pooled_common"] = fall
-    v["months_lower_at_10km"] = int(sum(mine[sd] < 0.0 for sd in common))
-    print(f"mechcorr: {len(common)} months, pooled β on 20-120 km {pooled['20']['beta_common']:.3f} at 20 km, "
-          f"{pooled['10']['beta_common']:.3f} at 10 km (fall {fall:.3f})")
-    print("rule RD24:", json.dumps(v))
-    _write_json("correlated", {"family": family, "law": law, "overrides": MONTH_VARIANTS["mechcorr"],
-                               "lab_factor": VARIANT_LAB_FACTOR["mechcorr"], "months": common,
-                               "dbeta_by_month": {str(sd): mine[sd] for sd in common},
-                               "beta_common": {km: pooled[km]["beta_common"] for km in ("20", "10")},
-                               "beta_common_per_run": {km: pooled[km]["beta_common_per_run"] for km in ("20", "10")},
-                               "mean_total_per_day": {km: pooled[km]["mean_total_per_day"] for km in ("20", "10")},
-                               "verdict": v})
-    return v
+    v = _fall_and_part(dbeta, part)
+    return {**v, "v_fall_with_white_disorder": bool(v["part_interval_90"][0] > 0.0),
+            "v2_fall_without_white_disorder": bool(v["dbeta_interval_90"][1] < 0.0)}
 
 
 def verdict_banded(dbeta: list, part: list) -> dict:
     """Rule RD25 (r): the band-width regularisation makes the fixed mesh's fall smaller if its part (Δβ with it
     less Δβ without, paired) has its 90 % interval above 0; (r'): the fall survives it if the regularised set's
     month-by-month Δβ has its 90 % interval below 0."""
-    m, lo, hi = mean_interval(dbeta)
-    pm, plo, phi = mean_interval(part)
-    return {"n_months": len(dbeta), "dbeta": m, "dbeta_interval_90": [lo, hi], "part": pm,
-            "part_interval_90": [plo, phi], "r_regularisation_reduces_fall": bool(plo > 0.0),
-            "r2_fall_survives": bool(hi < 0.0)}
+    v = _fall_and_part(dbeta, part)
+    return {**v, "r_regularisation_reduces_fall": bool(v["part_interval_90"][0] > 0.0),
+            "r2_fall_survives": bool(v["dbeta_interval_90"][1] < 0.0)}
 
 
-def banded(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE_MONTH_SEEDS) -> dict:
-    """Rule RD25: ``mechband``'s Δβ month by month over sixteen months and its pooled fall, and the
-    regularisation's part, Δβ(``mechband``) − Δβ(``mechanics``), paired by wind seed (RD22's record)."""
+def against_mechanics(variant: str, rule: str, verdict, family: str = "lead", law: str = "same_pa",
+                      seeds=MONTH_SEEDS + MORE_MONTH_SEEDS) -> tuple[dict, dict]:
+    """Rules RD24 and RD25: a fixed-mesh variant of the mechanics, its Δβ month by month and pooled fall, and its
+    part, Δβ(``variant``) − Δβ(``mechanics``), paired by wind seed (the mechanics' months from RD22's record);
+    ``verdict(dbeta, part)`` judges them. Returns (verdict, record)."""
     data = json.loads(JSON.read_text())
-    pooled = pool_windows(month_groups(family, law, "mechband", seeds))
+    pooled = pool_windows(month_groups(family, law, variant, seeds))
     mine = dbeta_by_seed(pooled)
     fall = pooled["20"]["beta_common"] - pooled["10"]["beta_common"]
     base = {int(k): x for k, x in data["counted"]["dbeta_by_month"]["mechanics"].items()}
     common = sorted(set(mine) & set(base))
-    v = verdict_banded([mine[sd] for sd in common], [mine[sd] - base[sd] for sd in common])
+    v = verdict([mine[sd] for sd in common], [mine[sd] - base[sd] for sd in common])
     v["fall_pooled_common"] = fall
     v["months_lower_at_10km"] = int(sum(mine[sd] < 0.0 for sd in common))
-    print(f"mechband: {len(common)} months, pooled β on 20-120 km {pooled['20']['beta_common']:.3f} at 20 km, "
+    print(f"{variant}: {len(common)} months, pooled β on 20-120 km {pooled['20']['beta_common']:.3f} at 20 km, "
           f"{pooled['10']['beta_common']:.3f} at 10 km (fall {fall:.3f})")
-    print("rule RD25:", json.dumps(v))
-    _write_json("banded", {"family": family, "law": law, "overrides": MONTH_VARIANTS["mechband"], "months": common,
-                           "dbeta_by_month": {str(sd): mine[sd] for sd in common},
-                           "beta_common": {km: pooled[km]["beta_common"] for km in ("20", "10")},
-                           "beta_common_per_run": {km: pooled[km]["beta_common_per_run"] for km in ("20", "10")},
-                           "mean_total_per_day": {km: pooled[km]["mean_total_per_day"] for km in ("20", "10")},
-                           "verdict": v})
+    print(f"rule {rule}:", json.dumps(v))
+    record = {"family": family, "law": law, "overrides": MONTH_VARIANTS[variant], "months": common,
+              "dbeta_by_month": {str(sd): mine[sd] for sd in common},
+              "beta_common": {km: pooled[km]["beta_common"] for km in ("20", "10")},
+              "beta_common_per_run": {km: pooled[km]["beta_common_per_run"] for km in ("20", "10")},
+              "mean_total_per_day": {km: pooled[km]["mean_total_per_day"] for km in ("20", "10")}}
+    return v, record
+
+
+def correlated(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE_MONTH_SEEDS) -> dict:
+    """Rule RD24: ``mechcorr`` (the disorder correlated over 40 km) against the mechanics."""
+    v, record = against_mechanics("mechcorr", "RD24", verdict_correlated, family, law, seeds)
+    _write_json("correlated", {**record, "lab_factor": VARIANT_LAB_FACTOR["mechcorr"], "verdict": v})
+    return v
+
+
+def banded(family: str = "lead", law: str = "same_pa", seeds=MONTH_SEEDS + MORE_MONTH_SEEDS) -> dict:
+    """Rule RD25: ``mechband`` (a damage time and a crack band of 20 km) against the mechanics."""
+    v, record = against_mechanics("mechband", "RD25", verdict_banded, family, law, seeds)
+    _write_json("banded", {**record, "verdict": v})
     return v
 
 #: rule RD14: the spun-up variants whose β is paired with RD9's (``spun``)
