@@ -526,6 +526,15 @@ mechanics' months from RD22's record).
   Predicted: (r) fails and (r') holds, with a Δβ of −0.008 to −0.020: each length alone left the basin's fall.
   Then a band's width is not the cause in the form these two lengths can reach.
 
+  Result (18:06 UTC): (r) fails and (r') holds, as predicted, but the fall is larger than predicted and the
+  regularisation's part has the other sign: with both lengths at 20 km the mechanics' Δβ is −0.028 (90 % interval
+  −0.042 to −0.015), lower at 10 km in 12 of 16 months; pooled β on 20–120 km 0.154 at 20 km and 0.126 at 10 km
+  (a fall of 0.028). The part is −0.018 (−0.034 to −0.003): shown, and it makes the fall larger. The lengths
+  change the 20 km mesh too (its elements' √area is about 13 km, so ℓ = 20 km slows its damage and speeds its
+  bands' relaxation): they raise its β (0.154 against the mechanics' 0.131 over RD20's months) and leave the
+  10 km β where it was. So giving the damage law's two lengths a physical size does not make β the same on both
+  meshes; the fall is not the element size entering td and λ.
+
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
     python benchmarks/disk_convergence.py run --family shipped --law same_pa --more-seeds --jobs 2
