@@ -532,8 +532,9 @@ mechanics' months from RD22's record).
   (a fall of 0.028). The part is −0.018 (−0.034 to −0.003): shown, and it makes the fall larger. The lengths
   change the 20 km mesh too (its elements' √area is about 13 km, so ℓ = 20 km slows its damage and speeds its
   bands' relaxation): over RD20's eight months, whose runs per month are in its record, they raise the 20 km β
-  by 0.017 on average (0.148 against 0.131) and lower the 10 km β by 0.008 (0.120 against 0.128). So giving the damage law's two lengths a physical size does not make β the same on both
-  meshes; the fall is not the element size entering td and λ.
+  by 0.017 on average (0.148 against 0.131) and lower the 10 km β by 0.008 (0.120 against 0.128). So giving the
+  damage law's two lengths a physical size does not make β the same on both meshes; the fall is not the element
+  size entering td and λ.
 
     python benchmarks/disk_convergence.py run --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py run --family lead --law same_pa --more-seeds --jobs 2   # RD2
