@@ -2054,29 +2054,14 @@ def main(argv=None) -> int:
     if a.what == "factors":
         factors(a.family, a.law)
         return 0
-    if a.what == "mechanics":
-        mechanics(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS)
-        return 0
-    if a.what == "counted":
-        counted(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
-        return 0
-    if a.what == "banded":
-        banded(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
-        return 0
-    if a.what == "correlated":
-        correlated(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
-        return 0
-    if a.what == "moved":
-        moved(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
-        return 0
-    if a.what == "restoring":
-        restoring(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS)
-        return 0
-    if a.what == "thermodynamics":
-        thermodynamics(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
-        return 0
-    if a.what == "healing":
-        healing(a.family, a.law, tuple(a.seeds) if a.seeds else MONTH_SEEDS + MORE_MONTH_SEEDS)
+    # the month-set analyses: (function, the wind seeds it reads by default)
+    analyses = {"mechanics": (mechanics, MONTH_SEEDS), "restoring": (restoring, MONTH_SEEDS),
+                **{name: (fn, MONTH_SEEDS + MORE_MONTH_SEEDS)
+                   for name, fn in (("counted", counted), ("banded", banded), ("correlated", correlated),
+                                    ("moved", moved), ("thermodynamics", thermodynamics), ("healing", healing))}}
+    if a.what in analyses:
+        fn, default_seeds = analyses[a.what]
+        fn(a.family, a.law, tuple(a.seeds) if a.seeds else default_seeds)
         return 0
     if a.stage == "month" and a.what == "report":
         report_month(a.family, a.law, a.variant, tuple(a.seeds) if a.seeds else MONTH_SEEDS)
