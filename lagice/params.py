@@ -92,7 +92,8 @@ class MaxwellEBParams:
             bell-shaped weight of Bažant and Jirásek (2002), so a crack is at least about R wide
             whatever the mesh (:mod:`lagice.solvers.nonlocal_damage`). Explicit CPU stepper only,
             with the default stress path (origin correction, whole stress relaxing, no
-            compressive term, no dilatancy)
+            compressive term, no dilatancy); with any ``failure_stress`` (since 2026-12-02: the
+            ratio averaged is then the effective stress's)
         damage_length_m: ℓ [m] of the damage time td = ℓ/cs, the same for every element (None or 0:
             off, the default: td = Δx/cs with Δx = √(2 A) the element's own size, Dansereau et al.
             2016 §3.1.1, as neXtSIM does). A rate-dependent damage law has a length of its own, the
@@ -123,13 +124,13 @@ class MaxwellEBParams:
             "Broken ice that keeps no cohesion"): the effective stress σ/(1 − d) of continuum
             damage mechanics (Kachanov 1958; Lemaitre 1985), so the cohesion and the tensile
             strength of an element are C (1 − d) and the friction μ is kept: broken ice holds by
-            friction alone, as a fault does. Explicit CPU stepper and implicit solver, with the
-            local damage (no ``damage_nonlocal_radius_m``). ``"energy"`` (a diagnostic of
+            friction alone, as a fault does. Explicit CPU stepper (local or nonlocal damage) and
+            implicit solver (local damage). ``"energy"`` (a diagnostic of
             lagice, 2026-11-30; docs/physics.md §4, "Broken ice that keeps part of its cohesion"):
             the effective stress of the hypothesis of strain-energy equivalence (Cordebois and
             Sidoroff 1982): with lagice's modulus E0 (1 − d) that effective stress is σ/√(1 − d),
             so the cohesion and tensile strength are C √(1 − d), friction kept. Explicit CPU
-            stepper and implicit solver, local damage
+            stepper (local or nonlocal damage) and implicit solver (local damage)
         crack_closure: False (Dansereau et al. 2016, neXtSIM; the default): damage lowers the
             modulus for every strain. True (a diagnostic of lagice, 2026-11-28; docs/physics.md §4,
             "Broken ice whose cracks close"): quasi-unilateral damage (Ladevèze and Lemaitre 1984,
@@ -219,10 +220,6 @@ class MaxwellEBParams:
         if self.failure_stress not in FAILURE_STRESSES:
             raise ConfigError(f"rheology.failure_stress = {self.failure_stress!r}: expected one of "
                               f"{list(FAILURE_STRESSES)}")
-        if self.failure_stress != "nominal" and self.damage_nonlocal_radius_m:
-            raise ConfigError(f"rheology.failure_stress = {self.failure_stress!r} is implemented with the local "
-                              f"damage only; it is set with damage_nonlocal_radius_m = "
-                              f"{self.damage_nonlocal_radius_m!r} m")
         if not isinstance(self.crack_closure, bool):
             raise ConfigError(f"rheology.crack_closure = {self.crack_closure!r}: expected true or false")
         if self.crack_closure and self.relax_mean_stress:

@@ -1872,3 +1872,22 @@ def test_disk_convergence_banded_verdict_and_overrides():
     extra = set(dc.MONTH_VARIANTS["mechband"]) - set(dc.MONTH_VARIANTS["mechanics"])
     assert extra == {"rheology.damage_length_m=20e3", "rheology.crack_band_length_m=20e3"}
     assert set(dc.MONTH_VARIANTS["mechanics"]) <= set(dc.MONTH_VARIANTS["mechband"])
+
+
+def test_disk_convergence_averaged_verdict_and_overrides():
+    """Rule RD26: (a) needs the averaging's part above 0 over its whole interval, (a') the averaged set's fall
+    below 0; the variant is the mechanics with R = 40 km and nothing else changed, and its analysis reads the
+    eight months chosen in the rule by default."""
+    import disk_convergence as dc
+
+    falls = [-0.02, -0.03, -0.01, -0.025, -0.015, -0.02, -0.03, -0.01]
+    v = dc.verdict_averaged(falls, [-x for x in falls])
+    assert v["a_averaging_reduces_fall"] and v["a2_fall_survives"]
+    w = dc.verdict_averaged([-x for x in falls], falls)
+    assert not w["a_averaging_reduces_fall"] and not w["a2_fall_survives"]
+    extra = set(dc.MONTH_VARIANTS["mechnl"]) - set(dc.MONTH_VARIANTS["mechanics"])
+    assert extra == {"rheology.damage_nonlocal_radius_m=40e3"}
+    assert set(dc.MONTH_VARIANTS["mechanics"]) <= set(dc.MONTH_VARIANTS["mechnl"])
+    cmd = dc.command("lead", "same_pa", 10, 2034, "month", "mechnl")
+    assert "rheology.failure_stress=effective" in cmd and "rheology.damage_nonlocal_radius_m=40e3" in cmd
+    assert dc.averaged.__defaults__[-1] == tuple(range(2034, 2042))

@@ -199,12 +199,11 @@ def test_effective_failure_stress(kernel):
     # (2) random stresses: the same as the nominal kernel with C (1 − d), and the implicit update agrees
     _check_scaled_cohesion(kernel, rheo, rng, 1.0, coh, d, lambda d: 1.0 - d)
     # (3) implemented in the CPU and CUDA steppers and the implicit solver (the CUDA kernel against
-    # this one: tests/test_cuda_explicit.py, simulator variants "effective*"), not with the nonlocal damage
+    # this one: tests/test_cuda_explicit.py, simulator variants "effective*"); with the nonlocal damage
+    # in the CPU stepper (tests/test_nonlocal_damage.py)
     rheo.require_stepper("explicit_cuda")
     rheo.require_stepper("explicit")
     rheo.require_stepper("implicit")
-    with pytest.raises(ConfigError, match="failure_stress = 'effective' is implemented with the local damage"):
-        MaxwellEB(failure_stress="effective", damage_nonlocal_radius_m=2e4)
     with pytest.raises(ConfigError, match="rheology.failure_stress = 'plastic': expected one of"):
         MaxwellEB(failure_stress="plastic")
 

@@ -137,8 +137,8 @@ def test_an_element_damages_exactly_where_its_neighbourhood_is_overloaded():
     assert np.allclose(st.stress[damaged][0], sigma0 * f, rtol=1e-12)
 
 
-def _sheared(mesh, radius, parallel=False, n_steps=30):
-    rheo = MaxwellEB(healing_time_s=None, damage_nonlocal_radius_m=radius)
+def _sheared(mesh, radius, parallel=False, n_steps=30, **rheology):
+    rheo = MaxwellEB(healing_time_s=None, damage_nonlocal_radius_m=radius, **rheology)
     s = ExplicitSolver(rheo, mesh, bcs=[VelocityBC("bottom", u=0.0, v=0.0), VelocityBC("top", u=0.02)],
                        parallel=parallel)
     st = IceState.uniform(mesh, cohesion_pa=2e3)
@@ -161,6 +161,27 @@ def test_a_radius_below_the_element_spacing_is_the_local_scheme(plate):
     wide = _sheared(plate, 3e3)
     assert np.abs(wide.damage - local.damage).max() > 0.1
     par = _sheared(plate, 3e3, parallel=True)
+    assert np.array_equal(par.damage, wide.damage) and np.array_equal(par.stress, wide.stress)
+
+
+@pytest.mark.parametrize("failure_stress", ["effective", "energy"])
+def test_the_nonlocal_ratio_judges_the_effective_stress_where_asked(plate, failure_stress):
+    """``failure_stress`` other than nominal with the nonlocal damage (2026-12-02): the ratio
+    averaged is the effective stress's, L/(1 − d)^p. With R = 1 m the run equals the local
+    kernel's with the same failure stress to round-off, and differs from the nominal
+    nonlocal run (so the damage of the sub-step's start does enter the ratio); with
+    R = 3 km it differs from the local run, and parallel equals serial bit for bit."""
+    cap = {"failure_stress": failure_stress, "max_damage": 0.97}
+    local = _sheared(plate, None, **cap)
+    assert (local.damage > 0.5).mean() > 0.15
+    tiny = _sheared(plate, 1.0, **cap)
+    assert np.abs(tiny.damage - local.damage).max() < 1e-10
+    assert np.abs(tiny.stress - local.stress).max() < 1e-10 * np.abs(local.stress).max()
+    nominal = _sheared(plate, 1.0, max_damage=0.97)
+    assert np.abs(nominal.damage - local.damage).max() > 0.05
+    wide = _sheared(plate, 3e3, **cap)
+    assert np.abs(wide.damage - local.damage).max() > 0.1
+    par = _sheared(plate, 3e3, parallel=True, **cap)
     assert np.array_equal(par.damage, wide.damage) and np.array_equal(par.stress, wide.stress)
 
 

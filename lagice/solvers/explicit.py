@@ -490,12 +490,15 @@ def _node_divergence(vel, ptr, elems, tri, b, c, area, divn):
         divn[i] = s / a
 
 
-def _element_trial_load(tri, b, c, vel, sigma, e_dt, gamma, cohesion, kxx, kxy, kss, q, denom, load):
+def _element_trial_load(tri, b, c, vel, sigma, e_dt, gamma, cohesion, damage, eff, kxx, kxy, kss, q, denom, load):
     """First pass of a sub-step with the nonlocal damage (rheology.damage_nonlocal_radius_m;
     :mod:`lagice.solvers.nonlocal_damage`): the Maxwell stress update of
     :func:`_element_stress_damage` (the default path: the whole stress relaxes, origin
     correction, no compressive term) and the element's load ratio
-    L = max(0, s1/σT, (q s1 − s2)/σc) into ``load``; no damage yet."""
+    L = max(0, s1/σT, (q s1 − s2)/σc) into ``load``; no damage yet. ``eff`` as in
+    :func:`_element_stress_damage` (None: σT and σc of the cohesion C; a power p: of
+    C (1 − d)^p, d the damage at the start of the sub-step, so L is the effective stress's
+    ratio, (1 − d)^−p times the nominal one)."""
     m = tri.shape[0]
     for e in prange(m):
         exx, eyy, exy = element_strain_rate(tri, b, c, vel, e)
@@ -511,7 +514,15 @@ def _element_trial_load(tri, b, c, vel, sigma, e_dt, gamma, cohesion, kxx, kxy, 
         r = math.sqrt(0.25 * (sxx - syy) ** 2 + sxy * sxy)
         s1 = mm + r
         s2 = mm - r
-        sc = 2.0 * cohesion[e] / denom
+        ce = cohesion[e]
+        if eff is not None:  # pruned when None (rheology.failure_stress = "nominal")
+            if eff == 1.0:
+                ce = ce * (1.0 - damage[e])
+            elif eff == 0.5:
+                ce = ce * math.sqrt(1.0 - damage[e])
+            else:
+                ce = ce * (1.0 - damage[e]) ** eff
+        sc = 2.0 * ce / denom
         st = sc / q
         ld = 0.0
         if s1 > 0.0:
@@ -654,15 +665,16 @@ element_nonlocal_damage_kernel_serial = _serial(_element_nonlocal_damage)
 
 @njit(cache=True, error_model="numpy")
 def substeps_nonlocal_serial(n_sub, vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1, tri,
-                             b, c, damage, conc_factor, coh, td, heal, e_dt, gamma, dt_s, kxx, kxy, kss, q, denom,
-                             max_damage, E0, lambda0, alpha, flag, nl_ptr, nl_idx, nl_w, load, mark):
+                             b, c, damage, conc_factor, coh, eff, td, heal, e_dt, gamma, dt_s, kxx, kxy, kss, q,
+                             denom, max_damage, E0, lambda0, alpha, flag, nl_ptr, nl_idx, nl_w, load, mark):
     """The sub-step loop with the nonlocal damage (:mod:`lagice.solvers.nonlocal_damage`):
     node kernel, then the two element passes (serial builds)."""
     n_capped = 0
     for k in range(n_sub):
         node_velocity_kernel_serial(vel, vel_sum, sigma, ptr, elems, w, nc, cos_t, sin_t, fixed, pres0, pres1,
                                     (k + 1) / n_sub)
-        element_trial_load_kernel_serial(tri, b, c, vel, sigma, e_dt, gamma, coh, kxx, kxy, kss, q, denom, load)
+        element_trial_load_kernel_serial(tri, b, c, vel, sigma, e_dt, gamma, coh, damage, eff, kxx, kxy, kss, q,
+                                         denom, load)
         mark_overloaded_neighbourhoods(nl_ptr, nl_idx, load, mark)
         n_capped += element_nonlocal_damage_kernel_serial(nl_ptr, nl_idx, nl_w, load, mark, sigma, damage,
                                                           conc_factor, td, heal, e_dt, gamma, dt_s, max_damage, E0,
@@ -1171,7 +1183,7 @@ class ExplicitSolver:
             nl_ptr, nl_idx, nl_w = self.nonlocal_weights.update(tri, mesh.nodes, ns.area)
             n_capped = SUBSTEPS_NONLOCAL[int(par)](
                 n_sub, vel, vel_sum, sigma, ptr32, elems32, w_adj, nc, terms.cos_turn, terms.sin_turn, ns.fixed,
-                pres0, pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, self.td, heal, e_dt, gamma, dt_s, kxx,
+                pres0, pres1, tri32, ns.b, ns.c, damage, conc_factor, coh, eff, self.td, heal, e_dt, gamma, dt_s, kxx,
                 kxy, kss, rh.q, rh._denom, p.max_damage, p.E0, p.relaxation_time_s, float(p.alpha), flag, nl_ptr,
                 nl_idx, nl_w, np.empty(mesh.n_elements, np.float64), np.empty(mesh.n_elements, np.int8))
         elif cr is not None and self._jump is not None:
