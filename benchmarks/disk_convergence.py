@@ -613,6 +613,13 @@ wind seed (the mechanics' months from RD22's record); also β on each mesh again
   the mechanics' months regressing; the same eight months gave the moving mesh a fall of −0.027 (RD23) and the
   other eight −0.011, so these months' larger falls are mostly their weather's.
 
+  Result (21:25 UTC): (a) fails and (a') holds, against the prediction. With the load ratio averaged over 40 km
+  the mechanics' Δβ is −0.019 (90 % interval −0.035 to −0.002), lower at 10 km in 5 of 8 months; pooled β on
+  20–120 km 0.091 at 20 km and 0.074 at 10 km (a fall of 0.017). The averaging's part is −0.002 (−0.024 to
+  +0.018): none. It lowers β on both meshes alike, by 0.054 at 20 km (−0.080 to −0.025) and 0.056 at 10 km
+  (−0.068 to −0.044), against the mechanics' same months. So bands at least 40 km wide on both meshes keep the
+  fall: it is not the bands' width of one element either.
+
     python benchmarks/disk_convergence.py run --stage month --variant mechnl --seeds 2034 2035 2036 2037 2038 \
         2039 2040 2041 --family lead --law same_pa --jobs 2
     python benchmarks/disk_convergence.py averaged                                                    # RD26
